@@ -1,0 +1,135 @@
+#include "calib/bounds.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include <glog/logging.h>
+
+#include "calib/input_error.h"
+
+namespace raycarve {
+namespace {
+
+// Value at quantile q of `values` (0 <= q <= 1), nearest rank; `values` is reordered.
+double Quantile(std::vector<double>* values, double q) {
+  const size_t index = std::min(values->size() - 1,
+                                static_cast<size_t>(std::floor(q * (values->size() - 1) + 0.5)));
+  std::nth_element(values->begin(), values->begin() + index, values->end());
+  return (*values)[index];
+}
+
+}  // namespace
+
+bool BoundsOptions::IsValid(std::string* reason) const {
+  if (min_track_length < 0) {
+    *reason = "min_track_length must be >= 0";
+    return false;
+  }
+  if (!(trim_fraction >= 0.0 && trim_fraction < 0.5)) {
+    *reason = "trim_fraction must be in [0, 0.5)";
+    return false;
+  }
+  if (!(margin >= 0.0 && std::isfinite(margin))) {
+    *reason = "margin must be finite and >= 0";
+    return false;
+  }
+  if (std::isnan(max_reprojection_error)) {
+    *reason = "max_reprojection_error must be a number";
+    return false;
+  }
+  return true;
+}
+
+std::string Bounds::Summary() const {
+  std::ostringstream text;
+  text.precision(6);
+  text << "bounds: min (" << box.min().transpose() << ") max (" << box.max().transpose()
+       << ") extent (" << box.sizes().transpose() << ")";
+  if (is_explicit) {
+    text << ", given explicitly";
+  } else {
+    text << ", from " << num_used << " of " << num_points << " sparse points (" << num_short_track
+         << " short tracks, " << num_high_error << " high error dropped; " << num_trimmed_outside
+         << " trimmed as outliers)";
+  }
+  return text.str();
+}
+
+Bounds ComputeBounds(const Reconstruction& reconstruction,
+                     const BoundsOptions& options,
+                     const std::string& source) {
+  std::string reason;
+  CHECK(options.IsValid(&reason)) << reason;
+  Bounds bounds;
+  bounds.num_points = static_cast<int>(reconstruction.points3D.size());
+  if (reconstruction.points3D.empty()) {
+    throw InputError(source +
+                     ": the model has no 3D points, so they cannot bound the volume; give an "
+                     "explicit box (--bbox)");
+  }
+  std::vector<Eigen::Vector3d> used;
+  for (const auto& [point3D_id, point3D] : reconstruction.points3D) {
+    if (static_cast<int>(point3D.track.size()) < options.min_track_length) {
+      ++bounds.num_short_track;
+    } else if (options.max_reprojection_error > 0.0 &&
+               point3D.error > options.max_reprojection_error) {
+      ++bounds.num_high_error;
+    } else {
+      used.push_back(point3D.xyz);
+    }
+  }
+  bounds.num_used = static_cast<int>(used.size());
+  if (used.empty()) {
+    std::ostringstream message;
+    message << source << ": all " << bounds.num_points << " 3D points were filtered out ("
+            << bounds.num_short_track << " with track length < " << options.min_track_length
+            << ", " << bounds.num_high_error << " with error > " << options.max_reprojection_error
+            << " px); relax the filters or give an explicit box (--bbox)";
+    throw InputError(message.str());
+  }
+  Eigen::Vector3d min, max;
+  std::vector<double> values(used.size());
+  for (int axis = 0; axis < 3; ++axis) {
+    for (size_t i = 0; i < used.size(); ++i) values[i] = used[i][axis];
+    min[axis] = Quantile(&values, options.trim_fraction);
+    max[axis] = Quantile(&values, 1.0 - options.trim_fraction);
+  }
+  bounds.box = Eigen::AlignedBox3d(min, max);
+  for (const Eigen::Vector3d& point : used) {
+    if (!bounds.box.contains(point)) ++bounds.num_trimmed_outside;
+  }
+  const double extent = bounds.box.sizes().maxCoeff();
+  if (!(extent > 0.0)) {
+    throw InputError(source + ": the " + std::to_string(bounds.num_used) +
+                     " usable 3D points span no volume; give an explicit box (--bbox)");
+  }
+  // A flat axis (all points on a plane) still gets the margin, so the box has volume.
+  const Eigen::Vector3d pad = Eigen::Vector3d::Constant(options.margin * extent);
+  bounds.box = Eigen::AlignedBox3d(min - pad, max + pad);
+  if (!(bounds.box.sizes().minCoeff() > 0.0)) {
+    throw InputError(source + ": the 3D points are flat along an axis and margin is 0; give a "
+                              "margin or an explicit box (--bbox)");
+  }
+  return bounds;
+}
+
+Bounds ExplicitBounds(const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
+  if (!min.allFinite() || !max.allFinite()) {
+    throw InputError("--bbox: coordinates must be finite numbers");
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(min[axis] < max[axis])) {
+      throw InputError("--bbox: min must be below max on every axis (axis " +
+                       std::to_string(axis) + ": " + std::to_string(min[axis]) +
+                       " >= " + std::to_string(max[axis]) + ")");
+    }
+  }
+  Bounds bounds;
+  bounds.box = Eigen::AlignedBox3d(min, max);
+  bounds.is_explicit = true;
+  return bounds;
+}
+
+}  // namespace raycarve

@@ -1,0 +1,52 @@
+#pragma once
+
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "calib/reconstruction.h"
+
+namespace raycarve {
+
+// How the volume to carve is bounded from a model's sparse points. Sparse SfM points contain
+// outliers (mismatches, points on the background far behind the object), so the box is robust:
+// points are filtered by track length and reprojection error, each axis is trimmed at quantiles,
+// and a margin is added.
+struct BoundsOptions {
+  // Points seen in fewer images than this are ignored.
+  int min_track_length = 2;
+  // Points whose mean reprojection error (pixels) exceeds this are ignored; <= 0 disables.
+  double max_reprojection_error = 2.0;
+  // Fraction of the remaining points dropped at each end of each axis (0 keeps the extremes).
+  double trim_fraction = 0.01;
+  // Added on every side, as a fraction of the trimmed box's largest extent.
+  double margin = 0.1;
+
+  // False, with the reason, when a field is out of its range.
+  bool IsValid(std::string* reason) const;
+};
+
+struct Bounds {
+  Eigen::AlignedBox3d box;
+  bool is_explicit = false;     // given by the user, not computed
+  int num_points = 0;           // points in the model
+  int num_used = 0;             // points that passed the filters
+  int num_short_track = 0;      // dropped for track length
+  int num_high_error = 0;       // dropped for reprojection error
+  int num_trimmed_outside = 0;  // used points outside the trimmed box (before the margin)
+
+  std::string Summary() const;
+};
+
+// Bounds of `reconstruction`'s sparse points with `options` (which must be valid, CHECKed).
+// Throws InputError naming `source` when the model has no 3D points, when the filters leave none
+// (saying how many each filter dropped), or when the points span no volume.
+Bounds ComputeBounds(const Reconstruction& reconstruction,
+                     const BoundsOptions& options,
+                     const std::string& source);
+
+// An explicit box (for --bbox): throws InputError when a coordinate is not finite or min >= max
+// on an axis.
+Bounds ExplicitBounds(const Eigen::Vector3d& min, const Eigen::Vector3d& max);
+
+}  // namespace raycarve

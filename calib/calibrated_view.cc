@@ -1,0 +1,54 @@
+#include "calib/calibrated_view.h"
+
+#include <glog/logging.h>
+
+#include "calib/input_error.h"
+#include "calib/undistortion.h"
+
+namespace raycarve {
+
+Eigen::Vector2d CalibratedView::Project(const Eigen::Vector3d& world) const {
+  const Eigen::Vector3d projected = P * world.homogeneous();
+  return projected.hnormalized();
+}
+
+double CalibratedView::Depth(const Eigen::Vector3d& world) const {
+  return (cam_from_world * world).z();
+}
+
+CalibratedView MakeCalibratedView(const Camera& camera,
+                                  const Image& image,
+                                  const cv::Mat& rgb,
+                                  const std::string& source) {
+  CHECK_EQ(rgb.type(), CV_8UC3);
+  if (static_cast<uint64_t>(rgb.cols) != camera.width ||
+      static_cast<uint64_t>(rgb.rows) != camera.height) {
+    throw InputError(source + ": photo of image " + std::to_string(image.image_id) + " is " +
+                     std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows) + " but camera " +
+                     std::to_string(camera.camera_id) + " says " + std::to_string(camera.width) +
+                     "x" + std::to_string(camera.height));
+  }
+  CalibratedView view;
+  view.image_id = image.image_id;
+  view.name = image.name;
+  view.width = rgb.cols;
+  view.height = rgb.rows;
+  view.cam_from_world = image.cam_from_world;
+  view.cam_from_world.rotation.normalize();
+  view.centre = view.cam_from_world.Inverse().translation;
+
+  const Camera pinhole = PinholeCameraFor(camera);
+  view.K << pinhole.params[0], 0.0, pinhole.params[2], 0.0, pinhole.params[1], pinhole.params[3],
+      0.0, 0.0, 1.0;
+  view.P = view.K * view.cam_from_world.ToMatrix();
+
+  if (CameraModelHasDistortion(camera.model)) {
+    UndistortImage(BuildUndistortionMaps(camera), rgb, &view.image, &view.valid);
+  } else {
+    view.image = rgb.clone();
+    view.valid = cv::Mat(rgb.rows, rgb.cols, CV_8UC1, cv::Scalar(255));
+  }
+  return view;
+}
+
+}  // namespace raycarve

@@ -1,0 +1,42 @@
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "calib/reconstruction.h"
+
+namespace raycarve {
+
+// A registered image ready for carving: undistorted pixels and an ideal pinhole camera.
+//
+// Frames and units: world coordinates of the model; pixels in COLMAP's convention (the centre of
+// cv::Mat element (row r, col c) is (c + 0.5, r + 0.5), see pixel.h).
+struct CalibratedView {
+  image_t image_id = 0;
+  std::string name;
+  int width = 0;
+  int height = 0;
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();  // pinhole intrinsics
+  Rigid3d cam_from_world;
+  Eigen::Matrix<double, 3, 4> P = Eigen::Matrix<double, 3, 4>::Zero();  // K [R | t]
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // camera centre in world coordinates
+  cv::Mat image;  // CV_8UC3, RGB order, undistorted
+  cv::Mat valid;  // CV_8UC1, 255 where `image` holds a photo pixel (0 beyond the distorted frame)
+
+  // Pixel (COLMAP convention) of a world point; meaningless for points with Depth() <= 0.
+  Eigen::Vector2d Project(const Eigen::Vector3d& world) const;
+  // Depth along the optical axis (camera z) of a world point.
+  double Depth(const Eigen::Vector3d& world) const;
+};
+
+// Builds the view of `image` (seen by `camera`) from its photo `rgb` (CV_8UC3 RGB as decoded).
+// Cameras with distortion are resampled to PinholeCameraFor(camera). Throws InputError naming
+// `source` (the photo's path) when the photo's size differs from the camera's.
+CalibratedView MakeCalibratedView(const Camera& camera,
+                                  const Image& image,
+                                  const cv::Mat& rgb,
+                                  const std::string& source);
+
+}  // namespace raycarve

@@ -1,0 +1,59 @@
+#include "calib/camera.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "calib/input_error.h"
+
+namespace raycarve {
+namespace {
+
+bool HasSingleFocal(CameraModelId model) {
+  const std::string info = CameraModelParamsInfo(model);
+  return info.rfind("f,", 0) == 0;
+}
+
+}  // namespace
+
+Eigen::Vector2d Camera::ImgFromCam(const Eigen::Vector2d& normalized) const {
+  return raycarve::ImgFromCam(model, params, normalized);
+}
+
+Eigen::Vector2d Camera::CamFromImg(const Eigen::Vector2d& pixel) const {
+  return raycarve::CamFromImg(model, params, pixel);
+}
+
+double Camera::FocalLengthX() const { return params.at(0); }
+
+double Camera::FocalLengthY() const { return HasSingleFocal(model) ? params.at(0) : params.at(1); }
+
+Eigen::Vector2d Camera::PrincipalPoint() const {
+  return HasSingleFocal(model) ? Eigen::Vector2d(params.at(1), params.at(2))
+                               : Eigen::Vector2d(params.at(2), params.at(3));
+}
+
+void ValidateCamera(const Camera& camera, const std::string& context) {
+  const int expected = CameraModelNumParams(camera.model);
+  std::ostringstream prefix;
+  prefix << context << ": camera " << camera.camera_id << " (" << CameraModelName(camera.model)
+         << ")";
+  if (static_cast<int>(camera.params.size()) != expected) {
+    throw InputError(prefix.str() + ": params: expected " + std::to_string(expected) + " (" +
+                     CameraModelParamsInfo(camera.model) + "), found " +
+                     std::to_string(camera.params.size()));
+  }
+  for (size_t i = 0; i < camera.params.size(); ++i) {
+    if (!std::isfinite(camera.params[i])) {
+      throw InputError(prefix.str() + ": params[" + std::to_string(i) + "] is not finite");
+    }
+  }
+  if (camera.width == 0 || camera.height == 0) {
+    throw InputError(prefix.str() + ": width/height must be positive, found " +
+                     std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  }
+  if (!(camera.FocalLengthX() > 0.0) || !(camera.FocalLengthY() > 0.0)) {
+    throw InputError(prefix.str() + ": focal length must be positive");
+  }
+}
+
+}  // namespace raycarve

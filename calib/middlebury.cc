@@ -1,0 +1,157 @@
+#include "calib/middlebury.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <locale>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <glog/logging.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "calib/input_error.h"
+
+namespace raycarve {
+namespace {
+
+constexpr int kNumValues = 21;
+const char* const kFieldNames[kNumValues] = {"k11", "k12", "k13", "k21", "k22", "k23", "k31",
+                                             "k32", "k33", "r11", "r12", "r13", "r21", "r22",
+                                             "r23", "r31", "r32", "r33", "t1",  "t2",  "t3"};
+
+}  // namespace
+
+bool MiddleburyImportOptions::IsValid(std::string* reason) const {
+  if (!std::isfinite(principal_point_offset) || std::abs(principal_point_offset) > 1.0) {
+    *reason = "principal_point_offset must be a finite number of at most one pixel";
+    return false;
+  }
+  return true;
+}
+
+Reconstruction ReadMiddleburyParameters(
+    std::istream& stream,
+    const std::string& source,
+    const std::function<Eigen::Vector2i(const std::string& name)>& image_size,
+    const MiddleburyImportOptions& options) {
+  std::string reason;
+  CHECK(options.IsValid(&reason)) << reason;
+  stream.imbue(std::locale::classic());
+  std::string line;
+  int line_number = 0;
+  auto fail = [&](const std::string& field, const std::string& what) {
+    throw InputError(source + ": line " + std::to_string(line_number) + ": field '" + field +
+                     "': " + what);
+  };
+  long long count = -1;
+  while (std::getline(stream, line)) {
+    ++line_number;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::istringstream parse(line);
+    parse.imbue(std::locale::classic());
+    if (!(parse >> count) || count <= 0) fail("number of images", "must be a positive integer");
+    break;
+  }
+  if (count < 0) throw InputError(source + ": empty file: no number of images on the first line");
+
+  Reconstruction reconstruction;
+  std::set<std::string> names;
+  image_t next_image_id = 1;
+  while (std::getline(stream, line)) {
+    ++line_number;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    if (static_cast<long long>(names.size()) == count) {
+      fail("name", "more image lines than the count " + std::to_string(count) + " on line 1");
+    }
+    std::istringstream parse(line);
+    parse.imbue(std::locale::classic());
+    std::string name;
+    parse >> name;
+    double values[kNumValues];
+    for (int k = 0; k < kNumValues; ++k) {
+      std::string token;
+      if (!(parse >> token)) fail(kFieldNames[k], "missing");
+      std::istringstream number(token);
+      number.imbue(std::locale::classic());
+      if (!(number >> values[k]) || !number.eof() || !std::isfinite(values[k])) {
+        fail(kFieldNames[k], "'" + token + "' is not a finite number");
+      }
+    }
+    if (!names.insert(name).second) fail("name", "duplicate image name '" + name + "'");
+
+    Eigen::Matrix3d K, R;
+    K << values[0], values[1], values[2], values[3], values[4], values[5], values[6], values[7],
+        values[8];
+    R << values[9], values[10], values[11], values[12], values[13], values[14], values[15],
+        values[16], values[17];
+    const Eigen::Vector3d t(values[18], values[19], values[20]);
+    if (K(0, 1) != 0.0 || K(1, 0) != 0.0) fail("k12", "non-zero skew cannot be a PINHOLE camera");
+    if (K(2, 0) != 0.0 || K(2, 1) != 0.0 || K(2, 2) != 1.0) {
+      fail("k31..k33", "the last row of K must be (0 0 1)");
+    }
+    if (!(K(0, 0) > 0.0) || !(K(1, 1) > 0.0)) fail("k11", "focal lengths must be positive");
+    if (!(R * R.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-6) ||
+        std::abs(R.determinant() - 1.0) > 1e-6) {
+      fail("r11..r33", "R is not a rotation matrix");
+    }
+    const Eigen::Vector2i size = image_size(name);
+
+    Camera camera;
+    camera.model = CameraModelId::kPinhole;
+    camera.width = size.x();
+    camera.height = size.y();
+    camera.params = {K(0, 0),
+                     K(1, 1),
+                     K(0, 2) + options.principal_point_offset,
+                     K(1, 2) + options.principal_point_offset};
+    camera_t camera_id = 0;
+    for (const auto& [id, existing] : reconstruction.cameras) {
+      if (existing.params == camera.params && existing.width == camera.width &&
+          existing.height == camera.height) {
+        camera_id = id;
+      }
+    }
+    if (camera_id == 0) {
+      camera_id = static_cast<camera_t>(reconstruction.cameras.size() + 1);
+      camera.camera_id = camera_id;
+      ValidateCamera(camera, source + ": line " + std::to_string(line_number));
+      reconstruction.cameras.emplace(camera_id, camera);
+    }
+
+    Image image;
+    image.image_id = next_image_id++;
+    image.camera_id = camera_id;
+    image.name = name;
+    // Re-orthonormalise through the quaternion; R passed the 1e-6 check above.
+    image.cam_from_world.rotation = Eigen::Quaterniond(R).normalized();
+    image.cam_from_world.translation = t;
+    reconstruction.images.emplace(image.image_id, std::move(image));
+  }
+  if (static_cast<long long>(names.size()) != count) {
+    throw InputError(source + ": line 1 announces " + std::to_string(count) +
+                     " images but the file holds " + std::to_string(names.size()));
+  }
+  return reconstruction;
+}
+
+Reconstruction ImportMiddlebury(const std::string& par_path,
+                                const std::string& image_path,
+                                const MiddleburyImportOptions& options) {
+  std::ifstream stream(par_path);
+  if (!stream) throw InputError(par_path + ": cannot open the calibration file");
+  auto image_size = [&](const std::string& name) {
+    const std::string path = (std::filesystem::path(image_path) / name).string();
+    if (!std::filesystem::is_regular_file(path)) {
+      throw InputError(path + ": photo named in " + par_path + " not found");
+    }
+    const cv::Mat photo = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (photo.empty()) throw InputError(path + ": cannot be decoded as an image");
+    return Eigen::Vector2i(photo.cols, photo.rows);
+  };
+  return ReadMiddleburyParameters(stream, par_path, image_size, options);
+}
+
+}  // namespace raycarve

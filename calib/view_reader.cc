@@ -1,0 +1,64 @@
+#include "calib/view_reader.h"
+
+#include <filesystem>
+#include <sstream>
+
+#include <glog/logging.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/input_error.h"
+
+namespace raycarve {
+
+std::string ViewReaderSummary::Summary() const {
+  std::ostringstream text;
+  text << "views: " << num_loaded << " of " << num_registered << " registered images loaded";
+  if (!missing.empty()) text << ", " << missing.size() << " skipped (photo missing)";
+  return text.str();
+}
+
+std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruction,
+                                                const std::string& image_path,
+                                                const ViewReaderOptions& options,
+                                                ViewReaderSummary* summary) {
+  ViewReaderSummary local_summary;
+  if (summary == nullptr) summary = &local_summary;
+  *summary = ViewReaderSummary();
+  summary->num_registered = static_cast<int>(reconstruction.images.size());
+  if (!std::filesystem::is_directory(image_path)) {
+    throw InputError(image_path + ": image folder does not exist or is not a folder");
+  }
+  std::vector<CalibratedView> views;
+  for (const auto& [image_id, image] : reconstruction.images) {
+    const std::string path = (std::filesystem::path(image_path) / image.name).string();
+    if (!std::filesystem::is_regular_file(path)) {
+      if (options.skip_missing_images) {
+        LOG(WARNING) << path << ": photo of image " << image_id << " not found; skipped";
+        summary->missing.push_back(path);
+        continue;
+      }
+      throw InputError(path + ": photo of image " + std::to_string(image_id) + " ('" +
+                       image.name + "') not found");
+    }
+    const cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);
+    if (bgr.empty()) {
+      throw InputError(path + ": photo of image " + std::to_string(image_id) +
+                       " cannot be decoded as an image");
+    }
+    cv::Mat rgb;
+    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    const Camera& camera = reconstruction.cameras.at(image.camera_id);
+    views.push_back(MakeCalibratedView(camera, image, rgb, path));
+    VLOG(1) << path << ": view built";
+  }
+  summary->num_loaded = static_cast<int>(views.size());
+  if (views.empty()) {
+    throw InputError(image_path + ": no view could be built: the model has " +
+                     std::to_string(reconstruction.images.size()) +
+                     " registered images and none of their photos was found");
+  }
+  return views;
+}
+
+}  // namespace raycarve

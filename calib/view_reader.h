@@ -1,0 +1,32 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/calibrated_view.h"
+#include "calib/reconstruction.h"
+
+namespace raycarve {
+
+struct ViewReaderOptions {
+  // Skip registered images whose photo is missing (counted and logged) instead of failing.
+  bool skip_missing_images = false;
+};
+
+struct ViewReaderSummary {
+  int num_registered = 0;
+  int num_loaded = 0;
+  std::vector<std::string> missing;  // photo paths not found (only with skip_missing_images)
+  std::string Summary() const;
+};
+
+// Loads the photo of every registered image of `reconstruction` from `image_path` / image.name
+// and builds its CalibratedView (undistorted, in image-id order). Throws InputError naming the
+// photo's path and image id when a photo is missing (unless skipped), cannot be decoded, or has
+// the wrong size, and when no view at all could be built.
+std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruction,
+                                                const std::string& image_path,
+                                                const ViewReaderOptions& options,
+                                                ViewReaderSummary* summary);
+
+}  // namespace raycarve

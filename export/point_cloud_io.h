@@ -1,0 +1,30 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace raycarve {
+namespace exporter {
+
+// A coloured point with a normal, as COLMAP's fused.ply stores it.
+struct ColouredPoint {
+  Eigen::Vector3f xyz = Eigen::Vector3f::Zero();
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // zero when unknown
+  Eigen::Matrix<uint8_t, 3, 1> rgb = Eigen::Matrix<uint8_t, 3, 1>::Zero();
+};
+
+// Writes a binary little-endian PLY through PCL, with per-vertex x y z, nx ny nz and
+// red green blue (uchar), so that COLMAP, MeshLab, CloudCompare and Open3D open it. Written to a
+// temporary name and renamed; throws InputError naming the path on failure.
+void WritePointCloudPly(const std::vector<ColouredPoint>& points, const std::string& path);
+
+// Reads a PLY point cloud (COLMAP's fused.ply, raycarve's own, or any PLY with x y z and
+// optionally normals and colours) through PCL. Throws InputError naming the path when the file
+// is missing or PCL cannot parse it.
+std::vector<ColouredPoint> ReadPointCloudPly(const std::string& path);
+
+}  // namespace exporter
+}  // namespace raycarve

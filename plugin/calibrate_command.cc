@@ -1,0 +1,243 @@
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <glog/logging.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/input_error.h"
+#include "calib/model_reader.h"
+#include "calib/view_reader.h"
+#include "plugin/calibrate.h"
+#include "plugin/commands.h"
+#include "plugin/json_writer.h"
+#include "plugin/workspace.h"
+
+namespace raycarve {
+namespace {
+
+std::vector<double> ToVector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return std::nan("");
+  const size_t middle = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + middle, values.end());
+  return values[middle];
+}
+
+// Writes in the format of the path's extension, through a temporary name and a rename.
+void WriteImageAtomically(const std::string& path, const cv::Mat& image) {
+  const std::filesystem::path final_path(path);
+  const std::string temporary =
+      (final_path.parent_path() / (".tmp." + final_path.filename().string())).string();
+  if (!cv::imwrite(temporary, image)) throw InputError(temporary + ": cannot write the image");
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) throw InputError(path + ": cannot rename into place: " + error.message());
+}
+
+}  // namespace
+
+CalibrationReport CalibrateProject(const Reconstruction& reconstruction,
+                                   const std::vector<CalibratedView>& views,
+                                   const Bounds& bounds) {
+  CalibrationReport report;
+  report.bounds = bounds;
+  for (const CalibratedView& view : views) {
+    const Image& image = reconstruction.images.at(view.image_id);
+    const Camera& camera = reconstruction.cameras.at(image.camera_id);
+    ViewCheck check;
+    check.image_id = view.image_id;
+    check.name = view.name;
+    std::vector<double> errors;
+    for (const Point2D& point2D : image.points2D) {
+      if (point2D.point3D_id == kInvalidPoint3DId) continue;
+      const Eigen::Vector3d& xyz = reconstruction.points3D.at(point2D.point3D_id).xyz;
+      if (view.Depth(xyz) <= 0.0) {
+        ++check.num_behind;
+        continue;
+      }
+      // The observation, moved from the photo's distorted pixels into the view's pinhole pixels.
+      const Eigen::Vector2d normalized = camera.CamFromImg(point2D.xy);
+      if (!normalized.allFinite()) continue;
+      const Eigen::Vector2d observed = (view.K * normalized.homogeneous()).hnormalized();
+      errors.push_back((view.Project(xyz) - observed).norm());
+    }
+    check.num_observations = static_cast<int>(errors.size());
+    if (!errors.empty()) {
+      double sum = 0.0;
+      for (double e : errors) sum += e;
+      check.mean_error = sum / errors.size();
+      check.median_error = Median(errors);
+      check.max_error = *std::max_element(errors.begin(), errors.end());
+    }
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d point = bounds.box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+      if (view.Depth(point) <= 0.0) {
+        check.box_in_front = false;
+        continue;
+      }
+      const Eigen::Vector2d pixel = view.Project(point);
+      if (pixel.x() >= 0 && pixel.y() >= 0 && pixel.x() <= view.width && pixel.y() <= view.height) {
+        ++check.box_corners_in_image;
+      }
+    }
+    int valid = cv::countNonZero(view.valid);
+    check.valid_fraction = static_cast<double>(valid) / (view.width * view.height);
+    report.views.push_back(check);
+  }
+  std::vector<double> all_means;
+  double weighted_sum = 0.0;
+  for (const ViewCheck& check : report.views) {
+    report.num_observations += check.num_observations;
+    weighted_sum += check.mean_error * check.num_observations;
+    report.max_error = std::max(report.max_error, check.max_error);
+  }
+  if (report.num_observations > 0) report.mean_error = weighted_sum / report.num_observations;
+  return report;
+}
+
+std::string CalibrationReport::Table() const {
+  std::string text;
+  char line[256];
+  std::snprintf(line, sizeof(line), "%6s  %-24s %7s %10s %10s %10s %8s %7s\n", "image", "name",
+                "points", "mean px", "median px", "max px", "box in", "valid");
+  text += line;
+  for (const ViewCheck& check : views) {
+    std::snprintf(line, sizeof(line), "%6u  %-24s %7d %10.2e %10.2e %10.2e %6d/8 %6.1f%%\n",
+                  check.image_id, check.name.c_str(), check.num_observations, check.mean_error,
+                  check.median_error, check.max_error, check.box_corners_in_image,
+                  100.0 * check.valid_fraction);
+    text += line;
+  }
+  std::snprintf(line, sizeof(line),
+                "all: %d observations, mean reprojection error %.3g px, max %.3g px\n",
+                num_observations, mean_error, max_error);
+  text += line;
+  return text;
+}
+
+std::string CalibrationReport::Json(const std::string& model_path,
+                                    const std::string& image_path,
+                                    const std::vector<CalibratedView>& calibrated) const {
+  JsonWriter json;
+  json.BeginObject()
+      .Key("model_path").Value(model_path)
+      .Key("image_path").Value(image_path)
+      .Key("num_views").Value(static_cast<uint64_t>(views.size()))
+      .Key("num_observations").Value(num_observations)
+      .Key("mean_reprojection_error_px").Value(mean_error)
+      .Key("max_reprojection_error_px").Value(max_error);
+  json.Key("bounds").BeginObject()
+      .Key("min").Value(ToVector(bounds.box.min()))
+      .Key("max").Value(ToVector(bounds.box.max()))
+      .Key("explicit").Value(bounds.is_explicit)
+      .Key("num_points_used").Value(bounds.num_used)
+      .Key("summary").Value(bounds.Summary())
+      .EndObject();
+  json.Key("views").BeginArray();
+  for (size_t i = 0; i < views.size(); ++i) {
+    const ViewCheck& check = views[i];
+    const CalibratedView& view = calibrated[i];
+    std::vector<double> P_rows;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) P_rows.push_back(view.P(r, c));
+    }
+    json.BeginObject()
+        .Key("image_id").Value(static_cast<uint64_t>(check.image_id))
+        .Key("name").Value(check.name)
+        .Key("width").Value(view.width)
+        .Key("height").Value(view.height)
+        .Key("P_row_major").Value(P_rows)
+        .Key("centre").Value(ToVector(view.centre))
+        .Key("num_observations").Value(check.num_observations)
+        .Key("num_behind_camera").Value(check.num_behind)
+        .Key("mean_reprojection_error_px").Value(check.mean_error)
+        .Key("median_reprojection_error_px").Value(check.median_error)
+        .Key("max_reprojection_error_px").Value(check.max_error)
+        .Key("box_corners_in_image").Value(check.box_corners_in_image)
+        .Key("box_in_front").Value(check.box_in_front)
+        .Key("valid_pixel_fraction").Value(check.valid_fraction)
+        .EndObject();
+  }
+  json.EndArray().EndObject();
+  return json.str();
+}
+
+int RunCalibrate(int argc, char** argv) {
+  std::string workspace_path, input_path, image_path, output_path;
+  bool write_undistorted = true;
+  ViewReaderOptions view_options;
+  BoundsFlags bounds_flags;
+  OptionParser parser(
+      "calibrate",
+      "Turns every registered image of a COLMAP project into a calibrated view (undistorted "
+      "photo, 3x4 projection), bounds the volume, checks the sparse points' reprojection through "
+      "the views, and writes undistorted photos, views and a report.");
+  parser.AddDefault("workspace_path", &workspace_path,
+                    "COLMAP project (sparse/0 or sparse or dense/sparse, with images/)");
+  parser.AddDefault("input_path", &input_path, "model folder, overriding the workspace's");
+  parser.AddDefault("image_path", &image_path, "photo folder, overriding the workspace's");
+  parser.AddDefault("output_path", &output_path, "output folder (default <workspace>/raycarve)");
+  parser.AddDefault("write_undistorted", &write_undistorted,
+                    "write the undistorted photos and their validity masks");
+  parser.AddDefault("skip_missing_images", &view_options.skip_missing_images,
+                    "skip registered images whose photo is missing instead of failing");
+  AddBoundsFlags(&parser, &bounds_flags);
+  if (!parser.Parse(argc, argv)) return 0;
+
+  const WorkspacePaths paths = ResolveWorkspace(workspace_path, input_path, image_path);
+  if (output_path.empty()) {
+    if (workspace_path.empty()) throw InputError("raycarve calibrate: give --output_path");
+    output_path = (std::filesystem::path(workspace_path) / "raycarve").string();
+  }
+  CheckOutputDoesNotOverwrite(output_path, paths.model_path, "input model");
+  CheckOutputDoesNotOverwrite(output_path, paths.image_path, "photo folder");
+
+  LOG(INFO) << "reading model " << paths.model_path << " (" << paths.layout << ")";
+  const Reconstruction reconstruction = ReadModel(paths.model_path);
+  if (reconstruction.images.empty()) {
+    throw InputError(paths.model_path + ": the model has no registered images");
+  }
+  const Bounds bounds = ResolveBounds(reconstruction, bounds_flags, paths.model_path);
+  LOG(INFO) << bounds.Summary();
+  LOG(INFO) << "loading and undistorting " << reconstruction.images.size() << " photos from "
+            << paths.image_path;
+  ViewReaderSummary view_summary;
+  const std::vector<CalibratedView> views =
+      ReadCalibratedViews(reconstruction, paths.image_path, view_options, &view_summary);
+  LOG(INFO) << view_summary.Summary();
+  const CalibrationReport report = CalibrateProject(reconstruction, views, bounds);
+
+  std::error_code error;
+  std::filesystem::create_directories(output_path, error);
+  if (error) throw InputError(output_path + ": cannot create the output folder: " + error.message());
+  if (write_undistorted) {
+    // COLMAP's conventions: photos keep their names (and format), masks are <name>.png.
+    const std::filesystem::path root(output_path);
+    for (const CalibratedView& view : views) {
+      const std::filesystem::path photo = root / "undistorted" / view.name;
+      const std::filesystem::path mask = root / "masks" / (view.name + ".png");
+      std::filesystem::create_directories(photo.parent_path(), error);
+      std::filesystem::create_directories(mask.parent_path(), error);
+      if (error) throw InputError(mask.parent_path().string() + ": cannot create: " + error.message());
+      cv::Mat bgr;
+      cv::cvtColor(view.image, bgr, cv::COLOR_RGB2BGR);
+      WriteImageAtomically(photo.string(), bgr);
+      WriteImageAtomically(mask.string(), view.valid);
+    }
+  }
+  const std::string report_path = (std::filesystem::path(output_path) / "report.json").string();
+  WriteTextFileAtomically(report_path, report.Json(paths.model_path, paths.image_path, views));
+  std::cout << report.Table() << bounds.Summary() << "\n"
+            << view_summary.Summary() << "\n"
+            << "wrote " << report_path
+            << (write_undistorted ? ", undistorted/<name> and masks/<name>.png (valid pixels)" : "")
+            << "\n";
+  return 0;
+}
+
+}  // namespace raycarve

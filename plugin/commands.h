@@ -1,0 +1,45 @@
+#pragma once
+
+#include <string>
+
+#include "calib/bounds.h"
+#include "calib/reconstruction.h"
+#include "plugin/option_parser.h"
+
+namespace raycarve {
+
+// Subcommands of the `raycarve` program. Each parses its options and calls a typed function
+// that tests call too; bad input throws InputError, which main() prints as one line before
+// exiting non-zero.
+int RunModelInfo(int argc, char** argv);
+int RunModelConverter(int argc, char** argv);
+int RunImportMiddlebury(int argc, char** argv);
+int RunSynth(int argc, char** argv);
+int RunCalibrate(int argc, char** argv);
+
+// Options shared by every command that bounds the volume.
+struct BoundsFlags {
+  BoundsOptions options;
+  std::string bbox;  // "min_x,min_y,min_z,max_x,max_y,max_z"; empty: from the sparse points
+};
+void AddBoundsFlags(OptionParser* parser, BoundsFlags* flags);
+// The explicit box when --bbox was given, else ComputeBounds; throws InputError on bad flags.
+Bounds ResolveBounds(const Reconstruction& reconstruction,
+                     const BoundsFlags& flags,
+                     const std::string& source);
+
+// model_info: a text and a JSON description of a model and the bounds it would carve.
+std::string DescribeModelText(const Reconstruction& reconstruction,
+                              const std::string& model_path,
+                              const Bounds& bounds);
+std::string DescribeModelJson(const Reconstruction& reconstruction,
+                              const std::string& model_path,
+                              const Bounds& bounds);
+
+// Throws InputError when `output_path` is `input_path` (after resolving links and dots): the
+// writers would replace the input's files.
+void CheckOutputDoesNotOverwrite(const std::string& output_path,
+                                 const std::string& input_path,
+                                 const std::string& what);
+
+}  // namespace raycarve

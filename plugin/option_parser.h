@@ -1,0 +1,56 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace raycarve {
+
+// Command-line options in COLMAP's style: `--name value` or `--name=value`, every option with a
+// default or marked required, and a help text listing defaults and allowed values.
+//
+// Parse throws InputError on an unknown option, a missing value, a value that does not parse as
+// the option's type or is not among its allowed values, or a missing required option. `--help`
+// makes Parse return false after printing the help to stdout.
+class OptionParser {
+ public:
+  OptionParser(std::string command, std::string description);
+
+  void AddRequired(const std::string& name, std::string* value, const std::string& help);
+  void AddDefault(const std::string& name,
+                  std::string* value,
+                  const std::string& help,
+                  std::vector<std::string> allowed_values = {});
+  void AddDefault(const std::string& name, int* value, const std::string& help);
+  void AddDefault(const std::string& name, uint64_t* value, const std::string& help);
+  void AddDefault(const std::string& name, double* value, const std::string& help);
+  void AddDefault(const std::string& name, bool* value, const std::string& help);
+
+  // Parses argv[first..argc); returns false when --help was asked for.
+  bool Parse(int argc, char** argv, int first = 2);
+
+  // True when the option was given on the command line (not left at its default).
+  bool IsSet(const std::string& name) const;
+
+  std::string Help() const;
+
+ private:
+  struct Option {
+    std::string name;
+    std::string help;
+    std::string default_text;
+    std::vector<std::string> allowed_values;
+    bool required = false;
+    bool is_flag = false;  // bool: "--name" alone means true
+    bool set = false;
+    std::function<void(const std::string&)> assign;
+  };
+  Option& Add(const std::string& name, const std::string& help, std::string default_text);
+
+  std::string command_;
+  std::string description_;
+  std::vector<Option> options_;
+};
+
+}  // namespace raycarve

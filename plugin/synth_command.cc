@@ -1,0 +1,47 @@
+#include <iostream>
+
+#include <glog/logging.h>
+
+#include "calib/input_error.h"
+#include "plugin/commands.h"
+#include "samples/synthetic_scene.h"
+
+namespace raycarve {
+
+int RunSynth(int argc, char** argv) {
+  std::string output_path;
+  std::string camera_model = "PINHOLE";
+  SyntheticSceneOptions options;
+  OptionParser parser("synth",
+                      "Generates a synthetic COLMAP project with ground truth: a textured sphere "
+                      "and box on a checkered ground, ray traced from cameras on a ring "
+                      "(images/, sparse/0).");
+  parser.AddRequired("output_path", &output_path, "project folder to write (created)");
+  parser.AddDefault("views", &options.num_views, "number of cameras on the ring");
+  parser.AddDefault("width", &options.width, "photo width in pixels");
+  parser.AddDefault("height", &options.height, "photo height in pixels");
+  parser.AddDefault("seed", &options.seed, "random seed of the sparse points and noise");
+  parser.AddDefault("points", &options.num_surface_samples,
+                    "surface samples tried as sparse points (kept when seen by >= 2 views)");
+  parser.AddDefault("pixel_noise", &options.pixel_noise,
+                    "std. dev. of noise on the 2D observations (px)");
+  std::vector<std::string> models;
+  for (CameraModelId model : SupportedCameraModels()) models.push_back(CameraModelName(model));
+  parser.AddDefault("camera_model", &camera_model,
+                    "camera model of the photos (with a typical distortion)", models);
+  if (!parser.Parse(argc, argv)) return 0;
+  options.camera_model = CameraModelIdFromName(camera_model, "--camera_model");
+  std::string reason;
+  if (!options.IsValid(&reason)) throw InputError("raycarve synth: " + reason);
+
+  LOG(INFO) << "rendering " << options.num_views << " views of " << options.width << "x"
+            << options.height << " (" << camera_model << ")";
+  const SyntheticScene scene = GenerateSyntheticScene(options);
+  WriteSyntheticProject(scene, output_path);
+  std::cout << "synth: wrote " << scene.photos.size() << " photos and a model with "
+            << scene.reconstruction.points3D.size() << " points to " << output_path
+            << " (images/, sparse/0)\n";
+  return 0;
+}
+
+}  // namespace raycarve

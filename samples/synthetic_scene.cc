@@ -1,0 +1,368 @@
+#include "samples/synthetic_scene.h"
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <random>
+
+#include <glog/logging.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/input_error.h"
+#include "calib/model_writer.h"
+#include "calib/pixel.h"
+
+namespace raycarve {
+namespace {
+
+constexpr double kGroundHalfSize = 1.5;
+const Eigen::Vector3d kSphereCentre(0.45, 0.35, 0.55);
+constexpr double kSphereRadius = 0.55;
+const Eigen::Vector3d kBoxMin(-1.05, -0.75, 0.0);
+const Eigen::Vector3d kBoxMax(-0.2, 0.05, 0.8);
+const Eigen::Vector3d kSkyColour(40, 40, 60);
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+enum class Surface { kNone, kGround, kSphere, kBox };
+
+struct Hit {
+  double t = kInfinity;
+  Surface surface = Surface::kNone;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+};
+
+void IntersectSphere(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Hit* hit) {
+  const Eigen::Vector3d offset = origin - kSphereCentre;
+  const double b = offset.dot(direction);
+  const double c = offset.squaredNorm() - kSphereRadius * kSphereRadius;
+  const double discriminant = b * b - c;
+  if (discriminant < 0.0) return;
+  const double t = -b - std::sqrt(discriminant);
+  if (t > 1e-9 && t < hit->t) {
+    hit->t = t;
+    hit->surface = Surface::kSphere;
+    hit->point = origin + t * direction;
+    hit->normal = (hit->point - kSphereCentre) / kSphereRadius;
+  }
+}
+
+void IntersectBox(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Hit* hit) {
+  double t_near = -kInfinity, t_far = kInfinity;
+  int near_axis = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (direction[axis] == 0.0) {
+      if (origin[axis] < kBoxMin[axis] || origin[axis] > kBoxMax[axis]) return;
+      continue;
+    }
+    double t0 = (kBoxMin[axis] - origin[axis]) / direction[axis];
+    double t1 = (kBoxMax[axis] - origin[axis]) / direction[axis];
+    if (t0 > t1) std::swap(t0, t1);
+    if (t0 > t_near) {
+      t_near = t0;
+      near_axis = axis;
+    }
+    t_far = std::min(t_far, t1);
+  }
+  if (t_near > t_far || t_near <= 1e-9 || t_near >= hit->t) return;
+  hit->t = t_near;
+  hit->surface = Surface::kBox;
+  hit->point = origin + t_near * direction;
+  hit->normal = Eigen::Vector3d::Zero();
+  hit->normal[near_axis] = direction[near_axis] > 0.0 ? -1.0 : 1.0;
+}
+
+void IntersectGround(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Hit* hit) {
+  if (direction.z() == 0.0) return;
+  const double t = -origin.z() / direction.z();
+  if (t <= 1e-9 || t >= hit->t) return;
+  const Eigen::Vector3d point = origin + t * direction;
+  if (std::abs(point.x()) > kGroundHalfSize || std::abs(point.y()) > kGroundHalfSize) return;
+  hit->t = t;
+  hit->surface = Surface::kGround;
+  hit->point = point;
+  hit->normal = Eigen::Vector3d::UnitZ();
+}
+
+Hit Trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
+  Hit hit;
+  IntersectSphere(origin, direction, &hit);
+  IntersectBox(origin, direction, &hit);
+  IntersectGround(origin, direction, &hit);
+  return hit;
+}
+
+// Texture colour (RGB, 0-255) of a surface point, with a fixed directional shading.
+Eigen::Vector3d SurfaceColour(const Hit& hit) {
+  Eigen::Vector3d albedo = Eigen::Vector3d::Zero();
+  switch (hit.surface) {
+    case Surface::kGround: {
+      const int cx = static_cast<int>(std::floor(hit.point.x() / 0.25));
+      const int cy = static_cast<int>(std::floor(hit.point.y() / 0.25));
+      albedo = ((cx + cy) & 1) ? Eigen::Vector3d(230, 225, 210) : Eigen::Vector3d(60, 70, 90);
+      break;
+    }
+    case Surface::kSphere: {
+      const Eigen::Vector3d d = hit.normal;
+      const double longitude = std::atan2(d.y(), d.x());
+      const double latitude = std::asin(std::clamp(d.z(), -1.0, 1.0));
+      const int band = static_cast<int>(std::floor(longitude / (M_PI / 6.0))) +
+                       static_cast<int>(std::floor(latitude / (M_PI / 8.0)));
+      albedo = (band & 1) ? Eigen::Vector3d(200, 60, 50) : Eigen::Vector3d(250, 200, 60);
+      albedo += Eigen::Vector3d(0, 40, 80) * (0.5 + 0.5 * std::sin(3.0 * longitude));
+      break;
+    }
+    case Surface::kBox: {
+      const double s = hit.point.x() + hit.point.y() + 1.7 * hit.point.z();
+      const bool stripe = static_cast<int>(std::floor(s / 0.12)) & 1;
+      albedo = stripe ? Eigen::Vector3d(40, 150, 80) : Eigen::Vector3d(170, 230, 240);
+      break;
+    }
+    case Surface::kNone:
+      return kSkyColour;
+  }
+  const Eigen::Vector3d light = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
+  const double shade = 0.55 + 0.45 * std::max(0.0, hit.normal.dot(light));
+  return (albedo * shade).cwiseMin(255.0);
+}
+
+Rigid3d LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
+  const Eigen::Vector3d z = (target - centre).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Matrix3d R;
+  R.row(0) = x;
+  R.row(1) = y;
+  R.row(2) = z;
+  Rigid3d cam_from_world;
+  cam_from_world.rotation = Eigen::Quaterniond(R);
+  cam_from_world.translation = -(R * centre);
+  return cam_from_world;
+}
+
+cv::Mat Render(const Camera& camera, const Rigid3d& cam_from_world, int supersampling) {
+  const Rigid3d world_from_cam = cam_from_world.Inverse();
+  cv::Mat photo(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC3);
+  for (int row = 0; row < photo.rows; ++row) {
+    for (int col = 0; col < photo.cols; ++col) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (int sy = 0; sy < supersampling; ++sy) {
+        for (int sx = 0; sx < supersampling; ++sx) {
+          const Eigen::Vector2d pixel(col + (sx + 0.5) / supersampling,
+                                      row + (sy + 0.5) / supersampling);
+          const Eigen::Vector2d normalized = camera.CamFromImg(pixel);
+          if (!normalized.allFinite()) continue;
+          const Eigen::Vector3d direction =
+              (world_from_cam.rotation * normalized.homogeneous()).normalized();
+          sum += SurfaceColour(Trace(world_from_cam.translation, direction));
+        }
+      }
+      const Eigen::Vector3d rgb = sum / (supersampling * supersampling);
+      photo.at<cv::Vec3b>(row, col) = cv::Vec3b(static_cast<uint8_t>(std::lround(rgb[0])),
+                                                static_cast<uint8_t>(std::lround(rgb[1])),
+                                                static_cast<uint8_t>(std::lround(rgb[2])));
+    }
+  }
+  return photo;
+}
+
+// A uniformly distributed point on one of the three surfaces, by area.
+Hit SampleSurface(std::mt19937_64* random) {
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double sphere_area = 4.0 * M_PI * kSphereRadius * kSphereRadius;
+  const Eigen::Vector3d box_size = kBoxMax - kBoxMin;
+  const double box_area = 2.0 * (box_size.x() * box_size.y() + box_size.y() * box_size.z() +
+                                 box_size.x() * box_size.z());
+  const double ground_area = 4.0 * kGroundHalfSize * kGroundHalfSize;
+  const double pick = uniform(*random) * (sphere_area + box_area + ground_area);
+  Hit hit;
+  if (pick < sphere_area) {
+    const double z = 2.0 * uniform(*random) - 1.0;
+    const double phi = 2.0 * M_PI * uniform(*random);
+    const double s = std::sqrt(1.0 - z * z);
+    hit.surface = Surface::kSphere;
+    hit.normal = Eigen::Vector3d(s * std::cos(phi), s * std::sin(phi), z);
+    hit.point = kSphereCentre + kSphereRadius * hit.normal;
+  } else if (pick < sphere_area + box_area) {
+    // A face picked in proportion to its area (faces normal to x, y, z), then a uniform point.
+    const double face_areas[3] = {box_size.y() * box_size.z(),
+                                  box_size.x() * box_size.z(),
+                                  box_size.x() * box_size.y()};
+    const double face_pick = uniform(*random) * (face_areas[0] + face_areas[1] + face_areas[2]);
+    const int axis = face_pick < face_areas[0]                   ? 0
+                     : face_pick < face_areas[0] + face_areas[1] ? 1
+                                                                 : 2;
+    hit.point = kBoxMin + box_size.cwiseProduct(
+                              Eigen::Vector3d(uniform(*random), uniform(*random), uniform(*random)));
+    const bool upper = uniform(*random) < 0.5;
+    hit.point[axis] = upper ? kBoxMax[axis] : kBoxMin[axis];
+    hit.normal = Eigen::Vector3d::Zero();
+    hit.normal[axis] = upper ? 1.0 : -1.0;
+    hit.surface = Surface::kBox;
+  } else {
+    hit.surface = Surface::kGround;
+    hit.point = Eigen::Vector3d((2.0 * uniform(*random) - 1.0) * kGroundHalfSize,
+                                (2.0 * uniform(*random) - 1.0) * kGroundHalfSize,
+                                0.0);
+    hit.normal = Eigen::Vector3d::UnitZ();
+  }
+  return hit;
+}
+
+}  // namespace
+
+bool SyntheticSceneOptions::IsValid(std::string* reason) const {
+  if (num_views < 2) {
+    *reason = "num_views must be at least 2";
+    return false;
+  }
+  if (width < 16 || height < 16 || width > 8192 || height > 8192) {
+    *reason = "width and height must be in [16, 8192]";
+    return false;
+  }
+  if (num_surface_samples < 0) {
+    *reason = "num_surface_samples must be >= 0";
+    return false;
+  }
+  if (!(pixel_noise >= 0.0)) {
+    *reason = "pixel_noise must be >= 0";
+    return false;
+  }
+  if (supersampling < 1 || supersampling > 8) {
+    *reason = "supersampling must be in [1, 8]";
+    return false;
+  }
+  return true;
+}
+
+std::vector<double> ExampleCameraParams(CameraModelId model, int width, int height, double focal) {
+  const double cx = 0.5 * width + 1.25;
+  const double cy = 0.5 * height - 0.75;
+  const double fy = focal * 1.01;
+  switch (model) {
+    case CameraModelId::kSimplePinhole:
+      return {focal, cx, cy};
+    case CameraModelId::kPinhole:
+      return {focal, fy, cx, cy};
+    case CameraModelId::kSimpleRadial:
+      return {focal, cx, cy, -0.08};
+    case CameraModelId::kRadial:
+      return {focal, cx, cy, -0.1, 0.03};
+    case CameraModelId::kOpenCv:
+      return {focal, fy, cx, cy, -0.12, 0.04, 0.002, -0.001};
+    case CameraModelId::kOpenCvFisheye:
+      return {focal, fy, cx, cy, 0.05, -0.02, 0.01, -0.003};
+    case CameraModelId::kFullOpenCv:
+      return {focal, fy, cx, cy, -0.1, 0.02, 0.001, -0.002, 0.003, 0.05, 0.01, 0.002};
+    case CameraModelId::kFov:
+      return {focal, fy, cx, cy, 0.6};
+    case CameraModelId::kSimpleRadialFisheye:
+      return {focal, cx, cy, 0.06};
+    case CameraModelId::kRadialFisheye:
+      return {focal, cx, cy, 0.05, -0.01};
+    case CameraModelId::kThinPrismFisheye:
+      return {focal, fy, cx, cy, 0.04, -0.01, 0.001, -0.002, 0.003, -0.001, 0.002, -0.001};
+  }
+  LOG(FATAL) << "unhandled camera model";
+  return {};
+}
+
+SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
+  std::string reason;
+  CHECK(options.IsValid(&reason)) << reason;
+  SyntheticScene scene;
+  scene.object_box = Eigen::AlignedBox3d(Eigen::Vector3d(-kGroundHalfSize, -kGroundHalfSize, 0.0),
+                                         Eigen::Vector3d(kGroundHalfSize, kGroundHalfSize,
+                                                         kSphereCentre.z() + kSphereRadius));
+  Reconstruction& reconstruction = scene.reconstruction;
+
+  // One camera shared by all views; the focal length frames the ground square from the ring.
+  Camera camera;
+  camera.camera_id = 1;
+  camera.model = options.camera_model;
+  camera.width = options.width;
+  camera.height = options.height;
+  const double focal = 0.95 * options.width;
+  camera.params = ExampleCameraParams(options.camera_model, options.width, options.height, focal);
+  reconstruction.cameras.emplace(camera.camera_id, camera);
+
+  const double ring_radius = 5.0;
+  const Eigen::Vector3d target(0.0, 0.0, 0.35);
+  for (int i = 0; i < options.num_views; ++i) {
+    const double angle = 2.0 * M_PI * i / options.num_views + 0.3;
+    const double height = 2.6 + 0.6 * std::sin(3.0 * angle);  // not all on one plane
+    const Eigen::Vector3d centre(
+        ring_radius * std::cos(angle), ring_radius * std::sin(angle), height);
+    Image image;
+    image.image_id = static_cast<image_t>(i + 1);
+    image.camera_id = camera.camera_id;
+    char name[32];
+    std::snprintf(name, sizeof(name), "view%03d.png", i + 1);
+    image.name = name;
+    image.cam_from_world = LookAt(centre, target);
+    scene.photos.emplace(image.image_id,
+                         Render(camera, image.cam_from_world, options.supersampling));
+    reconstruction.images.emplace(image.image_id, std::move(image));
+  }
+
+  std::mt19937_64 random(options.seed);
+  std::normal_distribution<double> noise(0.0, options.pixel_noise);
+  point3D_t next_point3D_id = 1;
+  for (int sample = 0; sample < options.num_surface_samples; ++sample) {
+    const Hit surface = SampleSurface(&random);
+    Point3D point3D;
+    point3D.xyz = surface.point;
+    std::vector<std::pair<image_t, Eigen::Vector2d>> observations;
+    for (const auto& [image_id, image] : reconstruction.images) {
+      const Eigen::Vector3d in_camera = image.cam_from_world * surface.point;
+      if (in_camera.z() <= 0.0) continue;
+      const Eigen::Vector2d pixel = camera.ImgFromCam(in_camera.hnormalized());
+      if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < options.width &&
+            pixel.y() < options.height)) {
+        continue;
+      }
+      const Eigen::Vector3d centre = image.ProjectionCenter();
+      const Eigen::Vector3d offset = surface.point - centre;
+      const Hit hit = Trace(centre, offset.normalized());
+      if (std::abs(hit.t - offset.norm()) > 1e-6 * offset.norm()) continue;  // occluded
+      observations.emplace_back(image_id, pixel);
+    }
+    if (observations.size() < 2) continue;
+    const Eigen::Vector3d colour = SurfaceColour(surface);
+    for (int k = 0; k < 3; ++k) point3D.color[k] = static_cast<uint8_t>(std::lround(colour[k]));
+    point3D.error = options.pixel_noise;
+    const point3D_t point3D_id = next_point3D_id++;
+    for (const auto& [image_id, pixel] : observations) {
+      Image& image = reconstruction.images.at(image_id);
+      Point2D point2D;
+      point2D.xy = pixel;
+      if (options.pixel_noise > 0.0) point2D.xy += Eigen::Vector2d(noise(random), noise(random));
+      point2D.point3D_id = point3D_id;
+      point3D.track.push_back({image_id, static_cast<point2D_t>(image.points2D.size())});
+      image.points2D.push_back(point2D);
+    }
+    reconstruction.points3D.emplace(point3D_id, std::move(point3D));
+  }
+  return scene;
+}
+
+void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path) {
+  const std::filesystem::path root(path);
+  std::error_code error;
+  std::filesystem::create_directories(root / "images", error);
+  if (error) throw InputError(path + ": cannot create the project folder: " + error.message());
+  for (const auto& [image_id, photo] : scene.photos) {
+    const std::string name = scene.reconstruction.images.at(image_id).name;
+    const std::filesystem::path final_path = root / "images" / name;
+    const std::string temporary = final_path.string() + ".tmp.png";
+    cv::Mat bgr;
+    cv::cvtColor(photo, bgr, cv::COLOR_RGB2BGR);
+    if (!cv::imwrite(temporary, bgr)) throw InputError(temporary + ": cannot write the photo");
+    std::filesystem::rename(temporary, final_path, error);
+    if (error) throw InputError(final_path.string() + ": cannot rename into place");
+  }
+  WriteModel(scene.reconstruction, (root / "sparse" / "0").string(), ModelFormat::kBinary);
+}
+
+}  // namespace raycarve

@@ -1,0 +1,55 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "calib/reconstruction.h"
+
+namespace raycarve {
+
+// A deterministic synthetic scene with exact ground truth: a textured sphere and a striped box
+// standing on a checkered ground square, under a uniform sky, seen by cameras on a ring around
+// and above it. Rendered by ray tracing (unlit textures with fixed, view-independent shading, so
+// every surface point has one colour in every view), through any COLMAP 3.8 camera model, so the
+// photos carry that model's distortion.
+//
+// World frame: z up, ground at z = 0, the scene inside [-1.5, 1.5]^2 x [0, 1.1]; units arbitrary.
+struct SyntheticSceneOptions {
+  int num_views = 8;           // cameras on the ring
+  int width = 320;             // photo width in pixels
+  int height = 240;            // photo height in pixels
+  uint64_t seed = 1;           // seeds the surface points' sampling and the pixel noise
+  CameraModelId camera_model = CameraModelId::kPinhole;  // distortion from ExampleCameraParams
+  int num_surface_samples = 3000;  // candidate sparse points before the visibility filter
+  double pixel_noise = 0.0;        // std. dev. of Gaussian noise on the 2D observations (px)
+  int supersampling = 2;           // rays per pixel along each axis when rendering
+
+  bool IsValid(std::string* reason) const;
+};
+
+struct SyntheticScene {
+  // Cameras, registered images with their observations, and true surface points each seen (not
+  // occluded, inside the frame) by at least two views; observations are exact projections
+  // (plus pixel_noise).
+  Reconstruction reconstruction;
+  std::map<image_t, cv::Mat> photos;  // CV_8UC3 RGB, as the camera model sees them
+  Eigen::AlignedBox3d object_box;     // smallest box holding the ground square and the objects
+};
+
+// Parameters of `model` for a camera of the given size and focal length: principal point near
+// the image centre and a mild distortion typical of that model (none for pinhole models).
+std::vector<double> ExampleCameraParams(CameraModelId model, int width, int height, double focal);
+
+// Generates the scene; the same options always give the same scene, bit for bit.
+SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options);
+
+// Writes a COLMAP project into `path`: images/<name>.png and sparse/0/ (binary). Throws
+// InputError when a file cannot be written.
+void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path);
+
+}  // namespace raycarve

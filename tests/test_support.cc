@@ -1,0 +1,180 @@
+#include "tests/test_support.h"
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace raycarve {
+namespace testing {
+
+std::string MakeTemporaryDirectory(const std::string& name) {
+  std::random_device device;
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() /
+      ("raycarve_test_" + name + "_" + std::to_string(getpid()) + "_" + std::to_string(device()));
+  std::filesystem::remove_all(path);
+  std::filesystem::create_directories(path);
+  return path.string();
+}
+
+std::string DataDirectory() {
+  if (const char* env = std::getenv("RAYCARVE_DATA_DIR"); env != nullptr && *env != '\0') {
+    return std::filesystem::exists(env) ? std::string(env) : std::string();
+  }
+  if (const char* source = std::getenv("RAYCARVE_SOURCE_DIR"); source != nullptr) {
+    const std::filesystem::path path = std::filesystem::path(source) / ".." / "shared" / "data";
+    if (std::filesystem::exists(path)) return std::filesystem::canonical(path).string();
+  }
+  return "";
+}
+
+int RunShell(const std::string& command, std::string* output) {
+  output->clear();
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return -1;
+  std::array<char, 4096> buffer;
+  size_t count;
+  while ((count = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) {
+    output->append(buffer.data(), count);
+  }
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string RaycarveBinary() {
+  const char* binary = std::getenv("RAYCARVE_BINARY");
+  return binary == nullptr ? std::string() : std::string(binary);
+}
+
+bool ColmapAvailable() {
+  std::string output;
+  return RunShell("command -v colmap", &output) == 0;
+}
+
+void WriteFile(const std::string& path, const std::string& bytes) {
+  std::ofstream stream(path, std::ios::binary);
+  stream << bytes;
+  if (!stream) {
+    ADD_FAILURE() << "cannot write " << path;
+  }
+}
+
+std::string ReadFileBytes(const std::string& path) {
+  std::ifstream stream(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << stream.rdbuf();
+  return bytes.str();
+}
+
+}  // namespace testing
+}  // namespace raycarve
+
+namespace raycarve {
+namespace testing {
+
+Reconstruction RandomReconstruction(uint64_t seed, int num_images, int num_points3D) {
+  std::mt19937_64 random(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Reconstruction reconstruction;
+  for (CameraModelId model : SupportedCameraModels()) {
+    Camera camera;
+    camera.camera_id = static_cast<camera_t>(static_cast<int>(model) + 1);
+    camera.model = model;
+    camera.width = 640 + static_cast<int>(model);
+    camera.height = 480;
+    for (int k = 0; k < CameraModelNumParams(model); ++k) {
+      camera.params.push_back(k < 2 ? 500.0 + 10 * uniform(random) : uniform(random) * 0.1 + (k < 4 ? 300.0 : 0.0));
+    }
+    reconstruction.cameras.emplace(camera.camera_id, camera);
+  }
+  for (int i = 0; i < num_images; ++i) {
+    Image image;
+    image.image_id = static_cast<image_t>(3 * i + 2);
+    image.camera_id = static_cast<camera_t>(1 + i % reconstruction.cameras.size());
+    image.name = "folder/photo " + std::to_string(i) + ".png";
+    image.cam_from_world.rotation =
+        Eigen::Quaterniond(uniform(random), uniform(random), uniform(random), uniform(random))
+            .normalized();
+    image.cam_from_world.translation =
+        Eigen::Vector3d(uniform(random), uniform(random), uniform(random)) * 3.0;
+    const int num_points2D = 3 + static_cast<int>(5 * (uniform(random) + 1));
+    for (int k = 0; k < num_points2D; ++k) {
+      Point2D point2D;
+      point2D.xy = Eigen::Vector2d(320 + 300 * uniform(random), 240 + 200 * uniform(random));
+      image.points2D.push_back(point2D);
+    }
+    reconstruction.images.emplace(image.image_id, image);
+  }
+  point3D_t next_id = 7;
+  for (int p = 0; p < num_points3D; ++p) {
+    Point3D point3D;
+    point3D.xyz = Eigen::Vector3d(uniform(random), uniform(random), uniform(random)) * 5.0;
+    point3D.color << static_cast<uint8_t>(random() % 256), static_cast<uint8_t>(random() % 256),
+        static_cast<uint8_t>(random() % 256);
+    point3D.error = 0.5 * (uniform(random) + 1.0);
+    // Attach to free points2D of two or three images.
+    for (auto& [image_id, image] : reconstruction.images) {
+      if (point3D.track.size() >= 3 || random() % 2 == 0) continue;
+      for (point2D_t k = 0; k < image.points2D.size(); ++k) {
+        if (image.points2D[k].point3D_id == kInvalidPoint3DId) {
+          image.points2D[k].point3D_id = next_id;
+          point3D.track.push_back({image_id, k});
+          break;
+        }
+      }
+    }
+    reconstruction.points3D.emplace(next_id, point3D);
+    next_id += 2;
+  }
+  return reconstruction;
+}
+
+void ExpectSameReconstruction(const Reconstruction& a, const Reconstruction& b) {
+  ASSERT_EQ(a.cameras.size(), b.cameras.size());
+  ASSERT_EQ(a.images.size(), b.images.size());
+  ASSERT_EQ(a.points3D.size(), b.points3D.size());
+  for (const auto& [id, camera] : a.cameras) {
+    ASSERT_EQ(b.cameras.count(id), 1u) << "camera " << id;
+    const Camera& other = b.cameras.at(id);
+    EXPECT_EQ(camera.model, other.model) << "camera " << id;
+    EXPECT_EQ(camera.width, other.width) << "camera " << id;
+    EXPECT_EQ(camera.height, other.height) << "camera " << id;
+    EXPECT_EQ(camera.params, other.params) << "camera " << id;
+  }
+  for (const auto& [id, image] : a.images) {
+    ASSERT_EQ(b.images.count(id), 1u) << "image " << id;
+    const Image& other = b.images.at(id);
+    EXPECT_EQ(image.name, other.name);
+    EXPECT_EQ(image.camera_id, other.camera_id) << "image " << id;
+    EXPECT_EQ(image.cam_from_world.rotation.coeffs(), other.cam_from_world.rotation.coeffs())
+        << "image " << id;
+    EXPECT_EQ(image.cam_from_world.translation, other.cam_from_world.translation) << "image " << id;
+    ASSERT_EQ(image.points2D.size(), other.points2D.size()) << "image " << id;
+    for (size_t k = 0; k < image.points2D.size(); ++k) {
+      EXPECT_EQ(image.points2D[k].xy, other.points2D[k].xy) << "image " << id << " point " << k;
+      EXPECT_EQ(image.points2D[k].point3D_id, other.points2D[k].point3D_id);
+    }
+  }
+  for (const auto& [id, point3D] : a.points3D) {
+    ASSERT_EQ(b.points3D.count(id), 1u) << "point3D " << id;
+    const Point3D& other = b.points3D.at(id);
+    EXPECT_EQ(point3D.xyz, other.xyz) << "point3D " << id;
+    EXPECT_EQ(point3D.color, other.color) << "point3D " << id;
+    EXPECT_EQ(point3D.error, other.error) << "point3D " << id;
+    ASSERT_EQ(point3D.track.size(), other.track.size()) << "point3D " << id;
+    for (size_t k = 0; k < point3D.track.size(); ++k) {
+      EXPECT_EQ(point3D.track[k].image_id, other.track[k].image_id);
+      EXPECT_EQ(point3D.track[k].point2D_idx, other.track[k].point2D_idx);
+    }
+  }
+}
+
+}  // namespace testing
+}  // namespace raycarve

@@ -1,0 +1,61 @@
+#pragma once
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace raycarve {
+namespace testing {
+
+// A fresh, empty folder for one test under the system's temporary folder.
+std::string MakeTemporaryDirectory(const std::string& name);
+
+// The shared data folder ($RAYCARVE_DATA_DIR, else <source>/../shared/data), or "" when absent.
+std::string DataDirectory();
+
+// Runs `command` through the shell; returns its exit status and stores stdout+stderr.
+int RunShell(const std::string& command, std::string* output);
+
+// The built `raycarve` program (set by CTest in $RAYCARVE_BINARY).
+std::string RaycarveBinary();
+
+// True when a `colmap` program is on the PATH.
+bool ColmapAvailable();
+
+// Writes bytes to a file (CHECK-fails on error).
+void WriteFile(const std::string& path, const std::string& bytes);
+std::string ReadFileBytes(const std::string& path);
+
+}  // namespace testing
+}  // namespace raycarve
+
+// Skips the test with a message naming what is missing.
+#define RAYCARVE_REQUIRE_DATA(relative_path)                                                \
+  const std::string data_path = ::raycarve::testing::DataDirectory().empty()                 \
+                                    ? std::string()                                          \
+                                    : ::raycarve::testing::DataDirectory() + "/" + relative_path; \
+  if (data_path.empty() || !std::filesystem::exists(data_path)) {                            \
+    GTEST_SKIP() << "shared data not found (" << relative_path                               \
+                 << "): set RAYCARVE_DATA_DIR or place ../shared/data beside the source";    \
+  }
+
+#define RAYCARVE_REQUIRE_COLMAP()                                                 \
+  if (!::raycarve::testing::ColmapAvailable()) {                                  \
+    GTEST_SKIP() << "the colmap program is not installed (apt-get install colmap)"; \
+  }
+
+#include "calib/reconstruction.h"
+
+namespace raycarve {
+namespace testing {
+
+// A random, consistent model: one camera of every COLMAP 3.8 model, `num_images` images with
+// random poses and points2D, and 3D points whose tracks refer to those points2D. Values use the
+// full double range of digits so that text round trips are really tested.
+Reconstruction RandomReconstruction(uint64_t seed, int num_images = 5, int num_points3D = 40);
+
+// Exact equality of every field (GoogleTest failures name the differing field).
+void ExpectSameReconstruction(const Reconstruction& a, const Reconstruction& b);
+
+}  // namespace testing
+}  // namespace raycarve

@@ -136,7 +136,9 @@ Reconstruction RandomReconstruction(uint64_t seed, int num_images, int num_point
   return reconstruction;
 }
 
-void ExpectSameReconstruction(const Reconstruction& a, const Reconstruction& b) {
+void ExpectSameReconstruction(const Reconstruction& a,
+                              const Reconstruction& b,
+                              double rotation_tolerance) {
   ASSERT_EQ(a.cameras.size(), b.cameras.size());
   ASSERT_EQ(a.images.size(), b.images.size());
   ASSERT_EQ(a.points3D.size(), b.points3D.size());
@@ -153,8 +155,16 @@ void ExpectSameReconstruction(const Reconstruction& a, const Reconstruction& b) 
     const Image& other = b.images.at(id);
     EXPECT_EQ(image.name, other.name);
     EXPECT_EQ(image.camera_id, other.camera_id) << "image " << id;
-    EXPECT_EQ(image.cam_from_world.rotation.coeffs(), other.cam_from_world.rotation.coeffs())
-        << "image " << id;
+    if (rotation_tolerance == 0.0) {
+      EXPECT_EQ(image.cam_from_world.rotation.coeffs(), other.cam_from_world.rotation.coeffs())
+          << "image " << id;
+    } else {
+      EXPECT_LE((image.cam_from_world.rotation.coeffs() - other.cam_from_world.rotation.coeffs())
+                    .cwiseAbs()
+                    .maxCoeff(),
+                rotation_tolerance)
+          << "image " << id;
+    }
     EXPECT_EQ(image.cam_from_world.translation, other.cam_from_world.translation) << "image " << id;
     ASSERT_EQ(image.points2D.size(), other.points2D.size()) << "image " << id;
     for (size_t k = 0; k < image.points2D.size(); ++k) {

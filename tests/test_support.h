@@ -54,8 +54,12 @@ namespace testing {
 // full double range of digits so that text round trips are really tested.
 Reconstruction RandomReconstruction(uint64_t seed, int num_images = 5, int num_points3D = 40);
 
-// Exact equality of every field (GoogleTest failures name the differing field).
-void ExpectSameReconstruction(const Reconstruction& a, const Reconstruction& b);
+// Equality of every field (GoogleTest failures name the differing field): exact, except that
+// quaternion coefficients may differ by `rotation_tolerance` (COLMAP renormalises quaternions
+// when it reads a model, which moves their last bits).
+void ExpectSameReconstruction(const Reconstruction& a,
+                              const Reconstruction& b,
+                              double rotation_tolerance = 0.0);
 
 }  // namespace testing
 }  // namespace raycarve

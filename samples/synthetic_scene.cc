@@ -229,6 +229,13 @@ bool SyntheticSceneOptions::IsValid(std::string* reason) const {
     *reason = "pixel_noise must be >= 0";
     return false;
   }
+  if (!camera_params.empty() &&
+      static_cast<int>(camera_params.size()) != CameraModelNumParams(camera_model)) {
+    *reason = "camera_params must hold " + std::to_string(CameraModelNumParams(camera_model)) +
+              " values for " + CameraModelName(camera_model) + " (" +
+              CameraModelParamsInfo(camera_model) + ")";
+    return false;
+  }
   if (supersampling < 1 || supersampling > 8) {
     *reason = "supersampling must be in [1, 8]";
     return false;
@@ -284,7 +291,10 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
   camera.width = options.width;
   camera.height = options.height;
   const double focal = 0.95 * options.width;
-  camera.params = ExampleCameraParams(options.camera_model, options.width, options.height, focal);
+  camera.params = options.camera_params.empty()
+                      ? ExampleCameraParams(
+                            options.camera_model, options.width, options.height, focal)
+                      : options.camera_params;
   reconstruction.cameras.emplace(camera.camera_id, camera);
 
   const double ring_radius = 5.0;

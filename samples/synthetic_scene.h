@@ -25,6 +25,7 @@ struct SyntheticSceneOptions {
   int height = 240;            // photo height in pixels
   uint64_t seed = 1;           // seeds the surface points' sampling and the pixel noise
   CameraModelId camera_model = CameraModelId::kPinhole;  // distortion from ExampleCameraParams
+  std::vector<double> camera_params;  // overrides ExampleCameraParams when not empty
   int num_surface_samples = 3000;  // candidate sparse points before the visibility filter
   double pixel_noise = 0.0;        // std. dev. of Gaussian noise on the 2D observations (px)
   int supersampling = 2;           // rays per pixel along each axis when rendering

@@ -1,0 +1,194 @@
+#include "calib/calibrated_view.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/input_error.h"
+#include "calib/model_reader.h"
+#include "calib/model_writer.h"
+#include "calib/pixel.h"
+#include "calib/view_reader.h"
+#include "samples/synthetic_scene.h"
+#include "tests/test_support.h"
+
+namespace raycarve {
+namespace {
+
+SyntheticSceneOptions SmallScene(CameraModelId model) {
+  SyntheticSceneOptions options;
+  options.num_views = 5;
+  options.width = 160;
+  options.height = 120;
+  options.camera_model = model;
+  options.num_surface_samples = 400;
+  options.supersampling = 1;
+  return options;
+}
+
+// Synthetic calibration: generate cameras around a scene, project known 3D points, write the model,
+// read it back, and reproject through the read cameras.
+TEST(SyntheticCalibration, ReprojectsThroughWrittenAndReadModelsBelowAMicroPixel) {
+  for (CameraModelId model : SupportedCameraModels()) {
+    SCOPED_TRACE(CameraModelName(model));
+    const SyntheticScene scene = GenerateSyntheticScene(SmallScene(model));
+    ASSERT_GT(scene.reconstruction.points3D.size(), 100u);
+    for (ModelFormat format : {ModelFormat::kBinary, ModelFormat::kText}) {
+      const std::string folder = testing::MakeTemporaryDirectory("synthetic_calibration");
+      WriteModel(scene.reconstruction, folder, format);
+      const Reconstruction read = ReadModel(folder);
+      double worst = 0.0;
+      int count = 0;
+      for (const auto& [image_id, image] : read.images) {
+        const Camera& camera = read.cameras.at(image.camera_id);
+        for (const Point2D& point2D : image.points2D) {
+          const Eigen::Vector3d xyz = read.points3D.at(point2D.point3D_id).xyz;
+          const Eigen::Vector2d projected =
+              camera.ImgFromCam((image.cam_from_world * xyz).hnormalized());
+          worst = std::max(worst, (projected - point2D.xy).norm());
+          ++count;
+        }
+      }
+      EXPECT_GT(count, 200);
+      EXPECT_LT(worst, 1e-6) << ModelFormatToString(format);
+      std::filesystem::remove_all(folder);
+    }
+  }
+}
+
+TEST(CalibratedView, ProjectionMatrixAgreesWithTheUndistortedObservations) {
+  for (CameraModelId model : SupportedCameraModels()) {
+    SCOPED_TRACE(CameraModelName(model));
+    const SyntheticScene scene = GenerateSyntheticScene(SmallScene(model));
+    const Reconstruction& reconstruction = scene.reconstruction;
+    for (const auto& [image_id, image] : reconstruction.images) {
+      const Camera& camera = reconstruction.cameras.at(image.camera_id);
+      const CalibratedView view =
+          MakeCalibratedView(camera, image, scene.photos.at(image_id), image.name);
+      EXPECT_TRUE(view.centre.isApprox(image.ProjectionCenter(), 1e-12));
+      // P = K [R | t] and the camera centre is its null space.
+      EXPECT_LT((view.P * view.centre.homogeneous()).norm(), 1e-9);
+      for (const Point2D& point2D : image.points2D) {
+        const Eigen::Vector3d xyz = reconstruction.points3D.at(point2D.point3D_id).xyz;
+        const Eigen::Vector2d observed =
+            (view.K * camera.CamFromImg(point2D.xy).homogeneous()).hnormalized();
+        EXPECT_LT((view.Project(xyz) - observed).norm(), 1e-6);
+        EXPECT_GT(view.Depth(xyz), 0.0);
+      }
+    }
+  }
+}
+
+enum class Sampling { kUndistortedAtProjection, kRawAtObservation, kRawAtProjection };
+
+// Mean colour difference (grey levels) between the sparse points' true colours and a photo
+// sampled bilinearly: the undistorted view at its P projection, the raw photo at the true
+// observation (the reference: texture edges and silhouettes cost something even there), or the
+// raw photo at the P projection (what ignoring distortion would give).
+double MeanColourError(const SyntheticScene& scene,
+                       const std::vector<CalibratedView>& views,
+                       Sampling sampling) {
+  double sum = 0.0;
+  int count = 0;
+  for (const CalibratedView& view : views) {
+    const cv::Mat& photo =
+        sampling == Sampling::kUndistortedAtProjection ? view.image : scene.photos.at(view.image_id);
+    for (const Point2D& point2D : scene.reconstruction.images.at(view.image_id).points2D) {
+      const Point3D& point3D = scene.reconstruction.points3D.at(point2D.point3D_id);
+      const Eigen::Vector2d at = OpenCvFromColmap(
+          sampling == Sampling::kRawAtObservation ? point2D.xy : view.Project(point3D.xyz));
+      cv::Mat patch;
+      cv::getRectSubPix(photo, cv::Size(1, 1), cv::Point2f(at.x(), at.y()), patch);
+      const cv::Vec3b colour = patch.at<cv::Vec3b>(0, 0);
+      for (int k = 0; k < 3; ++k) sum += std::abs(colour[k] - point3D.color[k]) / 3.0;
+      ++count;
+    }
+  }
+  return sum / count;
+}
+
+TEST(CalibratedView, UndistortedPhotosShowTheSparsePointsTrueColours) {
+  SyntheticSceneOptions options = SmallScene(CameraModelId::kOpenCv);
+  options.width = 320;
+  options.height = 240;
+  options.supersampling = 2;
+  options.num_surface_samples = 1500;
+  options.camera_params = {304, 304, 161, 119, -0.5, 0.05, 0.002, -0.001};  // strong barrel
+  const SyntheticScene scene = GenerateSyntheticScene(options);
+  std::vector<CalibratedView> views;
+  for (const auto& [image_id, image] : scene.reconstruction.images) {
+    views.push_back(MakeCalibratedView(scene.reconstruction.cameras.at(image.camera_id),
+                                       image,
+                                       scene.photos.at(image_id),
+                                       image.name));
+  }
+  const double undistorted = MeanColourError(scene, views, Sampling::kUndistortedAtProjection);
+  const double reference = MeanColourError(scene, views, Sampling::kRawAtObservation);
+  const double ignored = MeanColourError(scene, views, Sampling::kRawAtProjection);
+  std::cout << "mean colour error (grey levels): undistorted at P " << undistorted
+            << ", raw at true observation " << reference << ", raw at P " << ignored << "\n";
+  // Measured: 14.6, 12.1 and 25.3. The undistorted views lose only a second bilinear resampling
+  // against the reference; ignoring the distortion costs twice as much again.
+  EXPECT_LT(undistorted, reference + 4.0);
+  EXPECT_GT(ignored, undistorted + 6.0);
+}
+
+TEST(CalibratedView, PhotoOfTheWrongSizeIsAnErrorNamingIt) {
+  const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kPinhole));
+  const Image& image = scene.reconstruction.images.begin()->second;
+  const Camera& camera = scene.reconstruction.cameras.at(image.camera_id);
+  const cv::Mat small(60, 80, CV_8UC3, cv::Scalar::all(0));
+  try {
+    MakeCalibratedView(camera, image, small, "images/view001.png");
+    FAIL() << "wrong size accepted";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("images/view001.png"), std::string::npos) << message;
+    EXPECT_NE(message.find("80x60"), std::string::npos) << message;
+    EXPECT_NE(message.find("160x120"), std::string::npos) << message;
+  }
+}
+
+TEST(ViewReader, MissingPhotosAreErrorsOrSkippedAndCounted) {
+  const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kSimpleRadial));
+  const std::string root = testing::MakeTemporaryDirectory("view_reader");
+  WriteSyntheticProject(scene, root);
+  const std::string missing = root + "/images/view002.png";
+  std::filesystem::remove(missing);
+
+  try {
+    ReadCalibratedViews(scene.reconstruction, root + "/images", ViewReaderOptions(), nullptr);
+    FAIL() << "missing photo accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find(missing), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("image 2"), std::string::npos) << error.what();
+  }
+  ViewReaderOptions skip;
+  skip.skip_missing_images = true;
+  ViewReaderSummary summary;
+  const std::vector<CalibratedView> views =
+      ReadCalibratedViews(scene.reconstruction, root + "/images", skip, &summary);
+  EXPECT_EQ(views.size(), 4u);
+  EXPECT_EQ(summary.num_registered, 5);
+  ASSERT_EQ(summary.missing.size(), 1u);
+  EXPECT_EQ(summary.missing[0], missing);
+  // Photos round-trip through PNG losslessly, so the views hold the rendered pixels (undistorted).
+  EXPECT_EQ(views[0].image.size(), cv::Size(160, 120));
+
+  testing::WriteFile(root + "/images/view003.png", "not a png");
+  try {
+    ReadCalibratedViews(scene.reconstruction, root + "/images", skip, nullptr);
+    FAIL() << "corrupt photo accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("view003.png"), std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("decoded"), std::string::npos);
+  }
+  std::filesystem::remove_all(root);
+}
+
+}  // namespace
+}  // namespace raycarve

@@ -188,3 +188,28 @@ void ExpectSameReconstruction(const Reconstruction& a,
 
 }  // namespace testing
 }  // namespace raycarve
+
+namespace raycarve {
+namespace testing {
+
+Eigen::AlignedBox3d ReadMiddleburyReadmeBox(const std::string& readme_path) {
+  const std::string text = ReadFileBytes(readme_path);
+  const size_t at = text.find("bounding box");
+  EXPECT_NE(at, std::string::npos) << readme_path;
+  std::vector<double> values;
+  size_t position = at;
+  while (values.size() < 6) {
+    position = text.find_first_of("-0123456789", position);
+    if (position == std::string::npos) break;
+    size_t used = 0;
+    values.push_back(std::stod(text.substr(position), &used));
+    position += used;
+  }
+  EXPECT_EQ(values.size(), 6u) << readme_path;
+  values.resize(6, 0.0);
+  return Eigen::AlignedBox3d(Eigen::Vector3d(values[0], values[1], values[2]),
+                             Eigen::Vector3d(values[3], values[4], values[5]));
+}
+
+}  // namespace testing
+}  // namespace raycarve

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -60,6 +61,18 @@ Reconstruction RandomReconstruction(uint64_t seed, int num_images = 5, int num_p
 void ExpectSameReconstruction(const Reconstruction& a,
                               const Reconstruction& b,
                               double rotation_tolerance = 0.0);
+
+}  // namespace testing
+}  // namespace raycarve
+
+#include <Eigen/Geometry>
+
+namespace raycarve {
+namespace testing {
+
+// The "(tight) bounding box" stated in a Middlebury set's README.txt: the two lines of three
+// numbers in parentheses after the words "bounding box". Fails the test if absent.
+Eigen::AlignedBox3d ReadMiddleburyReadmeBox(const std::string& readme_path);
 
 }  // namespace testing
 }  // namespace raycarve

@@ -1,0 +1,67 @@
+#include "export/point_cloud_io.h"
+
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "calib/input_error.h"
+#include "tests/test_support.h"
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+std::vector<ColouredPoint> SomePoints() {
+  std::vector<ColouredPoint> points(3);
+  points[0].xyz = Eigen::Vector3f(1.5f, -2.0f, 0.25f);
+  points[0].normal = Eigen::Vector3f(0, 0, 1);
+  points[0].rgb << 255, 10, 0;
+  points[1].xyz = Eigen::Vector3f(0, 1e-3f, 7);
+  points[1].normal = Eigen::Vector3f(0.6f, 0.8f, 0);
+  points[1].rgb << 1, 2, 3;
+  points[2].xyz = Eigen::Vector3f(-4, 5, -6);
+  return points;
+}
+
+TEST(PointCloudIo, WritesBinaryPlyWithFusedPlyPropertiesAndReadsItBack) {
+  const std::string folder = testing::MakeTemporaryDirectory("ply");
+  const std::string path = folder + "/cloud.ply";
+  WritePointCloudPly(SomePoints(), path);
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp.ply"));
+
+  const std::string bytes = testing::ReadFileBytes(path);
+  const std::string header = bytes.substr(0, bytes.find("end_header"));
+  EXPECT_NE(header.find("format binary_little_endian 1.0"), std::string::npos) << header;
+  EXPECT_NE(header.find("element vertex 3"), std::string::npos) << header;
+  for (const char* property : {"float x", "float y", "float z", "float nx", "float ny",
+                               "float nz", "uchar red", "uchar green", "uchar blue"}) {
+    EXPECT_NE(header.find(std::string("property ") + property), std::string::npos)
+        << property << " missing from:\n" << header;
+  }
+  const std::vector<ColouredPoint> read = ReadPointCloudPly(path);
+  const std::vector<ColouredPoint> original = SomePoints();
+  ASSERT_EQ(read.size(), original.size());
+  for (size_t i = 0; i < read.size(); ++i) {
+    EXPECT_EQ(read[i].xyz, original[i].xyz);
+    EXPECT_EQ(read[i].normal, original[i].normal);
+    EXPECT_EQ(read[i].rgb, original[i].rgb);
+  }
+  std::filesystem::remove_all(folder);
+}
+
+TEST(PointCloudIo, MissingOrBrokenFilesAreNamed) {
+  const std::string folder = testing::MakeTemporaryDirectory("ply_bad");
+  EXPECT_THROW(ReadPointCloudPly(folder + "/none.ply"), InputError);
+  testing::WriteFile(folder + "/broken.ply", "ply\nformat ascii 1.0\nelement vertex 5\nend_header\n1 2\n");
+  try {
+    ReadPointCloudPly(folder + "/broken.ply");
+    FAIL();
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("broken.ply"), std::string::npos);
+  }
+  std::filesystem::remove_all(folder);
+}
+
+}  // namespace
+}  // namespace exporter
+}  // namespace raycarve

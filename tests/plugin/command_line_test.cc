@@ -1,0 +1,207 @@
+// The `raycarve` program as a user runs it: bad input ends with one line naming the file and the
+// field and exit status 1, never a crash; good input produces its outputs.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/test_support.h"
+
+namespace raycarve {
+namespace {
+
+namespace fs = std::filesystem;
+
+class CommandLine : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = new std::string(testing::MakeTemporaryDirectory("command_line"));
+    std::string output;
+    const int status = Run("synth --output_path " + Project() +
+                               " --views 4 --width 96 --height 72 --points 300 --camera_model RADIAL",
+                           &output);
+    ASSERT_EQ(status, 0) << output;
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*root_);
+    delete root_;
+  }
+
+  static std::string Project() { return *root_ + "/project"; }
+
+  static int Run(const std::string& arguments, std::string* output) {
+    return testing::RunShell("'" + testing::RaycarveBinary() + "' " + arguments, output);
+  }
+
+  // A copy of the project's model in `format` (BIN as written, or TXT) to corrupt.
+  static std::string CopyModel(const std::string& name, const std::string& format = "BIN") {
+    const std::string copy = *root_ + "/" + name;
+    fs::remove_all(copy);
+    std::string output;
+    EXPECT_EQ(Run("model_converter --input_path " + Project() + "/sparse/0 --output_path " + copy +
+                      " --output_type " + format,
+                  &output),
+              0)
+        << output;
+    return copy;
+  }
+
+  // Runs the command and expects exit status 1 with a message holding every part, and no sign
+  // of a crash or a failed internal check.
+  static void ExpectUserError(const std::string& arguments, std::initializer_list<std::string> parts) {
+    std::string output;
+    const int status = Run(arguments, &output);
+    EXPECT_EQ(status, 1) << arguments << "\n" << output;
+    EXPECT_NE(output.find("error: "), std::string::npos) << output;
+    for (const std::string& part : parts) {
+      EXPECT_NE(output.find(part), std::string::npos) << "'" << part << "' not in:\n" << output;
+    }
+    for (const char* crash : {"Check failed", "Aborted", "Segmentation", "terminate", "AddressSanitizer"}) {
+      EXPECT_EQ(output.find(crash), std::string::npos) << output;
+    }
+  }
+
+  static std::string* root_;
+};
+
+std::string* CommandLine::root_ = nullptr;
+
+TEST_F(CommandLine, UsageHelpAndUnknownCommands) {
+  std::string output;
+  EXPECT_EQ(Run("help", &output), 0);
+  EXPECT_NE(output.find("model_info"), std::string::npos);
+  EXPECT_EQ(Run("", &output), 1);
+  EXPECT_EQ(Run("carve_everything", &output), 1);
+  EXPECT_NE(output.find("unknown command 'carve_everything'"), std::string::npos);
+  EXPECT_EQ(Run("calibrate --help", &output), 0);
+  EXPECT_NE(output.find("--workspace_path"), std::string::npos);
+  ExpectUserError("model_info --input_path x --bogus 1", {"unknown option --bogus"});
+  ExpectUserError("synth --output_path x --views many", {"--views", "'many'"});
+}
+
+TEST_F(CommandLine, TruncatedBinaryFileIsNamedWithRecordAndField) {
+  const std::string model = CopyModel("truncated");
+  const std::string images = model + "/images.bin";
+  const std::string bytes = testing::ReadFileBytes(images);
+  testing::WriteFile(images, bytes.substr(0, bytes.size() / 2));
+  ExpectUserError("model_info --input_path " + model, {images, "image record", "field '"});
+}
+
+TEST_F(CommandLine, CorruptedCountAndUnknownCameraModelAreNamed) {
+  std::string model = CopyModel("corrupted_count");
+  std::string bytes = testing::ReadFileBytes(model + "/points3D.bin");
+  const uint64_t huge = uint64_t{1} << 62;
+  bytes.replace(0, 8, reinterpret_cast<const char*>(&huge), 8);
+  testing::WriteFile(model + "/points3D.bin", bytes);
+  ExpectUserError("model_info --input_path " + model,
+                  {model + "/points3D.bin", "num_points3D", "wrong count"});
+
+  model = CopyModel("unknown_model");
+  bytes = testing::ReadFileBytes(model + "/cameras.bin");
+  const int32_t eucm = 16;
+  bytes.replace(8 + 4, 4, reinterpret_cast<const char*>(&eucm), 4);
+  testing::WriteFile(model + "/cameras.bin", bytes);
+  ExpectUserError("model_info --input_path " + model,
+                  {model + "/cameras.bin", "camera 1", "model_id", "EUCM"});
+}
+
+TEST_F(CommandLine, NaNPoseIsNamed) {
+  const std::string model = CopyModel("nan_pose", "TXT");
+  std::ifstream in(model + "/images.txt");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // The first data line: "IMAGE_ID QW ..." -> replace QW by nan.
+  size_t line = 0;
+  while (text[line] == '#') line = text.find('\n', line) + 1;
+  const size_t qw = text.find(' ', line) + 1;
+  text.replace(qw, text.find(' ', qw) - qw, "nan");
+  testing::WriteFile(model + "/images.txt", text);
+  ExpectUserError("model_info --input_path " + model, {model, "image 1", "view001.png", "pose", "not finite"});
+}
+
+TEST_F(CommandLine, EmptyModelIsAClearErrorForEveryCommandThatNeedsContent) {
+  const std::string model = *root_ + "/empty";
+  fs::create_directories(model);
+  for (const char* file : {"cameras.txt", "images.txt", "points3D.txt"}) {
+    testing::WriteFile(model + "/" + file, "");
+  }
+  ExpectUserError("model_info --input_path " + model, {model, "no 3D points", "--bbox"});
+  ExpectUserError("calibrate --input_path " + model + " --image_path " + Project() +
+                      "/images --output_path " + *root_ + "/empty_out",
+                  {model, "no registered images"});
+  ExpectUserError("model_info --input_path " + *root_ + "/nowhere", {*root_ + "/nowhere", "does not exist"});
+}
+
+TEST_F(CommandLine, MissingOrWrongPhotosAreNamedAndCanBeSkipped) {
+  const std::string images = *root_ + "/images_missing";
+  fs::remove_all(images);
+  fs::copy(Project() + "/images", images);
+  fs::remove(images + "/view003.png");
+  const std::string base = "calibrate --input_path " + Project() + "/sparse/0 --output_path " +
+                           *root_ + "/out_missing --image_path " + images;
+  ExpectUserError(base, {images + "/view003.png", "image 3", "not found"});
+  std::string output;
+  EXPECT_EQ(Run(base + " --skip_missing_images 1", &output), 0) << output;
+  EXPECT_NE(output.find("3 of 4 registered images loaded, 1 skipped"), std::string::npos) << output;
+
+  cv::imwrite(images + "/view003.png", cv::Mat(10, 12, CV_8UC3, cv::Scalar::all(0)));
+  ExpectUserError(base, {images + "/view003.png", "12x10", "96x72"});
+}
+
+TEST_F(CommandLine, ConverterNeverOverwritesItsInput) {
+  const std::string model = CopyModel("no_overwrite");
+  ExpectUserError("model_converter --input_path " + model + " --output_path " + model + "/. --output_type TXT",
+                  {"never overwrites"});
+}
+
+// Reads the number after "key": in a JSON text (the reports are written by raycarve itself).
+double JsonNumber(const std::string& json, const std::string& key) {
+  const size_t at = json.find("\"" + key + "\":");
+  EXPECT_NE(at, std::string::npos) << key;
+  return at == std::string::npos ? NAN : std::stod(json.substr(at + key.size() + 3));
+}
+
+TEST_F(CommandLine, CalibrateWritesViewsAndAReportWithExactReprojection) {
+  const std::string out = *root_ + "/calibration";
+  std::string output;
+  ASSERT_EQ(Run("calibrate --workspace_path " + Project() + " --output_path " + out, &output), 0)
+      << output;
+  const std::string report = testing::ReadFileBytes(out + "/report.json");
+  EXPECT_EQ(JsonNumber(report, "num_views"), 4);
+  EXPECT_GT(JsonNumber(report, "num_observations"), 100);
+  EXPECT_LT(JsonNumber(report, "max_reprojection_error_px"), 1e-6);
+  for (int i = 1; i <= 4; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "view%03d.png", i);
+    EXPECT_TRUE(fs::is_regular_file(out + "/undistorted/" + name)) << name;
+    EXPECT_TRUE(fs::is_regular_file(out + "/masks/" + name + ".png")) << name;
+  }
+  ASSERT_EQ(Run("model_info --input_path " + Project() + "/sparse/0 --format json", &output), 0);
+  EXPECT_NE(output.find("\"bounds\""), std::string::npos) << output;
+  EXPECT_EQ(JsonNumber(output, "num_points"), JsonNumber(output, "count"));
+}
+
+TEST_F(CommandLine, ImportsTheRealMiddleburyCalibrationAndDescribesIt) {
+  RAYCARVE_REQUIRE_DATA("middlebury/templeSparseRing");
+  const std::string model = *root_ + "/temple_model";
+  std::string output;
+  ASSERT_EQ(Run("import_middlebury --input_path " + data_path + "/templeSR_par.txt --image_path " +
+                    data_path + " --output_path " + model,
+                &output),
+            0)
+      << output;
+  EXPECT_TRUE(fs::is_regular_file(model + "/cameras.txt"));
+  // No 3D points in an imported calibration: bounds must come from --bbox.
+  ExpectUserError("model_info --input_path " + model, {"no 3D points"});
+  ASSERT_EQ(Run("model_info --input_path " + model + " --format json --bbox " +
+                    "-0.073568,0.021728,-0.012445,0.028855,0.181892,0.062736",
+                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("templeSR0016.png"), std::string::npos);
+  EXPECT_NE(output.find("\"explicit\": true"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace raycarve

@@ -1,7 +1,19 @@
 #!/usr/bin/env bash
-# README command 2: set-up, build everything, and run every test (CTest, 2 at a time).
+# README command 2: set-up, build everything, and run every test (CTest, 2 at a time); then the
+# tests that feed raycarve bad input again under AddressSanitizer + UndefinedBehaviorSanitizer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-cd build
-ctest --output-on-failure --timeout 900 -j"$(nproc 2>/dev/null || echo 2)"
+jobs=$(nproc 2>/dev/null || echo 2)
+(cd build && ctest --output-on-failure --timeout 900 -j"$jobs")
+
+echo "[tests] bad-input tests under AddressSanitizer + UBSan (build-asan/)" >&2
+if [ ! -f build-asan/CMakeCache.txt ]; then
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYCARVE_ASAN_ENABLED=ON \
+    -DRAYCARVE_TESTS_ENABLED=ON >&2
+fi
+cmake --build build-asan -j"$jobs" --target raycarve calib_model_reader_test calib_middlebury_test \
+  calib_colmap_program_test export_point_cloud_io_test plugin_option_parser_test \
+  plugin_command_line_test >&2
+(cd build-asan && ctest --output-on-failure --timeout 900 -j"$jobs" \
+  -R 'calib/(model_reader|middlebury|colmap_program)_test|export/point_cloud_io_test|plugin/(option_parser|command_line)_test')

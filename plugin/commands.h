@@ -2,8 +2,14 @@
 
 #include <string>
 
+#include <memory>
+#include <utility>
+#include <vector>
+
 #include "calib/bounds.h"
 #include "calib/reconstruction.h"
+#include "calib/view_reader.h"
+#include "carve/carver.h"
 #include "plugin/option_parser.h"
 
 namespace raycarve {
@@ -16,6 +22,7 @@ int RunModelConverter(int argc, char** argv);
 int RunImportMiddlebury(int argc, char** argv);
 int RunSynth(int argc, char** argv);
 int RunCalibrate(int argc, char** argv);
+int RunCarve(int argc, char** argv);
 
 // Options shared by every command that bounds the volume.
 struct BoundsFlags {
@@ -35,6 +42,36 @@ std::string DescribeModelText(const Reconstruction& reconstruction,
 std::string DescribeModelJson(const Reconstruction& reconstruction,
                               const std::string& model_path,
                               const Bounds& bounds);
+
+// carve: everything `raycarve carve` takes, and what it produced.
+struct CarveRequest {
+  std::string workspace_path;
+  std::string input_path;
+  std::string image_path;
+  std::string output_path;  // default <workspace>/raycarve
+  CarveOptions options;
+  BoundsFlags bounds;
+  ViewReaderOptions view_options;
+  double progress_seconds = 2.0;  // between progress lines
+};
+
+struct CarveRun {
+  std::string model_path;
+  std::string image_path;
+  std::string output_path;
+  Bounds bounds;
+  int num_views = 0;
+  int num_missing_images = 0;
+  std::unique_ptr<CarveResult> result;
+  std::vector<std::pair<std::string, double>> stage_seconds;
+  size_t num_cloud_points = 0;
+  size_t num_mesh_triangles = 0;
+};
+
+// Reads the project, carves, and writes cloud.ply, mesh.ply, report.json and convergence.csv
+// into the output folder. Throws InputError on bad input or options.
+CarveRun CarveProject(const CarveRequest& request);
+std::string CarveReportJson(const CarveRequest& request, const CarveRun& run);
 
 // Throws InputError when `output_path` is `input_path` (after resolving links and dots): the
 // writers would replace the input's files.

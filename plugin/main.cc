@@ -24,6 +24,8 @@ const Command kCommands[] = {
      "turn a Middlebury *_par.txt calibration into a COLMAP model"},
     {"calibrate", raycarve::RunCalibrate,
      "build calibrated, undistorted views of a COLMAP project and check them"},
+    {"carve", raycarve::RunCarve,
+     "carve a coloured voxel model (cloud.ply, mesh.ply) from a COLMAP project"},
     {"synth", raycarve::RunSynth, "generate a synthetic COLMAP project with ground truth"},
 };
 

@@ -21,7 +21,6 @@ const Eigen::Vector3d kSphereCentre(0.45, 0.35, 0.55);
 constexpr double kSphereRadius = 0.55;
 const Eigen::Vector3d kBoxMin(-1.05, -0.75, 0.0);
 const Eigen::Vector3d kBoxMax(-0.2, 0.05, 0.8);
-const Eigen::Vector3d kSkyColour(40, 40, 60);
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 enum class Surface { kNone, kGround, kSphere, kBox };
@@ -93,6 +92,21 @@ Hit Trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
   return hit;
 }
 
+// The sky: a patchwork over directions (cells of 9 degrees of azimuth by 7 of elevation, each a
+// colour of its own). Empty space seen against it from different views shows different colours,
+// as against a real background; a uniform sky would be photo-consistent everywhere and leave a
+// shell of sky-coloured voxels.
+Eigen::Vector3d SkyColour(const Eigen::Vector3d& direction) {
+  const double azimuth = std::atan2(direction.y(), direction.x());
+  const double elevation = std::asin(std::clamp(direction.z(), -1.0, 1.0));
+  const int cell_a = static_cast<int>(std::floor(azimuth / (M_PI / 20.0)));
+  const int cell_e = static_cast<int>(std::floor(elevation / (M_PI / 26.0)));
+  uint32_t hash = static_cast<uint32_t>(cell_a * 73856093) ^ static_cast<uint32_t>(cell_e * 19349663);
+  hash = (hash ^ (hash >> 13)) * 0x5bd1e995u;
+  hash ^= hash >> 15;
+  return Eigen::Vector3d(40 + (hash & 0x7f), 40 + ((hash >> 8) & 0x7f), 60 + ((hash >> 16) & 0x7f));
+}
+
 // Texture colour (RGB, 0-255) of a surface point, with a fixed directional shading.
 Eigen::Vector3d SurfaceColour(const Hit& hit) {
   Eigen::Vector3d albedo = Eigen::Vector3d::Zero();
@@ -115,12 +129,12 @@ Eigen::Vector3d SurfaceColour(const Hit& hit) {
     }
     case Surface::kBox: {
       const double s = hit.point.x() + hit.point.y() + 1.7 * hit.point.z();
-      const bool stripe = static_cast<int>(std::floor(s / 0.12)) & 1;
+      const bool stripe = static_cast<int>(std::floor(s / 0.24)) & 1;
       albedo = stripe ? Eigen::Vector3d(40, 150, 80) : Eigen::Vector3d(170, 230, 240);
       break;
     }
     case Surface::kNone:
-      return kSkyColour;
+      LOG(FATAL) << "no surface: use SkyColour";
   }
   const Eigen::Vector3d light = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
   const double shade = 0.55 + 0.45 * std::max(0.0, hit.normal.dot(light));
@@ -155,7 +169,8 @@ cv::Mat Render(const Camera& camera, const Rigid3d& cam_from_world, int supersam
           if (!normalized.allFinite()) continue;
           const Eigen::Vector3d direction =
               (world_from_cam.rotation * normalized.homogeneous()).normalized();
-          sum += SurfaceColour(Trace(world_from_cam.translation, direction));
+          const Hit hit = Trace(world_from_cam.translation, direction);
+          sum += hit.surface == Surface::kNone ? SkyColour(direction) : SurfaceColour(hit);
         }
       }
       const Eigen::Vector3d rgb = sum / (supersampling * supersampling);

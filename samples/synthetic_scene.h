@@ -13,7 +13,7 @@
 namespace raycarve {
 
 // A deterministic synthetic scene with exact ground truth: a textured sphere and a striped box
-// standing on a checkered ground square, under a uniform sky, seen by cameras on a ring around
+// standing on a checkered ground square, under a patchwork sky, seen by cameras on a ring around
 // and above it. Rendered by ray tracing (unlit textures with fixed, view-independent shading, so
 // every surface point has one colour in every view), through any COLMAP 3.8 camera model, so the
 // photos carry that model's distortion.

@@ -1,0 +1,97 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "calib/calibrated_view.h"
+#include "carve/consistency.h"
+#include "carve/volume.h"
+
+namespace raycarve {
+
+// Incremental voxel colouring with ray-cast visibility (Batchelor, Mukundan, Green).
+struct CarveOptions {
+  // Voxels along the longest axis of the box; voxels are cubes.
+  int resolution = 128;
+  // How visible pixels are judged (see consistency.h).
+  ConsistencyMethod consistency = ConsistencyMethod::kMeanColour;
+  // Largest consistent error, in RGB units (0-255).
+  double threshold = 30.0;
+  // Views a voxel must be seen by to be judged; voxels seen by fewer stay.
+  int min_views = 2;
+  // Refuse a grid whose carving structures would need more memory than this (GiB).
+  double max_memory_gib = 8.0;
+
+  bool IsValid(std::string* reason) const;
+};
+
+struct CarveProgress {
+  int64_t evaluated = 0;
+  int64_t carved = 0;
+  int64_t queued = 0;
+  double seconds = 0.0;  // since carving started (after set-up)
+};
+
+// One point of the carving curve (the paper's Figure 6).
+struct CurveSample {
+  double seconds = 0.0;
+  int64_t carved = 0;
+  int64_t evaluated = 0;
+};
+
+struct CarveStatistics {
+  std::string visibility;  // "ray"
+  Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
+  double voxel_size = 0.0;
+  int64_t num_voxels = 0;
+  int64_t initial_surface = 0;
+  int64_t final_surface = 0;
+  int64_t final_solid = 0;
+  int64_t carved = 0;
+  int64_t evaluated = 0;
+  int64_t visible_surface = 0;  // final surface voxels seen by at least one pixel
+  double setup_seconds = 0.0;   // volume and rays
+  double carve_seconds = 0.0;   // the carving loop: the convergence time
+  double colour_seconds = 0.0;  // colouring the final surface
+  size_t peak_memory_bytes = 0;  // volume, visibility structures and the CVSVL
+  std::vector<CurveSample> curve;
+
+  std::string Summary() const;
+};
+
+struct ColouredVoxel {
+  int64_t index = 0;
+  Eigen::Vector3f colour = Eigen::Vector3f::Zero();  // RGB 0-255, mean of the visible pixels
+  int num_views = 0;
+  int num_pixels = 0;  // 0: no view sees this surface voxel (it is not coloured)
+};
+
+struct CarveResult {
+  explicit CarveResult(const VoxelGrid& grid) : volume(grid) {}
+  Volume volume;
+  std::vector<ColouredVoxel> surface;  // every final surface voxel, in index order
+  CarveStatistics statistics;
+};
+
+// Estimates the memory of carving `views` over `box` with `options` and returns false, with a
+// reason giving the sizes, when the options are invalid or the estimate exceeds
+// options.max_memory_gib.
+bool CheckCarveFits(const std::vector<CalibratedView>& views,
+                    const Eigen::AlignedBox3d& box,
+                    const CarveOptions& options,
+                    std::string* reason);
+
+// Carves the volume over `box` seen by `views` until no voxel whose visibility changed is
+// inconsistent. `progress` (optional) is called about every `progress_interval_seconds` of
+// carving. Options must pass CheckCarveFits (CHECKed).
+CarveResult CarveVolume(const std::vector<CalibratedView>& views,
+                        const Eigen::AlignedBox3d& box,
+                        const CarveOptions& options,
+                        const std::function<void(const CarveProgress&)>& progress = {},
+                        double progress_interval_seconds = 1.0);
+
+}  // namespace raycarve

@@ -1,0 +1,61 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace raycarve {
+
+// The colour statistics of a voxel's visible pixels in one view (RGB, 0-255).
+struct ViewColourStats {
+  int view = 0;
+  int count = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sum_squares = Eigen::Vector3d::Zero();
+
+  void Add(const Eigen::Vector3d& rgb) {
+    ++count;
+    sum += rgb;
+    sum_squares += rgb.cwiseProduct(rgb);
+  }
+};
+
+enum class ConsistencyMethod {
+  kMeanColour,         // the seed paper's weighted difference of per-view mean colours
+  kStandardDeviation,  // Seitz and Dyer's standard deviation of all visible pixels
+};
+std::string ConsistencyMethodToString(ConsistencyMethod method);
+// Returns false when `text` names no method.
+bool ConsistencyMethodFromString(const std::string& text, ConsistencyMethod* method);
+
+struct Consistency {
+  bool judged = false;      // seen by at least min_views views; otherwise kept unjudged
+  bool consistent = true;   // false: carve
+  double error = 0.0;       // the method's error (RGB units, 0-255)
+  Eigen::Vector3d colour = Eigen::Vector3d::Zero();  // the voxel's colour: pixel-weighted mean
+  int num_views = 0;
+  int num_pixels = 0;
+};
+
+// Decides whether a voxel's visible pixels agree on one colour.
+//
+// kMeanColour: per view j the mean m_j of its n_j pixels; m = sum n_j m_j / sum n_j; the error
+// is sum n_j |m_j - m| / sum n_j with |.| the Euclidean norm in RGB.
+// kStandardDeviation: the root mean square over the channels of the standard deviation of all
+// visible pixels together.
+// Either way a voxel is inconsistent when its error exceeds `threshold`; a voxel seen by fewer
+// than `min_views` views is not judged and stays.
+class ConsistencyTest {
+ public:
+  ConsistencyTest(ConsistencyMethod method, double threshold, int min_views);
+  Consistency Evaluate(const std::vector<ViewColourStats>& views) const;
+
+ private:
+  ConsistencyMethod method_;
+  double threshold_;
+  int min_views_;
+};
+
+}  // namespace raycarve

@@ -1,0 +1,83 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "carve/volume.h"
+#include "carve/voxel_grid.h"
+
+namespace raycarve {
+
+// The image of rays of one view: the seed paper's item buffer. One ray per pixel, from the camera
+// centre through the pixel centre, clipped to the grid's box, with the state of an Amanatides-Woo
+// traversal (the current voxel and, per axis, the ray parameter of the next voxel boundary).
+//
+// Inputs: the view's 3x4 projection in its pinhole form (K, cam_from_world rotation, centre),
+// its size, and an optional mask of pixels that hold photo data (rays are only made there).
+// Outputs: per pixel, the current voxel (the nearest solid voxel along the ray, once Initialise
+// and Advance keep it so) or kNoVoxel when the ray missed the box, has left it, or the pixel is
+// masked out.
+//
+// Memory: 20 bytes per pixel (the direction is recomputed from the pixel when a ray is stepped).
+// Voxel coordinates are stored in 16 bits: grids up to 32767 voxels along an axis.
+class RayImage {
+ public:
+  static constexpr int64_t kNoVoxel = -1;
+
+  // `world_from_pixel` maps homogeneous COLMAP pixel coordinates (x, y, 1) to a world-space
+  // direction (R^T K^-1); `centre` is the camera centre in world coordinates.
+  RayImage(const VoxelGrid& grid,
+           const Eigen::Matrix3d& world_from_pixel,
+           const Eigen::Vector3d& centre,
+           int width,
+           int height,
+           const cv::Mat& valid = cv::Mat());
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int num_pixels() const { return width_ * height_; }
+
+  // Moves every ray to the first solid voxel of `volume` along it.
+  void Initialise(const Volume& volume);
+
+  int64_t CurrentVoxel(int pixel) const {
+    const RayState& ray = rays_[pixel];
+    return ray.active ? grid_.Index(Eigen::Vector3i(ray.voxel[0], ray.voxel[1], ray.voxel[2]))
+                      : kNoVoxel;
+  }
+
+  // Steps the ray at `pixel` until its current voxel is solid in `volume` or it leaves the box
+  // (then kNoVoxel). Returns the new current voxel. A ray already at a solid voxel stays.
+  // Cost: one step per voxel passed (Amanatides-Woo).
+  int64_t Advance(int pixel, const Volume& volume);
+
+  // The ray parameter convention: world point = centre + t * Direction(pixel).
+  Eigen::Vector3d Direction(int pixel) const;
+
+  size_t MemoryBytes() const { return rays_.capacity() * sizeof(RayState); }
+
+ private:
+  struct RayState {
+    int16_t voxel[3];
+    int16_t active;  // 1 while the ray is inside the box
+    float t_max[3];  // ray parameter of the next boundary crossing per axis
+  };
+  static_assert(sizeof(RayState) == 20, "ray state must stay compact");
+
+  void InitialiseRay(int pixel);
+  // The direction in grid units (voxel size 1) for `pixel`.
+  Eigen::Vector3d GridDirection(int pixel) const;
+
+  VoxelGrid grid_;
+  Eigen::Matrix3d world_from_pixel_;
+  Eigen::Vector3d centre_grid_;  // camera centre in grid coordinates
+  int width_;
+  int height_;
+  cv::Mat valid_;
+  std::vector<RayState> rays_;
+};
+
+}  // namespace raycarve

@@ -1,0 +1,41 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace raycarve {
+
+// One pixel of one view.
+struct PixelRef {
+  uint32_t view;
+  uint32_t pixel;  // row * width + col
+};
+
+// How the carver learns which pixels see which voxel: the one thing in which ray casting, GVC
+// and GVC-LDI differ. Everything else (grid, surface, footprints, consistency, colouring) is
+// shared by the carver.
+class Visibility {
+ public:
+  virtual ~Visibility() = default;
+
+  virtual std::string Name() const = 0;
+
+  // Vis(V): appends to `pixels` every pixel, in every view, at which `voxel` is the nearest solid
+  // voxel as this method currently knows it, view by view.
+  virtual void ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels) = 0;
+
+  // Called after `voxel` was carved (the volume is already updated). Inputs: `vis`, the voxel's
+  // last Vis(V); `newly_exposed`, the interior voxels the carving made surface. Outputs: updates
+  // the method's structures and appends to `changed` every voxel whose visibility may have
+  // changed (they must be re-evaluated; duplicates are allowed).
+  virtual void UpdateAfterCarve(int64_t voxel,
+                                const std::vector<PixelRef>& vis,
+                                const std::vector<int64_t>& newly_exposed,
+                                std::vector<int64_t>* changed) = 0;
+
+  // Bytes held by the method's structures.
+  virtual size_t MemoryBytes() const = 0;
+};
+
+}  // namespace raycarve

@@ -1,0 +1,59 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "carve/voxel_grid.h"
+
+namespace raycarve {
+
+// The carved volume as two 3D bit images over a VoxelGrid: solid voxels, and the surface (solid
+// voxels with an empty 6-neighbour or on the grid's border). Everything starts solid, so the
+// surface starts as the grid's border. Memory: 2 bits per voxel.
+class Volume {
+ public:
+  explicit Volume(const VoxelGrid& grid);
+
+  const VoxelGrid& grid() const { return grid_; }
+
+  bool IsSolid(int64_t index) const { return Test(solid_, index); }
+  bool IsSurface(int64_t index) const { return Test(surface_, index); }
+  bool IsSolid(const Eigen::Vector3i& voxel) const {
+    return grid_.Contains(voxel) && IsSolid(grid_.Index(voxel));
+  }
+
+  // Carves a solid voxel (CHECKed): it leaves the solid set and the surface, and its solid
+  // 6-neighbours that were interior become surface; they are appended to `newly_exposed`.
+  void Carve(int64_t index, std::vector<int64_t>* newly_exposed);
+
+  int64_t num_solid() const { return num_solid_; }
+  int64_t num_surface() const { return num_surface_; }
+
+  // All surface voxels, in index order.
+  std::vector<int64_t> SurfaceVoxels() const;
+
+  // Whether a solid voxel has an empty 6-neighbour or lies on the border (the definition,
+  // computed from the solid set; used to check the incremental surface).
+  bool IsExposed(int64_t index) const;
+
+  size_t MemoryBytes() const { return (solid_.size() + surface_.size()) * sizeof(uint64_t); }
+
+ private:
+  static bool Test(const std::vector<uint64_t>& bits, int64_t index) {
+    return (bits[index >> 6] >> (index & 63)) & 1u;
+  }
+  static void Set(std::vector<uint64_t>* bits, int64_t index) {
+    (*bits)[index >> 6] |= uint64_t{1} << (index & 63);
+  }
+  static void Clear(std::vector<uint64_t>* bits, int64_t index) {
+    (*bits)[index >> 6] &= ~(uint64_t{1} << (index & 63));
+  }
+
+  VoxelGrid grid_;
+  std::vector<uint64_t> solid_;
+  std::vector<uint64_t> surface_;
+  int64_t num_solid_ = 0;
+  int64_t num_surface_ = 0;
+};
+
+}  // namespace raycarve

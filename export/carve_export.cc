@@ -1,0 +1,110 @@
+#include "export/carve_export.h"
+
+#include <filesystem>
+#include <algorithm>
+#include <cmath>
+
+#include <pcl/PolygonMesh.h>
+#include <pcl/conversions.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include "calib/input_error.h"
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+bool Solid(const Volume& volume, const Eigen::Vector3i& voxel) { return volume.IsSolid(voxel); }
+
+Eigen::Matrix<uint8_t, 3, 1> ToRgb(const Eigen::Vector3f& colour) {
+  Eigen::Matrix<uint8_t, 3, 1> rgb;
+  for (int k = 0; k < 3; ++k) {
+    rgb[k] = static_cast<uint8_t>(std::clamp(std::lround(colour[k]), 0L, 255L));
+  }
+  return rgb;
+}
+
+}  // namespace
+
+std::vector<ColouredPoint> SurfacePoints(const CarveResult& result) {
+  const Volume& volume = result.volume;
+  const VoxelGrid& grid = volume.grid();
+  std::vector<ColouredPoint> points;
+  for (const ColouredVoxel& coloured : result.surface) {
+    if (coloured.num_pixels == 0) continue;
+    const Eigen::Vector3i voxel = grid.Voxel(coloured.index);
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Eigen::Vector3i offset(dx, dy, dz);
+          if (offset == Eigen::Vector3i::Zero() || Solid(volume, voxel + offset)) continue;
+          normal += offset.cast<double>().normalized();
+        }
+      }
+    }
+    ColouredPoint point;
+    point.xyz = grid.Centre(voxel).cast<float>();
+    if (normal.norm() > 1e-9) point.normal = normal.normalized().cast<float>();
+    point.rgb = ToRgb(coloured.colour);
+    points.push_back(point);
+  }
+  return points;
+}
+
+MeshSummary WriteVoxelMeshPly(const CarveResult& result, const std::string& path) {
+  const Volume& volume = result.volume;
+  const VoxelGrid& grid = volume.grid();
+  pcl::PointCloud<pcl::PointXYZRGB> vertices;
+  pcl::PolygonMesh mesh;
+  // The 6 faces: axis, side, and the 4 corner bits (x, y, z) of the face in counter-clockwise
+  // order seen from outside.
+  struct Face {
+    Eigen::Vector3i normal;
+    int corners[4];
+  };
+  const Face faces[6] = {{{1, 0, 0}, {1, 3, 7, 5}},  {{-1, 0, 0}, {0, 4, 6, 2}},
+                         {{0, 1, 0}, {2, 6, 7, 3}},  {{0, -1, 0}, {0, 1, 5, 4}},
+                         {{0, 0, 1}, {4, 5, 7, 6}},  {{0, 0, -1}, {0, 2, 3, 1}}};
+  for (const ColouredVoxel& coloured : result.surface) {
+    const Eigen::Vector3i voxel = grid.Voxel(coloured.index);
+    const Eigen::Matrix<uint8_t, 3, 1> rgb =
+        coloured.num_pixels > 0 ? ToRgb(coloured.colour) : Eigen::Matrix<uint8_t, 3, 1>(128, 128, 128);
+    for (const Face& face : faces) {
+      if (Solid(volume, voxel + face.normal)) continue;
+      const auto first = static_cast<pcl::index_t>(vertices.size());
+      for (int corner : face.corners) {
+        const Eigen::Vector3d p = grid.Corner(voxel, corner);
+        pcl::PointXYZRGB vertex;
+        vertex.x = static_cast<float>(p.x());
+        vertex.y = static_cast<float>(p.y());
+        vertex.z = static_cast<float>(p.z());
+        vertex.r = rgb[0];
+        vertex.g = rgb[1];
+        vertex.b = rgb[2];
+        vertices.push_back(vertex);
+      }
+      pcl::Vertices triangle;
+      triangle.vertices = {first, first + 1, first + 2};
+      mesh.polygons.push_back(triangle);
+      triangle.vertices = {first, first + 2, first + 3};
+      mesh.polygons.push_back(triangle);
+    }
+  }
+  vertices.width = static_cast<uint32_t>(vertices.size());
+  vertices.height = 1;
+  pcl::toPCLPointCloud2(vertices, mesh.cloud);
+  const std::string temporary = path + ".tmp.ply";
+  if (pcl::io::savePLYFileBinary(temporary, mesh) != 0) {
+    throw InputError(temporary + ": PCL could not write the mesh");
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) throw InputError(path + ": cannot rename into place: " + error.message());
+  return {vertices.size(), mesh.polygons.size()};
+}
+
+}  // namespace exporter
+}  // namespace raycarve

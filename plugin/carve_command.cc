@@ -1,0 +1,216 @@
+#include <chrono>
+#include <iomanip>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include <glog/logging.h>
+
+#include "calib/input_error.h"
+#include "calib/model_reader.h"
+#include "calib/view_reader.h"
+#include "carve/carver.h"
+#include "export/carve_export.h"
+#include "plugin/commands.h"
+#include "plugin/json_writer.h"
+#include "plugin/workspace.h"
+
+namespace raycarve {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::vector<double> ToVector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+CarveRun CarveProject(const CarveRequest& request) {
+  CarveRun run;
+  const WorkspacePaths paths =
+      ResolveWorkspace(request.workspace_path, request.input_path, request.image_path);
+  run.model_path = paths.model_path;
+  run.image_path = paths.image_path;
+  run.output_path = request.output_path;
+  if (run.output_path.empty()) {
+    if (request.workspace_path.empty()) throw InputError("raycarve carve: give --output_path");
+    run.output_path = (std::filesystem::path(request.workspace_path) / "raycarve").string();
+  }
+  CheckOutputDoesNotOverwrite(run.output_path, paths.model_path, "input model");
+  CheckOutputDoesNotOverwrite(run.output_path, paths.image_path, "photo folder");
+  std::string reason;
+  if (!request.options.IsValid(&reason)) throw InputError("raycarve carve: " + reason);
+
+  Clock::time_point stage = Clock::now();
+  LOG(INFO) << "reading model " << paths.model_path << " (" << paths.layout << ")";
+  const Reconstruction reconstruction = ReadModel(paths.model_path);
+  if (reconstruction.images.size() < 2) {
+    throw InputError(paths.model_path + ": the model has " +
+                     std::to_string(reconstruction.images.size()) +
+                     " registered images; carving needs at least 2");
+  }
+  run.bounds = ResolveBounds(reconstruction, request.bounds, paths.model_path);
+  LOG(INFO) << run.bounds.Summary();
+  run.stage_seconds.emplace_back("read_model", SecondsSince(stage));
+
+  stage = Clock::now();
+  LOG(INFO) << "loading and undistorting " << reconstruction.images.size() << " photos from "
+            << paths.image_path;
+  ViewReaderSummary view_summary;
+  const std::vector<CalibratedView> views =
+      ReadCalibratedViews(reconstruction, paths.image_path, request.view_options, &view_summary);
+  run.num_views = static_cast<int>(views.size());
+  run.num_missing_images = static_cast<int>(view_summary.missing.size());
+  LOG(INFO) << view_summary.Summary();
+  run.stage_seconds.emplace_back("load_views", SecondsSince(stage));
+  if (views.size() < 2) throw InputError(paths.image_path + ": fewer than 2 photos could be loaded");
+
+  if (!CheckCarveFits(views, run.bounds.box, request.options, &reason)) {
+    throw InputError("raycarve carve: " + reason);
+  }
+  stage = Clock::now();
+  const VoxelGrid grid(run.bounds.box, request.options.resolution);
+  LOG(INFO) << "carving a " << grid.dimensions().x() << "x" << grid.dimensions().y() << "x"
+            << grid.dimensions().z() << " grid (voxel " << grid.voxel_size() << ") with "
+            << views.size() << " views, " << ConsistencyMethodToString(request.options.consistency)
+            << " threshold " << request.options.threshold;
+  auto progress = [](const CarveProgress& p) {
+    LOG(INFO) << "carving " << std::fixed << std::setprecision(1) << p.seconds << " s: evaluated "
+              << p.evaluated << ", carved " << p.carved << ", queue " << p.queued << ", "
+              << static_cast<int64_t>(p.seconds > 0 ? p.evaluated / p.seconds : 0)
+              << " evaluations/s";
+  };
+  run.result = std::make_unique<CarveResult>(
+      CarveVolume(views, run.bounds.box, request.options, progress, request.progress_seconds));
+  run.stage_seconds.emplace_back("carve_setup", run.result->statistics.setup_seconds);
+  run.stage_seconds.emplace_back("carve", run.result->statistics.carve_seconds);
+  run.stage_seconds.emplace_back("colour", run.result->statistics.colour_seconds);
+
+  stage = Clock::now();
+  std::error_code error;
+  std::filesystem::create_directories(run.output_path, error);
+  if (error) throw InputError(run.output_path + ": cannot create: " + error.message());
+  const std::filesystem::path out(run.output_path);
+  const std::vector<exporter::ColouredPoint> points = exporter::SurfacePoints(*run.result);
+  exporter::WritePointCloudPly(points, (out / "cloud.ply").string());
+  run.num_cloud_points = points.size();
+  const exporter::MeshSummary mesh =
+      exporter::WriteVoxelMeshPly(*run.result, (out / "mesh.ply").string());
+  run.num_mesh_triangles = mesh.num_triangles;
+  run.stage_seconds.emplace_back("export", SecondsSince(stage));
+
+  std::ostringstream csv;
+  csv << "seconds,carved,evaluated\n";
+  for (const CurveSample& sample : run.result->statistics.curve) {
+    csv << sample.seconds << "," << sample.carved << "," << sample.evaluated << "\n";
+  }
+  WriteTextFileAtomically((out / "convergence.csv").string(), csv.str());
+  WriteTextFileAtomically((out / "report.json").string(), CarveReportJson(request, run));
+  return run;
+}
+
+std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
+  const CarveStatistics& s = run.result->statistics;
+  JsonWriter json;
+  json.BeginObject()
+      .Key("model_path").Value(run.model_path)
+      .Key("image_path").Value(run.image_path)
+      .Key("num_views").Value(run.num_views)
+      .Key("num_missing_images").Value(run.num_missing_images);
+  json.Key("options").BeginObject()
+      .Key("resolution").Value(request.options.resolution)
+      .Key("consistency").Value(ConsistencyMethodToString(request.options.consistency))
+      .Key("threshold").Value(request.options.threshold)
+      .Key("min_views").Value(request.options.min_views)
+      .Key("max_memory_gib").Value(request.options.max_memory_gib)
+      .EndObject();
+  json.Key("bounds").BeginObject()
+      .Key("min").Value(ToVector(run.bounds.box.min()))
+      .Key("max").Value(ToVector(run.bounds.box.max()))
+      .Key("explicit").Value(run.bounds.is_explicit)
+      .EndObject();
+  json.Key("statistics").BeginObject()
+      .Key("visibility").Value(s.visibility)
+      .Key("grid").Value(std::vector<double>{static_cast<double>(s.dimensions.x()),
+                                              static_cast<double>(s.dimensions.y()),
+                                              static_cast<double>(s.dimensions.z())})
+      .Key("voxel_size").Value(s.voxel_size)
+      .Key("num_voxels").Value(s.num_voxels)
+      .Key("initial_surface").Value(s.initial_surface)
+      .Key("carved").Value(s.carved)
+      .Key("evaluated").Value(s.evaluated)
+      .Key("final_solid").Value(s.final_solid)
+      .Key("final_surface").Value(s.final_surface)
+      .Key("visible_surface").Value(s.visible_surface)
+      .Key("convergence_seconds").Value(s.carve_seconds)
+      .Key("peak_memory_bytes").Value(static_cast<uint64_t>(s.peak_memory_bytes))
+      .EndObject();
+  json.Key("stage_seconds").BeginObject();
+  for (const auto& [name, seconds] : run.stage_seconds) json.Key(name).Value(seconds);
+  json.EndObject();
+  json.Key("outputs").BeginObject()
+      .Key("cloud").Value("cloud.ply")
+      .Key("cloud_points").Value(static_cast<uint64_t>(run.num_cloud_points))
+      .Key("mesh").Value("mesh.ply")
+      .Key("mesh_triangles").Value(static_cast<uint64_t>(run.num_mesh_triangles))
+      .Key("convergence").Value("convergence.csv")
+      .EndObject();
+  json.EndObject();
+  return json.str();
+}
+
+int RunCarve(int argc, char** argv) {
+  CarveRequest request;
+  std::string consistency = ConsistencyMethodToString(request.options.consistency);
+  OptionParser parser(
+      "carve",
+      "Carves a coloured voxel model from a COLMAP project by incremental voxel colouring with "
+      "ray-cast visibility, and writes cloud.ply (points with normals and colours, laid out like "
+      "COLMAP's fused.ply), mesh.ply (the voxel surface), report.json and convergence.csv.");
+  parser.AddDefault("workspace_path", &request.workspace_path,
+                    "COLMAP project (sparse/0 or sparse or dense/sparse, with images/)");
+  parser.AddDefault("input_path", &request.input_path, "model folder, overriding the workspace's");
+  parser.AddDefault("image_path", &request.image_path, "photo folder, overriding the workspace's");
+  parser.AddDefault("output_path", &request.output_path,
+                    "output folder (default <workspace>/raycarve)");
+  parser.AddDefault("resolution", &request.options.resolution,
+                    "voxels along the longest axis of the volume");
+  parser.AddDefault("consistency", &consistency, "photo-consistency test",
+                    {"mean_colour", "standard_deviation"});
+  parser.AddDefault("threshold", &request.options.threshold,
+                    "largest consistent error, RGB units 0-255");
+  parser.AddDefault("min_views", &request.options.min_views,
+                    "views a voxel must be seen by to be judged");
+  parser.AddDefault("max_memory_gib", &request.options.max_memory_gib,
+                    "refuse grids whose carving structures would need more (GiB)");
+  parser.AddDefault("skip_missing_images", &request.view_options.skip_missing_images,
+                    "skip registered images whose photo is missing instead of failing");
+  AddBoundsFlags(&parser, &request.bounds);
+  if (!parser.Parse(argc, argv)) return 0;
+  ConsistencyMethodFromString(consistency, &request.options.consistency);
+
+  const CarveRun run = CarveProject(request);
+  const CarveStatistics& s = run.result->statistics;
+  std::printf(
+      "\ncarved %s\n"
+      "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
+      "  carved          %lld voxels, %lld evaluations\n"
+      "  convergence     %.2f s (+ %.2f s set-up), peak memory %.1f MiB\n"
+      "  surface         %lld voxels, %lld seen by the photos\n"
+      "  outputs         %s/cloud.ply (%zu points), mesh.ply (%zu triangles),\n"
+      "                  report.json, convergence.csv\n"
+      "  open with       meshlab %s/mesh.ply   (or CloudCompare, Open3D, colmap gui)\n",
+      run.model_path.c_str(), s.dimensions.x(), s.dimensions.y(), s.dimensions.z(), s.voxel_size,
+      static_cast<long long>(s.num_voxels), static_cast<long long>(s.carved),
+      static_cast<long long>(s.evaluated), s.carve_seconds, s.setup_seconds,
+      s.peak_memory_bytes / (1024.0 * 1024.0), static_cast<long long>(s.final_surface),
+      static_cast<long long>(s.visible_surface), run.output_path.c_str(), run.num_cloud_points,
+      run.num_mesh_triangles, run.output_path.c_str());
+  return 0;
+}
+
+}  // namespace raycarve

@@ -7,7 +7,6 @@
 
 #include <glog/logging.h>
 
-#include "carve/ray_cast_visibility.h"
 
 namespace raycarve {
 namespace {
@@ -44,8 +43,8 @@ bool CarveOptions::IsValid(std::string* reason) const {
     *reason = "resolution must be in [1, 4096], got " + std::to_string(resolution);
     return false;
   }
-  if (!(threshold >= 0.0) || !std::isfinite(threshold)) {
-    *reason = "threshold must be a finite number >= 0";
+  if (!std::isfinite(threshold)) {
+    *reason = "threshold must be a finite number";
     return false;
   }
   if (min_views < 1) {
@@ -88,106 +87,127 @@ bool CheckCarveFits(const std::vector<CalibratedView>& views,
   return CheckGridFits(box, options.resolution, kBytesPerVoxel, max_bytes - ray_bytes, reason);
 }
 
-CarveResult CarveVolume(const std::vector<CalibratedView>& views,
-                        const Eigen::AlignedBox3d& box,
-                        const CarveOptions& options,
-                        const std::function<void(const CarveProgress&)>& progress,
-                        double progress_interval_seconds) {
+IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
+                                     const Eigen::AlignedBox3d& box,
+                                     const CarveOptions& options)
+    : views_(views),
+      volume_(VoxelGrid(box, options.resolution)),
+      visibility_(views, volume_),
+      test_(options.consistency, options.threshold, options.min_views),
+      queued_((volume_.grid().num_voxels() + 63) / 64, 0) {
   std::string reason;
   CHECK(CheckCarveFits(views, box, options, &reason)) << reason;
-  const Clock::time_point setup_start = Clock::now();
-  CarveResult result{VoxelGrid(box, options.resolution)};
-  Volume& volume = result.volume;
-  CarveStatistics& statistics = result.statistics;
-  statistics.dimensions = volume.grid().dimensions();
-  statistics.voxel_size = volume.grid().voxel_size();
-  statistics.num_voxels = volume.grid().num_voxels();
-  statistics.initial_surface = volume.num_surface();
+  for (int64_t voxel : volume_.SurfaceVoxels()) Enqueue(voxel);
+  max_queue_ = queue_.size();
+}
 
-  RayCastVisibility visibility(views, volume);
-  statistics.visibility = visibility.Name();
-  const ConsistencyTest test(options.consistency, options.threshold, options.min_views);
+void IncrementalCarver::Enqueue(int64_t voxel) {
+  uint64_t& word = queued_[voxel >> 6];
+  const uint64_t bit = uint64_t{1} << (voxel & 63);
+  if (word & bit) return;
+  word |= bit;
+  queue_.push_back(voxel);
+}
 
-  // The CVSVL: first in, first out; a voxel is queued at most once at a time.
-  std::deque<int64_t> queue;
-  std::vector<uint64_t> queued((volume.grid().num_voxels() + 63) / 64, 0);
-  auto enqueue = [&](int64_t voxel) {
-    uint64_t& word = queued[voxel >> 6];
-    const uint64_t bit = uint64_t{1} << (voxel & 63);
-    if (word & bit) return;
-    word |= bit;
-    queue.push_back(voxel);
-  };
-  for (int64_t voxel : volume.SurfaceVoxels()) enqueue(voxel);
-  statistics.setup_seconds = SecondsSince(setup_start);
+Consistency IncrementalCarver::Evaluate(int64_t voxel) {
+  vis_.clear();
+  visibility_.ComputeVis(voxel, &vis_);
+  GatherColours(views_, vis_, &stats_);
+  return test_.Evaluate(stats_);
+}
 
-  const Clock::time_point start = Clock::now();
-  size_t max_queue = queue.size();
-  std::vector<PixelRef> vis;
-  std::vector<ViewColourStats> stats;
-  std::vector<int64_t> exposed, changed;
-  double next_report = progress_interval_seconds;
-  double next_sample = 0.0;
-  auto sample = [&](double seconds) {
-    statistics.curve.push_back({seconds, statistics.carved, statistics.evaluated});
-  };
-  sample(0.0);
-  while (!queue.empty()) {
-    const int64_t voxel = queue.front();
-    queue.pop_front();
-    queued[voxel >> 6] &= ~(uint64_t{1} << (voxel & 63));
-    if (!volume.IsSolid(voxel)) continue;
-    vis.clear();
-    visibility.ComputeVis(voxel, &vis);
-    GatherColours(views, vis, &stats);
-    ++statistics.evaluated;
-    if (!test.Evaluate(stats).consistent) {
-      exposed.clear();
-      changed.clear();
-      volume.Carve(voxel, &exposed);
-      visibility.UpdateAfterCarve(voxel, vis, exposed, &changed);
-      for (int64_t next : changed) enqueue(next);
-      ++statistics.carved;
-      max_queue = std::max(max_queue, queue.size());
-    }
-    if ((statistics.evaluated & 1023) == 0) {
-      const double seconds = SecondsSince(start);
-      if (seconds >= next_sample) {
-        sample(seconds);
-        next_sample = seconds + 0.05;
-      }
-      if (progress && seconds >= next_report) {
-        progress({statistics.evaluated, statistics.carved, static_cast<int64_t>(queue.size()),
-                  seconds});
-        next_report = seconds + progress_interval_seconds;
-      }
-    }
-  }
-  statistics.carve_seconds = SecondsSince(start);
-  sample(statistics.carve_seconds);
-  statistics.peak_memory_bytes = volume.MemoryBytes() + visibility.MemoryBytes() +
-                                 queued.size() * sizeof(uint64_t) + max_queue * sizeof(int64_t);
+bool IncrementalCarver::Step() {
+  if (queue_.empty()) return false;
+  const int64_t voxel = queue_.front();
+  queue_.pop_front();
+  queued_[voxel >> 6] &= ~(uint64_t{1} << (voxel & 63));
+  if (!volume_.IsSolid(voxel)) return true;
+  ++evaluated_;
+  if (Evaluate(voxel).consistent) return true;
+  exposed_.clear();
+  changed_.clear();
+  volume_.Carve(voxel, &exposed_);
+  visibility_.UpdateAfterCarve(voxel, vis_, exposed_, &changed_);
+  for (int64_t next : changed_) Enqueue(next);
+  ++carved_;
+  max_queue_ = std::max(max_queue_, queue_.size());
+  return true;
+}
 
-  // Colour every final surface voxel from its visible pixels.
-  const Clock::time_point colour_start = Clock::now();
-  for (int64_t voxel : volume.SurfaceVoxels()) {
-    vis.clear();
-    visibility.ComputeVis(voxel, &vis);
-    GatherColours(views, vis, &stats);
-    const Consistency consistency = test.Evaluate(stats);
+std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
+  std::vector<ColouredVoxel> surface;
+  for (int64_t voxel : volume_.SurfaceVoxels()) {
+    const Consistency consistency = Evaluate(voxel);
     ColouredVoxel coloured;
     coloured.index = voxel;
     coloured.colour = consistency.colour.cast<float>();
     coloured.num_views = consistency.num_views;
     coloured.num_pixels = consistency.num_pixels;
-    if (coloured.num_pixels > 0) ++statistics.visible_surface;
-    result.surface.push_back(coloured);
+    surface.push_back(coloured);
+  }
+  return surface;
+}
+
+size_t IncrementalCarver::MemoryBytes() const {
+  return volume_.MemoryBytes() + visibility_.MemoryBytes() + queued_.size() * sizeof(uint64_t) +
+         max_queue_ * sizeof(int64_t);
+}
+
+CarveResult CarveVolume(const std::vector<CalibratedView>& views,
+                        const Eigen::AlignedBox3d& box,
+                        const CarveOptions& options,
+                        const std::function<void(const CarveProgress&)>& progress,
+                        double progress_interval_seconds) {
+  const Clock::time_point setup_start = Clock::now();
+  IncrementalCarver carver(views, box, options);
+  CarveStatistics statistics;
+  statistics.visibility = carver.visibility().Name();
+  statistics.dimensions = carver.volume().grid().dimensions();
+  statistics.voxel_size = carver.volume().grid().voxel_size();
+  statistics.num_voxels = carver.volume().grid().num_voxels();
+  statistics.initial_surface = carver.volume().num_surface();
+  statistics.setup_seconds = SecondsSince(setup_start);
+
+  const Clock::time_point start = Clock::now();
+  auto sample = [&](double seconds) {
+    statistics.curve.push_back({seconds, carver.carved(), carver.evaluated()});
+  };
+  sample(0.0);
+  double next_report = progress_interval_seconds;
+  double next_sample = 0.0;
+  for (int64_t steps = 1; carver.Step(); ++steps) {
+    if ((steps & 1023) != 0) continue;
+    const double seconds = SecondsSince(start);
+    if (seconds >= next_sample) {
+      sample(seconds);
+      next_sample = seconds + 0.05;
+    }
+    if (progress && seconds >= next_report) {
+      progress({carver.evaluated(), carver.carved(), static_cast<int64_t>(carver.queue_size()),
+                seconds});
+      next_report = seconds + progress_interval_seconds;
+    }
+  }
+  statistics.carve_seconds = SecondsSince(start);
+  sample(statistics.carve_seconds);
+  statistics.carved = carver.carved();
+  statistics.evaluated = carver.evaluated();
+  statistics.peak_memory_bytes = carver.MemoryBytes();
+
+  const Clock::time_point colour_start = Clock::now();
+  CarveResult result{carver.volume().grid()};
+  result.surface = carver.ColourSurface();
+  for (const ColouredVoxel& voxel : result.surface) {
+    if (voxel.num_pixels > 0) ++statistics.visible_surface;
   }
   statistics.colour_seconds = SecondsSince(colour_start);
-  statistics.final_surface = volume.num_surface();
-  statistics.final_solid = volume.num_solid();
+  statistics.final_surface = carver.volume().num_surface();
+  statistics.final_solid = carver.volume().num_solid();
+  result.volume = std::move(*carver.mutable_volume());
+  result.statistics = std::move(statistics);
   if (progress) {
-    progress({statistics.evaluated, statistics.carved, 0, statistics.carve_seconds});
+    progress({result.statistics.evaluated, result.statistics.carved, 0,
+              result.statistics.carve_seconds});
   }
   return result;
 }

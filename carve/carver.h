@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <string>
 #include <vector>
@@ -9,6 +10,7 @@
 
 #include "calib/calibrated_view.h"
 #include "carve/consistency.h"
+#include "carve/ray_cast_visibility.h"
 #include "carve/volume.h"
 
 namespace raycarve {
@@ -19,7 +21,8 @@ struct CarveOptions {
   int resolution = 128;
   // How visible pixels are judged (see consistency.h).
   ConsistencyMethod consistency = ConsistencyMethod::kMeanColour;
-  // Largest consistent error, in RGB units (0-255).
+  // Largest consistent error, in RGB units (0-255). Negative: nothing is consistent, so every
+  // voxel seen by min_views views is carved.
   double threshold = 30.0;
   // Views a voxel must be seen by to be judged; voxels seen by fewer stay.
   int min_views = 2;
@@ -75,6 +78,53 @@ struct CarveResult {
   Volume volume;
   std::vector<ColouredVoxel> surface;  // every final surface voxel, in index order
   CarveStatistics statistics;
+};
+
+// The carving loop of the seed paper, one CVSVL entry at a time (CarveVolume runs it to the end;
+// tests step it and look inside). The CVSVL is first in, first out, and holds a voxel at most
+// once at a time; it starts as the whole surface.
+class IncrementalCarver {
+ public:
+  // `views` must outlive the carver. Options must pass CheckCarveFits (CHECKed).
+  IncrementalCarver(const std::vector<CalibratedView>& views,
+                    const Eigen::AlignedBox3d& box,
+                    const CarveOptions& options);
+
+  // Takes the next voxel from the CVSVL and evaluates it if still solid: computes Vis(V) and its
+  // consistency; if inconsistent, carves it, updates the surface and the rays of Vis(V), and
+  // queues the voxels those rays reach. Returns false once the CVSVL is empty (converged).
+  bool Step();
+
+  // Colours every surface voxel from its current visible pixels.
+  std::vector<ColouredVoxel> ColourSurface();
+
+  const Volume& volume() const { return volume_; }
+  Volume* mutable_volume() { return &volume_; }
+  RayCastVisibility& visibility() { return visibility_; }
+  int64_t evaluated() const { return evaluated_; }
+  int64_t carved() const { return carved_; }
+  size_t queue_size() const { return queue_.size(); }
+  // Volume, visibility structures and the CVSVL at its largest so far.
+  size_t MemoryBytes() const;
+
+ private:
+  void Enqueue(int64_t voxel);
+  // Vis(V) into vis_ and its consistency.
+  Consistency Evaluate(int64_t voxel);
+
+  const std::vector<CalibratedView>& views_;
+  Volume volume_;
+  RayCastVisibility visibility_;
+  ConsistencyTest test_;
+  std::deque<int64_t> queue_;
+  std::vector<uint64_t> queued_;
+  size_t max_queue_ = 0;
+  int64_t evaluated_ = 0;
+  int64_t carved_ = 0;
+  std::vector<PixelRef> vis_;
+  std::vector<ViewColourStats> stats_;
+  std::vector<int64_t> exposed_;
+  std::vector<int64_t> changed_;
 };
 
 // Estimates the memory of carving `views` over `box` with `options` and returns false, with a

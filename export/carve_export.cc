@@ -28,12 +28,12 @@ Eigen::Matrix<uint8_t, 3, 1> ToRgb(const Eigen::Vector3f& colour) {
 
 }  // namespace
 
-std::vector<ColouredPoint> SurfacePoints(const CarveResult& result) {
+std::vector<ColouredPoint> SurfacePoints(const CarveResult& result, int min_views) {
   const Volume& volume = result.volume;
   const VoxelGrid& grid = volume.grid();
   std::vector<ColouredPoint> points;
   for (const ColouredVoxel& coloured : result.surface) {
-    if (coloured.num_pixels == 0) continue;
+    if (coloured.num_pixels == 0 || coloured.num_views < min_views) continue;
     const Eigen::Vector3i voxel = grid.Voxel(coloured.index);
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     for (int dz = -1; dz <= 1; ++dz) {

@@ -9,11 +9,12 @@
 namespace raycarve {
 namespace exporter {
 
-// The carved model as a coloured point cloud: one point per surface voxel that some view sees, at
-// the voxel's centre, with its colour and an outward normal (towards the empty side: the sum of
+// The carved model as a coloured point cloud: one point per surface voxel seen by at least
+// `min_views` views (voxels seen by fewer could not be judged and are left out), at the voxel's
+// centre, with its colour and an outward normal (towards the empty side: the sum of
 // the offsets to the empty or outside voxels among its 26 neighbours, normalised; zero when
 // enclosed). World coordinates of the model.
-std::vector<ColouredPoint> SurfacePoints(const CarveResult& result);
+std::vector<ColouredPoint> SurfacePoints(const CarveResult& result, int min_views);
 
 struct MeshSummary {
   size_t num_vertices = 0;

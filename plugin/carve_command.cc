@@ -95,7 +95,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   std::filesystem::create_directories(run.output_path, error);
   if (error) throw InputError(run.output_path + ": cannot create: " + error.message());
   const std::filesystem::path out(run.output_path);
-  const std::vector<exporter::ColouredPoint> points = exporter::SurfacePoints(*run.result);
+  const std::vector<exporter::ColouredPoint> points = exporter::SurfacePoints(*run.result, request.options.min_views);
   exporter::WritePointCloudPly(points, (out / "cloud.ply").string());
   run.num_cloud_points = points.size();
   const exporter::MeshSummary mesh =
@@ -200,7 +200,7 @@ int RunCarve(int argc, char** argv) {
       "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
       "  carved          %lld voxels, %lld evaluations\n"
       "  convergence     %.2f s (+ %.2f s set-up), peak memory %.1f MiB\n"
-      "  surface         %lld voxels, %lld seen by the photos\n"
+      "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more (cloud.ply)\n"
       "  outputs         %s/cloud.ply (%zu points), mesh.ply (%zu triangles),\n"
       "                  report.json, convergence.csv\n"
       "  open with       meshlab %s/mesh.ply   (or CloudCompare, Open3D, colmap gui)\n",
@@ -208,7 +208,8 @@ int RunCarve(int argc, char** argv) {
       static_cast<long long>(s.num_voxels), static_cast<long long>(s.carved),
       static_cast<long long>(s.evaluated), s.carve_seconds, s.setup_seconds,
       s.peak_memory_bytes / (1024.0 * 1024.0), static_cast<long long>(s.final_surface),
-      static_cast<long long>(s.visible_surface), run.output_path.c_str(), run.num_cloud_points,
+      static_cast<long long>(s.visible_surface), run.num_cloud_points, request.options.min_views,
+      run.output_path.c_str(), run.num_cloud_points,
       run.num_mesh_triangles, run.output_path.c_str());
   return 0;
 }

@@ -227,6 +227,22 @@ Hit SampleSurface(std::mt19937_64* random) {
 
 }  // namespace
 
+double TrueSurfaceDistance(const Eigen::Vector3d& point) {
+  const double sphere = std::abs((point - kSphereCentre).norm() - kSphereRadius);
+  // Box: outside, the distance to the box; inside, to the nearest face.
+  const Eigen::Vector3d below = (kBoxMin - point).cwiseMax(0.0);
+  const Eigen::Vector3d above = (point - kBoxMax).cwiseMax(0.0);
+  const Eigen::Vector3d outside = below.cwiseMax(above);
+  double box = outside.norm();
+  if (box == 0.0) {
+    box = std::min((point - kBoxMin).minCoeff(), (kBoxMax - point).minCoeff());
+  }
+  const double dx = std::max(std::abs(point.x()) - kGroundHalfSize, 0.0);
+  const double dy = std::max(std::abs(point.y()) - kGroundHalfSize, 0.0);
+  const double ground = std::sqrt(dx * dx + dy * dy + point.z() * point.z());
+  return std::min({sphere, box, ground});
+}
+
 bool SyntheticSceneOptions::IsValid(std::string* reason) const {
   if (num_views < 2) {
     *reason = "num_views must be at least 2";

@@ -46,6 +46,9 @@ struct SyntheticScene {
 // the image centre and a mild distortion typical of that model (none for pinhole models).
 std::vector<double> ExampleCameraParams(CameraModelId model, int width, int height, double focal);
 
+// Distance from a world point to the scene's true surface (sphere, box, ground square), exact.
+double TrueSurfaceDistance(const Eigen::Vector3d& point);
+
 // Generates the scene; the same options always give the same scene, bit for bit.
 SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options);
 

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <vector>
+
+#include "calib/calibrated_view.h"
+#include "samples/synthetic_scene.h"
+
+namespace raycarve {
+namespace testing {
+
+// The synthetic scene's views as carving inputs (undistorted, pinhole).
+inline std::vector<CalibratedView> SceneViews(const SyntheticScene& scene) {
+  std::vector<CalibratedView> views;
+  for (const auto& [image_id, image] : scene.reconstruction.images) {
+    views.push_back(MakeCalibratedView(scene.reconstruction.cameras.at(image.camera_id), image,
+                                       scene.photos.at(image_id), image.name));
+  }
+  return views;
+}
+
+// Brute force: the nearest solid voxel of `volume` on the ray from `origin` along `direction`
+// (only voxels the ray passes through with non-zero length), or -1.
+inline int64_t NearestSolidVoxel(const Volume& volume,
+                                 const Eigen::Vector3d& origin,
+                                 const Eigen::Vector3d& direction) {
+  const VoxelGrid& grid = volume.grid();
+  int64_t best = -1;
+  double best_t = 1e300;
+  for (int64_t index = 0; index < grid.num_voxels(); ++index) {
+    if (!volume.IsSolid(index)) continue;
+    const Eigen::Vector3i voxel = grid.Voxel(index);
+    const Eigen::Vector3d lo = grid.Corner(voxel, 0), hi = grid.Corner(voxel, 7);
+    double t0 = 0.0, t1 = 1e300;
+    for (int axis = 0; axis < 3; ++axis) {
+      double a = (lo[axis] - origin[axis]) / direction[axis];
+      double b = (hi[axis] - origin[axis]) / direction[axis];
+      if (a > b) std::swap(a, b);
+      t0 = std::max(t0, a);
+      t1 = std::min(t1, b);
+    }
+    if (t1 - t0 > 1e-9 && t0 < best_t) {
+      best_t = t0;
+      best = index;
+    }
+  }
+  return best;
+}
+
+inline Eigen::Vector3d PixelDirection(const CalibratedView& view, int pixel) {
+  const int row = pixel / view.width, col = pixel % view.width;
+  return view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse() *
+         Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
+}
+
+}  // namespace testing
+}  // namespace raycarve

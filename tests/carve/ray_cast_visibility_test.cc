@@ -1,0 +1,71 @@
+#include "carve/ray_cast_visibility.h"
+
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "tests/carve/carve_fixture.h"
+
+namespace raycarve {
+namespace {
+
+TEST(RayCastVisibility, VisAndRaysMatchABruteForceNearestVoxelSearchAfterRandomCarvings) {
+  SyntheticSceneOptions options;
+  options.num_views = 4;
+  options.width = 64;
+  options.height = 48;
+  options.num_surface_samples = 0;
+  const SyntheticScene scene = GenerateSyntheticScene(options);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  Volume volume(VoxelGrid(scene.object_box, 12));
+  RayCastVisibility visibility(views, volume);
+
+  std::mt19937 random(11);
+  std::vector<PixelRef> vis;
+  std::vector<int64_t> exposed, changed;
+  int carved = 0;
+  for (int round = 0; round < 4; ++round) {
+    // Carve a random third of the current surface, through the visibility protocol.
+    for (int64_t voxel : volume.SurfaceVoxels()) {
+      if (random() % 3 != 0) continue;
+      vis.clear();
+      visibility.ComputeVis(voxel, &vis);
+      exposed.clear();
+      changed.clear();
+      volume.Carve(voxel, &exposed);
+      visibility.UpdateAfterCarve(voxel, vis, exposed, &changed);
+      for (int64_t next : changed) EXPECT_TRUE(volume.IsSolid(next));
+      ++carved;
+    }
+    // Each ray's current voxel is the nearest solid voxel along it.
+    std::map<int64_t, std::vector<std::pair<uint32_t, uint32_t>>> expected_vis;
+    int rays_in_box = 0;
+    for (size_t v = 0; v < views.size(); ++v) {
+      for (int pixel = 0; pixel < views[v].width * views[v].height; ++pixel) {
+        const int64_t nearest = testing::NearestSolidVoxel(volume, views[v].centre,
+                                                           testing::PixelDirection(views[v], pixel));
+        ASSERT_EQ(visibility.rays(v).CurrentVoxel(pixel), nearest)
+            << "round " << round << " view " << v << " pixel " << pixel;
+        if (nearest >= 0) {
+          expected_vis[nearest].emplace_back(static_cast<uint32_t>(v), static_cast<uint32_t>(pixel));
+          ++rays_in_box;
+        }
+      }
+    }
+    EXPECT_GT(rays_in_box, 1000);
+    // Vis(V) from the footprint scan is exactly the pixels whose nearest voxel is V, so each
+    // pixel is in at most one voxel's Vis.
+    for (int64_t voxel : volume.SurfaceVoxels()) {
+      vis.clear();
+      visibility.ComputeVis(voxel, &vis);
+      std::vector<std::pair<uint32_t, uint32_t>> got;
+      for (const PixelRef& ref : vis) got.emplace_back(ref.view, ref.pixel);
+      EXPECT_EQ(got, expected_vis[voxel]) << "voxel " << voxel;
+    }
+  }
+  EXPECT_GT(carved, 300);
+}
+
+}  // namespace
+}  // namespace raycarve

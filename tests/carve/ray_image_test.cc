@@ -1,0 +1,162 @@
+#include "carve/ray_image.h"
+
+#include <algorithm>
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace raycarve {
+namespace {
+
+// Brute force: the voxels whose (open) interior the segment of the ray inside the box crosses,
+// ordered by entry parameter. A voxel that the ray only touches along an edge or at a corner
+// (zero length inside) is not included.
+std::vector<int64_t> BruteForceVoxels(const VoxelGrid& grid,
+                                      const Eigen::Vector3d& origin,
+                                      const Eigen::Vector3d& direction) {
+  std::vector<std::pair<double, int64_t>> hits;
+  for (int64_t index = 0; index < grid.num_voxels(); ++index) {
+    const Eigen::Vector3i voxel = grid.Voxel(index);
+    const Eigen::Vector3d lo = grid.Corner(voxel, 0), hi = grid.Corner(voxel, 7);
+    double t0 = 0.0, t1 = 1e300;
+    bool miss = false;
+    for (int axis = 0; axis < 3 && !miss; ++axis) {
+      if (direction[axis] == 0.0) {
+        if (origin[axis] <= lo[axis] || origin[axis] >= hi[axis]) miss = true;
+        continue;
+      }
+      double a = (lo[axis] - origin[axis]) / direction[axis];
+      double b = (hi[axis] - origin[axis]) / direction[axis];
+      if (a > b) std::swap(a, b);
+      t0 = std::max(t0, a);
+      t1 = std::min(t1, b);
+    }
+    if (!miss && t1 - t0 > 1e-9) hits.emplace_back(t0, index);
+  }
+  std::sort(hits.begin(), hits.end());
+  std::vector<int64_t> voxels;
+  for (const auto& [t, index] : hits) voxels.push_back(index);
+  return voxels;
+}
+
+// Walks one ray through an empty volume by carving each voxel it reaches, recording the visits.
+std::vector<int64_t> TraversedVoxels(const VoxelGrid& grid,
+                                     const Eigen::Vector3d& origin,
+                                     const Eigen::Vector3d& direction) {
+  Volume volume(grid);
+  // A 1x1 "image" whose only pixel centre (0.5, 0.5) maps to `direction`.
+  Eigen::Matrix3d world_from_pixel = Eigen::Matrix3d::Zero();
+  world_from_pixel.col(2) = direction;
+  RayImage rays(grid, world_from_pixel, origin, 1, 1);
+  rays.Initialise(volume);
+  std::vector<int64_t> visited;
+  for (int64_t voxel = rays.CurrentVoxel(0); voxel != RayImage::kNoVoxel;
+       voxel = rays.Advance(0, volume)) {
+    visited.push_back(voxel);
+    volume.Carve(voxel, nullptr);
+    if (visited.size() > 1000) break;
+  }
+  return visited;
+}
+
+const VoxelGrid kGrid(Eigen::AlignedBox3d(Eigen::Vector3d(-1, -0.5, 0), Eigen::Vector3d(1, 0.5, 1)), 8);
+
+TEST(RayImage, TraversalVisitsExactlyTheVoxelsARandomRayCrosses) {
+  std::mt19937_64 random(42);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  int rays_hitting = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Eigen::Vector3d origin(3 * uniform(random), 3 * uniform(random), 3 * uniform(random));
+    const Eigen::Vector3d target(uniform(random), 0.5 * uniform(random), 0.5 + 0.5 * uniform(random));
+    const Eigen::Vector3d direction = target - origin;
+    const std::vector<int64_t> expected = BruteForceVoxels(kGrid, origin, direction);
+    EXPECT_EQ(TraversedVoxels(kGrid, origin, direction), expected) << "trial " << trial;
+    rays_hitting += !expected.empty();
+  }
+  EXPECT_GT(rays_hitting, 250);
+}
+
+TEST(RayImage, RaysAlongGridPlanesEdgesAndCornersStayOnAConnectedPathOfTouchedVoxels) {
+  const double s = kGrid.voxel_size();  // 0.25: planes at exact binary fractions
+  ASSERT_EQ(s, 0.25);
+  const struct {
+    Eigen::Vector3d origin, direction;
+  } cases[] = {
+      {{-3, 0.0, 0.5}, {1, 0, 0}},            // along the plane y = 0 and z = 0.5: an edge line
+      {{-3, 0.125, 0.5}, {1, 0, 0}},          // along the plane z = 0.5
+      {{-3, -3.5, -3}, {1, 1, 1}},            // through voxel corners (diagonal)
+      {{-1.5, 0.125, -0.5}, {1, 0, 1}},       // through edges in the xz plane
+      {{-1, -0.5, 0}, {1, 1, 1}},             // starting exactly on the box's corner
+      {{0.0, 0.0, 3.0}, {0, 0, -1}},          // straight down an edge line
+  };
+  for (const auto& c : cases) {
+    const std::vector<int64_t> visited = TraversedVoxels(kGrid, c.origin, c.direction);
+    const std::vector<int64_t> crossed = BruteForceVoxels(kGrid, c.origin, c.direction);
+    ASSERT_FALSE(visited.empty()) << c.origin.transpose();
+    // Every voxel with a segment inside is visited, in order.
+    size_t next = 0;
+    for (int64_t voxel : visited) {
+      if (next < crossed.size() && crossed[next] == voxel) ++next;
+    }
+    EXPECT_EQ(next, crossed.size()) << "missed a crossed voxel, ray from " << c.origin.transpose();
+    // Consecutive visits are face neighbours, and each visited voxel's closed box touches the ray.
+    for (size_t i = 0; i < visited.size(); ++i) {
+      const Eigen::Vector3i voxel = kGrid.Voxel(visited[i]);
+      if (i > 0) {
+        EXPECT_EQ((voxel - kGrid.Voxel(visited[i - 1])).cwiseAbs().sum(), 1);
+      }
+      const Eigen::Vector3d lo = kGrid.Corner(voxel, 0), hi = kGrid.Corner(voxel, 7);
+      double t0 = -1e300, t1 = 1e300;
+      for (int axis = 0; axis < 3; ++axis) {
+        if (c.direction[axis] == 0.0) {
+          EXPECT_TRUE(c.origin[axis] >= lo[axis] - 1e-12 && c.origin[axis] <= hi[axis] + 1e-12);
+          continue;
+        }
+        double a = (lo[axis] - c.origin[axis]) / c.direction[axis];
+        double b = (hi[axis] - c.origin[axis]) / c.direction[axis];
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, b);
+      }
+      EXPECT_LE(t0, t1 + 1e-9) << "visited a voxel the ray does not touch";
+    }
+  }
+}
+
+TEST(RayImage, RaysMissingTheBoxOrMaskedOutHaveNoVoxel) {
+  Volume volume(kGrid);
+  Eigen::Matrix3d away = Eigen::Matrix3d::Zero();
+  away.col(2) = Eigen::Vector3d(0, 0, 1);  // upwards from above the box
+  RayImage rays(kGrid, away, Eigen::Vector3d(0, 0, 2), 1, 1);
+  rays.Initialise(volume);
+  EXPECT_EQ(rays.CurrentVoxel(0), RayImage::kNoVoxel);
+  Eigen::Matrix3d down = Eigen::Matrix3d::Zero();
+  down.col(2) = Eigen::Vector3d(0.01, 0.02, -1);
+  cv::Mat masked(1, 1, CV_8UC1, cv::Scalar(0));
+  RayImage masked_rays(kGrid, down, Eigen::Vector3d(0, 0, 2), 1, 1, masked);
+  masked_rays.Initialise(volume);
+  EXPECT_EQ(masked_rays.CurrentVoxel(0), RayImage::kNoVoxel);
+  RayImage open_rays(kGrid, down, Eigen::Vector3d(0, 0, 2), 1, 1);
+  open_rays.Initialise(volume);
+  EXPECT_EQ(kGrid.Voxel(open_rays.CurrentVoxel(0)).z(), 3);  // the top layer
+  EXPECT_EQ(open_rays.MemoryBytes(), 20u);
+}
+
+TEST(RayImage, StepsToTheNextSolidVoxelAfterCarving) {
+  Volume volume(kGrid);
+  Eigen::Matrix3d down = Eigen::Matrix3d::Zero();
+  down.col(2) = Eigen::Vector3d(0, 0, -1);
+  RayImage rays(kGrid, down, Eigen::Vector3d(0.1, 0.1, 2), 1, 1);
+  rays.Initialise(volume);
+  const int64_t top = rays.CurrentVoxel(0);
+  // Carve the top two voxels of the column: the ray skips both in one Advance.
+  volume.Carve(top, nullptr);
+  const int64_t below = kGrid.Index(kGrid.Voxel(top) - Eigen::Vector3i(0, 0, 1));
+  volume.Carve(below, nullptr);
+  const int64_t next = rays.Advance(0, volume);
+  EXPECT_EQ(kGrid.Voxel(next), kGrid.Voxel(top) - Eigen::Vector3i(0, 0, 2));
+  EXPECT_EQ(rays.Advance(0, volume), next);  // already solid: stays
+}
+
+}  // namespace
+}  // namespace raycarve

@@ -1,7 +1,6 @@
 // Google Benchmark figures for calib/: the cost of undistortion maps per camera model, of
 // unprojecting pixels, and of reading models in both formats. Run:
-//   cmake -S . -B build -DRAYCARVE_BENCHMARKS_ENABLED=ON && cmake --build build -j2 \
-//     && build/benchmarks/calib_benchmark
+//   scripts/run_benchmark.sh builds it; then build/benchmarks/calib_benchmark
 #include <filesystem>
 #include <random>
 

@@ -19,15 +19,16 @@ RayCastVisibility::RayCastVisibility(const std::vector<CalibratedView>& views,
 
 void RayCastVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels) {
   const Eigen::Vector3i coordinates = volume_.grid().Voxel(voxel);
+  const uint64_t key = RayImage::Key(coordinates);
   for (size_t v = 0; v < views_.size(); ++v) {
     const CalibratedView& view = views_[v];
     const Footprint footprint =
         ComputeFootprint(view.P, view.width, view.height, volume_.grid(), coordinates);
-    const RayImage& rays = rays_[v];
+    const uint64_t* keys = rays_[v].keys();
     for (int row = footprint.row_min; row <= footprint.row_max; ++row) {
       const int base = row * view.width;
       for (int col = footprint.col_min; col <= footprint.col_max; ++col) {
-        if (rays.CurrentVoxel(base + col) == voxel) {
+        if (keys[base + col] == key) {
           pixels->push_back({static_cast<uint32_t>(v), static_cast<uint32_t>(base + col)});
         }
       }

@@ -26,7 +26,8 @@ RayImage::RayImage(const VoxelGrid& grid,
       valid_(valid) {
   CHECK((grid.dimensions().array() <= 32767).all()) << "grid too large for 16-bit coordinates";
   CHECK(valid.empty() || (valid.type() == CV_8UC1 && valid.cols == width && valid.rows == height));
-  rays_.resize(static_cast<size_t>(width) * height);
+  keys_.assign(static_cast<size_t>(width) * height, kInactive);
+  t_max_.resize(static_cast<size_t>(width) * height);
   for (int pixel = 0; pixel < num_pixels(); ++pixel) InitialiseRay(pixel);
 }
 
@@ -41,8 +42,8 @@ Eigen::Vector3d RayImage::GridDirection(int pixel) const {
 }
 
 void RayImage::InitialiseRay(int pixel) {
-  RayState& ray = rays_[pixel];
-  ray.active = 0;
+  keys_[pixel] = kInactive;
+  float* t_max = t_max_[pixel].axis;
   if (!valid_.empty() && valid_.data[pixel] == 0) return;
   const Eigen::Vector3d d = GridDirection(pixel);
   const Eigen::Vector3d& o = centre_grid_;
@@ -63,19 +64,18 @@ void RayImage::InitialiseRay(int pixel) {
   if (!(t_enter < t_exit)) return;
   // The voxel holding the entry point; the clamp settles points that round onto an outer face.
   const Eigen::Vector3d entry = o + t_enter * d;
+  Eigen::Vector3i voxel;
   for (int axis = 0; axis < 3; ++axis) {
-    int coordinate = static_cast<int>(std::floor(entry[axis]));
-    coordinate = std::clamp(coordinate, 0, n[axis] - 1);
-    ray.voxel[axis] = static_cast<int16_t>(coordinate);
+    voxel[axis] = std::clamp(static_cast<int>(std::floor(entry[axis])), 0, n[axis] - 1);
     if (d[axis] > 0.0) {
-      ray.t_max[axis] = static_cast<float>((coordinate + 1 - o[axis]) / d[axis]);
+      t_max[axis] = static_cast<float>((voxel[axis] + 1 - o[axis]) / d[axis]);
     } else if (d[axis] < 0.0) {
-      ray.t_max[axis] = static_cast<float>((coordinate - o[axis]) / d[axis]);
+      t_max[axis] = static_cast<float>((voxel[axis] - o[axis]) / d[axis]);
     } else {
-      ray.t_max[axis] = std::numeric_limits<float>::infinity();
+      t_max[axis] = std::numeric_limits<float>::infinity();
     }
   }
-  ray.active = 1;
+  keys_[pixel] = Key(voxel);
 }
 
 void RayImage::Initialise(const Volume& volume) {
@@ -86,32 +86,37 @@ void RayImage::Initialise(const Volume& volume) {
 }
 
 int64_t RayImage::Advance(int pixel, const Volume& volume) {
-  RayState& ray = rays_[pixel];
-  if (!ray.active) return kNoVoxel;
+  const uint64_t key = keys_[pixel];
+  if (key == kInactive) return kNoVoxel;
   const Eigen::Vector3i& n = grid_.dimensions();
-  int64_t index = grid_.Index(Eigen::Vector3i(ray.voxel[0], ray.voxel[1], ray.voxel[2]));
+  int voxel[3] = {static_cast<int>(key & 0xffff), static_cast<int>((key >> 16) & 0xffff),
+                  static_cast<int>((key >> 32) & 0xffff)};
+  int64_t index = voxel[0] + static_cast<int64_t>(n.x()) * (voxel[1] + static_cast<int64_t>(n.y()) * voxel[2]);
   if (volume.IsSolid(index)) return index;
   const Eigen::Vector3d d = GridDirection(pixel);
   int step[3];
   float t_delta[3];
-  int64_t stride[3] = {1, n.x(), static_cast<int64_t>(n.x()) * n.y()};
+  const int64_t stride[3] = {1, n.x(), static_cast<int64_t>(n.x()) * n.y()};
   for (int axis = 0; axis < 3; ++axis) {
     step[axis] = d[axis] > 0.0 ? 1 : -1;
     t_delta[axis] = d[axis] == 0.0 ? std::numeric_limits<float>::infinity()
                                    : static_cast<float>(1.0 / std::abs(d[axis]));
   }
+  float* t_max = t_max_[pixel].axis;
   while (true) {
-    const int axis = ray.t_max[0] < ray.t_max[1] ? (ray.t_max[0] < ray.t_max[2] ? 0 : 2)
-                                                 : (ray.t_max[1] < ray.t_max[2] ? 1 : 2);
-    const int next = ray.voxel[axis] + step[axis];
-    if (next < 0 || next >= n[axis]) {
-      ray.active = 0;
+    const int axis = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2)
+                                         : (t_max[1] < t_max[2] ? 1 : 2);
+    voxel[axis] += step[axis];
+    if (voxel[axis] < 0 || voxel[axis] >= n[axis]) {
+      keys_[pixel] = kInactive;
       return kNoVoxel;
     }
-    ray.voxel[axis] = static_cast<int16_t>(next);
-    ray.t_max[axis] += t_delta[axis];
+    t_max[axis] += t_delta[axis];
     index += step[axis] * stride[axis];
-    if (volume.IsSolid(index)) return index;
+    if (volume.IsSolid(index)) {
+      keys_[pixel] = Key(Eigen::Vector3i(voxel[0], voxel[1], voxel[2]));
+      return index;
+    }
   }
 }
 

@@ -22,6 +22,7 @@ namespace raycarve {
 // masked out.
 //
 // Memory: 20 bytes per pixel (the direction is recomputed from the pixel when a ray is stepped).
+// Coordinates are kept as 16-bit fields of a 64-bit key per pixel, tMax in a separate array.
 // Voxel coordinates are stored in 16 bits: grids up to 32767 voxels along an axis.
 class RayImage {
  public:
@@ -44,10 +45,19 @@ class RayImage {
   void Initialise(const Volume& volume);
 
   int64_t CurrentVoxel(int pixel) const {
-    const RayState& ray = rays_[pixel];
-    return ray.active ? grid_.Index(Eigen::Vector3i(ray.voxel[0], ray.voxel[1], ray.voxel[2]))
-                      : kNoVoxel;
+    const uint64_t key = keys_[pixel];
+    return key == kInactive ? kNoVoxel : grid_.Index(Unpack(key));
   }
+
+  // A voxel's key: what keys() holds for a ray whose current voxel it is. Comparing keys is how
+  // a footprint is scanned without decoding every ray.
+  static uint64_t Key(const Eigen::Vector3i& voxel) {
+    return static_cast<uint64_t>(static_cast<uint16_t>(voxel.x())) |
+           static_cast<uint64_t>(static_cast<uint16_t>(voxel.y())) << 16 |
+           static_cast<uint64_t>(static_cast<uint16_t>(voxel.z())) << 32;
+  }
+  // Per pixel, row-major: the current voxel's key, or a value no voxel has when the ray is gone.
+  const uint64_t* keys() const { return keys_.data(); }
 
   // Steps the ray at `pixel` until its current voxel is solid in `volume` or it leaves the box
   // (then kNoVoxel). Returns the new current voxel. A ray already at a solid voxel stays.
@@ -57,15 +67,20 @@ class RayImage {
   // The ray parameter convention: world point = centre + t * Direction(pixel).
   Eigen::Vector3d Direction(int pixel) const;
 
-  size_t MemoryBytes() const { return rays_.capacity() * sizeof(RayState); }
+  size_t MemoryBytes() const {
+    return keys_.capacity() * sizeof(uint64_t) + t_max_.capacity() * sizeof(TMax);
+  }
 
  private:
-  struct RayState {
-    int16_t voxel[3];
-    int16_t active;  // 1 while the ray is inside the box
-    float t_max[3];  // ray parameter of the next boundary crossing per axis
+  static constexpr uint64_t kInactive = ~uint64_t{0};
+  // Ray parameter of the next voxel boundary crossing, per axis.
+  struct TMax {
+    float axis[3];
   };
-  static_assert(sizeof(RayState) == 20, "ray state must stay compact");
+  static Eigen::Vector3i Unpack(uint64_t key) {
+    return Eigen::Vector3i(static_cast<int>(key & 0xffff), static_cast<int>((key >> 16) & 0xffff),
+                           static_cast<int>((key >> 32) & 0xffff));
+  }
 
   void InitialiseRay(int pixel);
   // The direction in grid units (voxel size 1) for `pixel`.
@@ -77,7 +92,9 @@ class RayImage {
   int width_;
   int height_;
   cv::Mat valid_;
-  std::vector<RayState> rays_;
+  // Structure of arrays: the keys are what footprint scans read, 8 bytes a pixel.
+  std::vector<uint64_t> keys_;
+  std::vector<TMax> t_max_;
 };
 
 }  // namespace raycarve

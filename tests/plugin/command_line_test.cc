@@ -203,5 +203,40 @@ TEST_F(CommandLine, ImportsTheRealMiddleburyCalibrationAndDescribesIt) {
   EXPECT_NE(output.find("\"explicit\": true"), std::string::npos);
 }
 
+TEST_F(CommandLine, CarveWritesCloudMeshReportAndCurve) {
+  const std::string out = *root_ + "/carved";
+  std::string output;
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + out + " --resolution 40",
+                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("carving a 40x"), std::string::npos) << output;
+  EXPECT_NE(output.find("open with"), std::string::npos) << output;
+  for (const char* file : {"cloud.ply", "mesh.ply", "report.json", "convergence.csv"}) {
+    EXPECT_TRUE(fs::is_regular_file(out + "/" + file)) << file;
+  }
+  const std::string report = testing::ReadFileBytes(out + "/report.json");
+  const double carved = JsonNumber(report, "carved");
+  EXPECT_GT(carved, 0);
+  EXPECT_EQ(carved + JsonNumber(report, "final_solid"), JsonNumber(report, "num_voxels"));
+  EXPECT_GT(JsonNumber(report, "evaluated"), carved);
+  EXPECT_GT(JsonNumber(report, "peak_memory_bytes"), 0);
+  EXPECT_EQ(JsonNumber(report, "resolution"), 40);
+  EXPECT_NE(report.find("\"carve\":"), std::string::npos);  // a stage timing
+  const std::string csv = testing::ReadFileBytes(out + "/convergence.csv");
+  EXPECT_EQ(csv.rfind("seconds,carved,evaluated\n", 0), 0u);
+  // The last row of the curve is the final count.
+  const std::string last = csv.substr(csv.rfind('\n', csv.size() - 2) + 1);
+  EXPECT_EQ(std::stod(last.substr(last.find(',') + 1)), carved) << last;
+}
+
+TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
+  const std::string base = "carve --workspace_path " + Project() + " --output_path " + *root_ + "/refused";
+  ExpectUserError(base + " --resolution 0", {"resolution must be in [1, 4096]"});
+  ExpectUserError(base + " --resolution 4000 --max_memory_gib 1", {"GiB", "lower the resolution"});
+  ExpectUserError(base + " --threshold nan", {"threshold must be a finite number"});
+  ExpectUserError(base + " --consistency median", {"not one of: mean_colour, standard_deviation"});
+}
+
 }  // namespace
 }  // namespace raycarve

@@ -1,0 +1,98 @@
+// Carving benchmark: the generated scene (samples/synthetic_scene) at N views of WxH, carved at
+// each requested resolution; prints convergence time, memory, voxels carved and evaluated as a
+// table and as JSON. A benchmark, not a test: figures depend on the machine.
+//   scripts/run_benchmark.sh [--views 14 --width 800 --height 600 --resolutions 128,256]
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "calib/calibrated_view.h"
+#include "carve/carver.h"
+#include "samples/synthetic_scene.h"
+
+namespace {
+
+// The process's peak resident memory (VmHWM), in MiB.
+double PeakResidentMiB() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  }
+  return -1.0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  raycarve::SyntheticSceneOptions scene_options;
+  scene_options.num_views = 14;
+  scene_options.width = 800;
+  scene_options.height = 600;
+  scene_options.num_surface_samples = 0;
+  std::vector<int> resolutions = {128, 256};
+  double threshold = 30.0;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string flag = argv[i], value = argv[i + 1];
+    if (flag == "--views") scene_options.num_views = std::stoi(value);
+    else if (flag == "--width") scene_options.width = std::stoi(value);
+    else if (flag == "--height") scene_options.height = std::stoi(value);
+    else if (flag == "--threshold") threshold = std::stod(value);
+    else if (flag == "--resolutions") {
+      resolutions.clear();
+      std::stringstream list(value);
+      std::string item;
+      while (std::getline(list, item, ',')) resolutions.push_back(std::stoi(item));
+    } else {
+      std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
+      return 1;
+    }
+  }
+  std::string reason;
+  if (!scene_options.IsValid(&reason)) {
+    std::fprintf(stderr, "%s\n", reason.c_str());
+    return 1;
+  }
+  std::fprintf(stderr, "rendering %d views of %dx%d...\n", scene_options.num_views,
+               scene_options.width, scene_options.height);
+  const raycarve::SyntheticScene scene = raycarve::GenerateSyntheticScene(scene_options);
+  std::vector<raycarve::CalibratedView> views;
+  for (const auto& [image_id, image] : scene.reconstruction.images) {
+    views.push_back(raycarve::MakeCalibratedView(
+        scene.reconstruction.cameras.at(image.camera_id), image, scene.photos.at(image_id), image.name));
+  }
+
+  std::printf("%-10s %-14s %10s %10s %12s %12s %12s %12s\n", "resolution", "grid", "set-up s",
+              "converge s", "memory MiB", "peak RSS MiB", "carved", "evaluated");
+  std::ostringstream json;
+  json << "[";
+  for (size_t k = 0; k < resolutions.size(); ++k) {
+    raycarve::CarveOptions options;
+    options.resolution = resolutions[k];
+    options.threshold = threshold;
+    if (!raycarve::CheckCarveFits(views, scene.object_box, options, &reason)) {
+      std::fprintf(stderr, "resolution %d: %s\n", resolutions[k], reason.c_str());
+      return 1;
+    }
+    const raycarve::CarveResult result = raycarve::CarveVolume(views, scene.object_box, options);
+    const raycarve::CarveStatistics& s = result.statistics;
+    char grid[32];
+    std::snprintf(grid, sizeof(grid), "%dx%dx%d", s.dimensions.x(), s.dimensions.y(), s.dimensions.z());
+    const double memory = s.peak_memory_bytes / (1024.0 * 1024.0);
+    std::printf("%-10d %-14s %10.2f %10.2f %12.1f %12.1f %12lld %12lld\n", resolutions[k], grid,
+                s.setup_seconds, s.carve_seconds, memory, PeakResidentMiB(),
+                static_cast<long long>(s.carved), static_cast<long long>(s.evaluated));
+    std::fflush(stdout);
+    json << (k ? "," : "") << "\n  {\"resolution\": " << resolutions[k] << ", \"grid\": \"" << grid
+         << "\", \"views\": " << views.size() << ", \"width\": " << scene_options.width
+         << ", \"height\": " << scene_options.height << ", \"setup_seconds\": " << s.setup_seconds
+         << ", \"convergence_seconds\": " << s.carve_seconds << ", \"memory_mib\": " << memory
+         << ", \"peak_rss_mib\": " << PeakResidentMiB() << ", \"carved\": " << s.carved
+         << ", \"evaluated\": " << s.evaluated << "}";
+  }
+  json << "\n]\n";
+  std::printf("\n%s", json.str().c_str());
+  return 0;
+}

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # README command 1: set-up, build, and the main job on the embedded default scene.
-# Generates a synthetic COLMAP project (ray-traced sphere, box and checkered ground, 8 views with
-# OPENCV lens distortion), then runs raycarve's calibration on it: views undistorted, the volume
-# bounded, every sparse point reprojected through its view. Outputs go to out/demo/.
+# Generates a synthetic COLMAP project (ray-traced sphere, striped box and checkered ground under
+# a patchwork sky, 8 views of 640x480 through an OPENCV camera with lens distortion), then carves
+# it with raycarve: photos undistorted, volume bounded from the sparse points, incremental voxel
+# colouring with ray-cast visibility, coloured cloud and mesh exported. Outputs go to out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh raycarve
@@ -11,12 +12,13 @@ mkdir -p "$out"
 build/plugin/raycarve synth --output_path "$out/scene" --camera_model OPENCV --views 8 \
   --width 640 --height 480
 build/plugin/raycarve model_info --input_path "$out/scene/sparse/0" \
-  --output_path "$out/model_info.json"
-build/plugin/raycarve calibrate --workspace_path "$out/scene" --output_path "$out/calibration"
+  --output_path "$out/model_info.json" > /dev/null
+build/plugin/raycarve carve --workspace_path "$out/scene" --output_path "$out/carve"
 echo
 echo "Outputs in $out/:"
-echo "  scene/images/*.png, scene/sparse/0/   the generated COLMAP project (open in colmap gui)"
+echo "  scene/images/*.png, scene/sparse/0/   the generated COLMAP project (colmap gui can open it)"
 echo "  model_info.json                       cameras, images, points and the carving bounds"
-echo "  calibration/report.json               per-view projections and reprojection errors"
-echo "  calibration/undistorted/*.png         photos resampled to ideal pinhole views"
-echo "  calibration/masks/*.png.png           where each undistorted view holds photo pixels"
+echo "  carve/cloud.ply                       coloured points with normals (COLMAP fused.ply layout)"
+echo "  carve/mesh.ply                        coloured voxel surface mesh"
+echo "  carve/report.json, convergence.csv    statistics, timings per stage, carving curve"
+echo "Open the PLY files in MeshLab, CloudCompare or Open3D (e.g. meshlab $out/carve/mesh.ply)."

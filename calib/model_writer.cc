@@ -7,6 +7,7 @@
 #include <functional>
 #include <locale>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 
 namespace raycarve {
@@ -25,24 +26,19 @@ void PrepareText(std::ostream& stream) {
 void WriteAtomically(const std::filesystem::path& path,
                      const std::function<void(std::ostream&)>& write,
                      bool binary) {
-  const std::filesystem::path temporary = path.string() + ".tmp";
+  const std::string temporary = TemporaryPathFor(path.string());
   {
     std::ofstream stream(temporary, binary ? std::ios::binary : std::ios::out);
     if (!stream) {
-      throw InputError(temporary.string() + ": cannot open for writing: " + std::strerror(errno));
+      throw InputError(temporary + ": cannot open for writing: " + std::strerror(errno));
     }
     write(stream);
     stream.flush();
     if (!stream) {
-      throw InputError(temporary.string() + ": write failed");
+      throw InputError(temporary + ": write failed");
     }
   }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    throw InputError(path.string() + ": cannot rename the written file into place: " +
-                     error.message());
-  }
+  RenameIntoPlace(temporary, path.string());
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 
 namespace raycarve {
@@ -96,13 +97,11 @@ MeshSummary WriteVoxelMeshPly(const CarveResult& result, const std::string& path
   vertices.width = static_cast<uint32_t>(vertices.size());
   vertices.height = 1;
   pcl::toPCLPointCloud2(vertices, mesh.cloud);
-  const std::string temporary = path + ".tmp.ply";
+  const std::string temporary = TemporaryPathFor(path);
   if (pcl::io::savePLYFileBinary(temporary, mesh) != 0) {
     throw InputError(temporary + ": PCL could not write the mesh");
   }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) throw InputError(path + ": cannot rename into place: " + error.message());
+  RenameIntoPlace(temporary, path);
   return {vertices.size(), mesh.polygons.size()};
 }
 

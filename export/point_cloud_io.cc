@@ -6,6 +6,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 
 namespace raycarve {
@@ -31,14 +32,12 @@ void WritePointCloudPly(const std::vector<ColouredPoint>& points, const std::str
   }
   cloud.width = static_cast<uint32_t>(cloud.size());
   cloud.height = 1;
-  const std::string temporary = path + ".tmp.ply";
+  const std::string temporary = TemporaryPathFor(path);
   pcl::PLYWriter writer;
   if (writer.write(temporary, cloud, /*binary=*/true, /*use_camera=*/false) != 0) {
     throw InputError(temporary + ": PCL could not write the point cloud");
   }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) throw InputError(path + ": cannot rename into place: " + error.message());
+  RenameIntoPlace(temporary, path);
 }
 
 std::vector<ColouredPoint> ReadPointCloudPly(const std::string& path) {

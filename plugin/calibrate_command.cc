@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
 #include "calib/view_reader.h"
@@ -19,8 +20,6 @@
 namespace raycarve {
 namespace {
 
-std::vector<double> ToVector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
 double Median(std::vector<double> values) {
   if (values.empty()) return std::nan("");
   const size_t middle = values.size() / 2;
@@ -30,13 +29,9 @@ double Median(std::vector<double> values) {
 
 // Writes in the format of the path's extension, through a temporary name and a rename.
 void WriteImageAtomically(const std::string& path, const cv::Mat& image) {
-  const std::filesystem::path final_path(path);
-  const std::string temporary =
-      (final_path.parent_path() / (".tmp." + final_path.filename().string())).string();
+  const std::string temporary = TemporaryPathFor(path);
   if (!cv::imwrite(temporary, image)) throw InputError(temporary + ": cannot write the image");
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) throw InputError(path + ": cannot rename into place: " + error.message());
+  RenameIntoPlace(temporary, path);
 }
 
 }  // namespace
@@ -132,8 +127,8 @@ std::string CalibrationReport::Json(const std::string& model_path,
       .Key("mean_reprojection_error_px").Value(mean_error)
       .Key("max_reprojection_error_px").Value(max_error);
   json.Key("bounds").BeginObject()
-      .Key("min").Value(ToVector(bounds.box.min()))
-      .Key("max").Value(ToVector(bounds.box.max()))
+      .Key("min").Value(JsonArray(bounds.box.min()))
+      .Key("max").Value(JsonArray(bounds.box.max()))
       .Key("explicit").Value(bounds.is_explicit)
       .Key("num_points_used").Value(bounds.num_used)
       .Key("summary").Value(bounds.Summary())
@@ -152,7 +147,7 @@ std::string CalibrationReport::Json(const std::string& model_path,
         .Key("width").Value(view.width)
         .Key("height").Value(view.height)
         .Key("P_row_major").Value(P_rows)
-        .Key("centre").Value(ToVector(view.centre))
+        .Key("centre").Value(JsonArray(view.centre))
         .Key("num_observations").Value(check.num_observations)
         .Key("num_behind_camera").Value(check.num_behind)
         .Key("mean_reprojection_error_px").Value(check.mean_error)

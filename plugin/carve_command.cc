@@ -25,8 +25,6 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::vector<double> ToVector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
 }  // namespace
 
 CarveRun CarveProject(const CarveRequest& request) {
@@ -129,8 +127,8 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("max_memory_gib").Value(request.options.max_memory_gib)
       .EndObject();
   json.Key("bounds").BeginObject()
-      .Key("min").Value(ToVector(run.bounds.box.min()))
-      .Key("max").Value(ToVector(run.bounds.box.max()))
+      .Key("min").Value(JsonArray(run.bounds.box.min()))
+      .Key("max").Value(JsonArray(run.bounds.box.max()))
       .Key("explicit").Value(run.bounds.is_explicit)
       .EndObject();
   json.Key("statistics").BeginObject()

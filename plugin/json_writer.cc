@@ -8,6 +8,7 @@
 
 #include <glog/logging.h>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 
 namespace raycarve {
@@ -161,16 +162,16 @@ std::string JsonWriter::str() const {
 }
 
 void WriteTextFileAtomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp";
+  const std::string temporary = TemporaryPathFor(path);
   {
     std::ofstream stream(temporary);
     if (!stream) throw InputError(temporary + ": cannot open for writing");
     stream << text;
     if (!stream.flush()) throw InputError(temporary + ": write failed");
   }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) throw InputError(path + ": cannot rename into place: " + error.message());
+  RenameIntoPlace(temporary, path);
 }
+
+std::vector<double> JsonArray(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace raycarve

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 namespace raycarve {
 
 // A small streaming JSON writer for reports: objects, arrays, strings, numbers and booleans,
@@ -44,5 +46,8 @@ class JsonWriter {
 
 // Writes `text` to `path` through a temporary file and a rename; throws InputError on failure.
 void WriteTextFileAtomically(const std::string& path, const std::string& text);
+
+// A 3-vector as the std::vector that JsonWriter::Value writes as a one-line array.
+std::vector<double> JsonArray(const Eigen::Vector3d& v);
 
 }  // namespace raycarve

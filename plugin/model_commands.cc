@@ -18,8 +18,6 @@
 namespace raycarve {
 namespace {
 
-std::vector<double> ToVector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
 struct PointStatistics {
   double mean_track_length = 0.0;
   double mean_error = 0.0;
@@ -156,8 +154,8 @@ std::string DescribeModelJson(const Reconstruction& reconstruction,
         .Key("name").Value(image.name)
         .Key("camera_id").Value(static_cast<uint64_t>(image.camera_id))
         .Key("qvec").Value(std::vector<double>{q.w(), q.x(), q.y(), q.z()})
-        .Key("tvec").Value(ToVector(image.cam_from_world.translation))
-        .Key("centre").Value(ToVector(image.ProjectionCenter()))
+        .Key("tvec").Value(JsonArray(image.cam_from_world.translation))
+        .Key("centre").Value(JsonArray(image.ProjectionCenter()))
         .Key("num_points2D").Value(static_cast<uint64_t>(image.points2D.size()))
         .EndObject();
   }
@@ -169,9 +167,9 @@ std::string DescribeModelJson(const Reconstruction& reconstruction,
       .Key("mean_reprojection_error").Value(points.mean_error)
       .EndObject();
   json.Key("bounds").BeginObject()
-      .Key("min").Value(ToVector(bounds.box.min()))
-      .Key("max").Value(ToVector(bounds.box.max()))
-      .Key("extent").Value(ToVector(bounds.box.sizes()))
+      .Key("min").Value(JsonArray(bounds.box.min()))
+      .Key("max").Value(JsonArray(bounds.box.max()))
+      .Key("extent").Value(JsonArray(bounds.box.sizes()))
       .Key("explicit").Value(bounds.is_explicit)
       .Key("num_points").Value(bounds.num_points)
       .Key("num_used").Value(bounds.num_used)

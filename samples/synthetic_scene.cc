@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "calib/model_writer.h"
 #include "calib/pixel.h"
@@ -396,12 +397,11 @@ void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path)
   for (const auto& [image_id, photo] : scene.photos) {
     const std::string name = scene.reconstruction.images.at(image_id).name;
     const std::filesystem::path final_path = root / "images" / name;
-    const std::string temporary = final_path.string() + ".tmp.png";
+    const std::string temporary = TemporaryPathFor(final_path.string());
     cv::Mat bgr;
     cv::cvtColor(photo, bgr, cv::COLOR_RGB2BGR);
     if (!cv::imwrite(temporary, bgr)) throw InputError(temporary + ": cannot write the photo");
-    std::filesystem::rename(temporary, final_path, error);
-    if (error) throw InputError(final_path.string() + ": cannot rename into place");
+    RenameIntoPlace(temporary, final_path.string());
   }
   WriteModel(scene.reconstruction, (root / "sparse" / "0").string(), ModelFormat::kBinary);
 }

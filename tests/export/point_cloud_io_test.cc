@@ -27,7 +27,7 @@ TEST(PointCloudIo, WritesBinaryPlyWithFusedPlyPropertiesAndReadsItBack) {
   const std::string folder = testing::MakeTemporaryDirectory("ply");
   const std::string path = folder + "/cloud.ply";
   WritePointCloudPly(SomePoints(), path);
-  EXPECT_FALSE(std::filesystem::exists(path + ".tmp.ply"));
+  EXPECT_FALSE(std::filesystem::exists(folder + "/.tmp.cloud.ply"));
 
   const std::string bytes = testing::ReadFileBytes(path);
   const std::string header = bytes.substr(0, bytes.find("end_header"));

@@ -5,25 +5,49 @@
 #include <pcl/io/ply_io.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <pcl/register_point_struct.h>
 
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
 
 namespace raycarve {
 namespace exporter {
+namespace {
+
+// COLMAP's fused.ply vertex: x y z nx ny nz red green blue, in that order. PCL's PLY writer names
+// normal_x "nx" and splits the packed rgb into red, green and blue.
+struct FusedPoint {
+  PCL_ADD_POINT4D;
+  float normal_x;
+  float normal_y;
+  float normal_z;
+  PCL_ADD_RGB;
+  PCL_MAKE_ALIGNED_OPERATOR_NEW
+} EIGEN_ALIGN16;
+
+}  // namespace
+}  // namespace exporter
+}  // namespace raycarve
+
+POINT_CLOUD_REGISTER_POINT_STRUCT(raycarve::exporter::FusedPoint,
+                                  (float, x, x)(float, y, y)(float, z, z)
+                                  (float, normal_x, normal_x)(float, normal_y, normal_y)
+                                  (float, normal_z, normal_z)(float, rgb, rgb))
+
+namespace raycarve {
+namespace exporter {
 
 void WritePointCloudPly(const std::vector<ColouredPoint>& points, const std::string& path) {
-  pcl::PointCloud<pcl::PointXYZRGBNormal> cloud;
+  pcl::PointCloud<FusedPoint> cloud;
   cloud.reserve(points.size());
   for (const ColouredPoint& point : points) {
-    pcl::PointXYZRGBNormal p;
+    FusedPoint p;
     p.x = point.xyz.x();
     p.y = point.xyz.y();
     p.z = point.xyz.z();
     p.normal_x = point.normal.x();
     p.normal_y = point.normal.y();
     p.normal_z = point.normal.z();
-    p.curvature = 0.0f;
     p.r = point.rgb[0];
     p.g = point.rgb[1];
     p.b = point.rgb[2];

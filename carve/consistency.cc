@@ -19,37 +19,49 @@ bool ConsistencyMethodFromString(const std::string& text, ConsistencyMethod* met
   return false;
 }
 
+double MeanColourDifference::Error(const std::vector<ViewColourStats>& views,
+                                   const Eigen::Vector3d& mean,
+                                   int num_pixels) const {
+  double weighted = 0.0;
+  for (const ViewColourStats& view : views) {
+    if (view.count == 0) continue;
+    weighted += view.count * (view.sum / view.count - mean).norm();
+  }
+  return weighted / num_pixels;
+}
+
+double PooledStandardDeviation::Error(const std::vector<ViewColourStats>& views,
+                                      const Eigen::Vector3d& mean,
+                                      int num_pixels) const {
+  Eigen::Vector3d sum_squares = Eigen::Vector3d::Zero();
+  for (const ViewColourStats& view : views) sum_squares += view.sum_squares;
+  const Eigen::Vector3d variance =
+      (sum_squares / num_pixels - mean.cwiseProduct(mean)).cwiseMax(0.0);
+  return std::sqrt(variance.sum() / 3.0);
+}
+
+std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod method) {
+  if (method == ConsistencyMethod::kMeanColour) return std::make_unique<MeanColourDifference>();
+  return std::make_unique<PooledStandardDeviation>();
+}
+
 ConsistencyTest::ConsistencyTest(ConsistencyMethod method, double threshold, int min_views)
-    : method_(method), threshold_(threshold), min_views_(min_views) {}
+    : function_(MakeConsistencyFunction(method)), threshold_(threshold), min_views_(min_views) {}
 
 Consistency ConsistencyTest::Evaluate(const std::vector<ViewColourStats>& views) const {
   Consistency result;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Vector3d sum_squares = Eigen::Vector3d::Zero();
   for (const ViewColourStats& view : views) {
     if (view.count == 0) continue;
     ++result.num_views;
     result.num_pixels += view.count;
     sum += view.sum;
-    sum_squares += view.sum_squares;
   }
   if (result.num_pixels == 0) return result;
   result.colour = sum / result.num_pixels;
   if (result.num_views < min_views_) return result;
   result.judged = true;
-  if (method_ == ConsistencyMethod::kMeanColour) {
-    double weighted = 0.0;
-    for (const ViewColourStats& view : views) {
-      if (view.count == 0) continue;
-      weighted += view.count * (view.sum / view.count - result.colour).norm();
-    }
-    result.error = weighted / result.num_pixels;
-  } else {
-    const Eigen::Vector3d variance =
-        (sum_squares / result.num_pixels - result.colour.cwiseProduct(result.colour))
-            .cwiseMax(0.0);
-    result.error = std::sqrt(variance.sum() / 3.0);
-  }
+  result.error = function_->Error(views, result.colour, result.num_pixels);
   result.consistent = result.error <= threshold_;
   return result;
 }

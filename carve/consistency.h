@@ -39,21 +39,47 @@ struct Consistency {
   int num_pixels = 0;
 };
 
-// Decides whether a voxel's visible pixels agree on one colour.
-//
-// kMeanColour: per view j the mean m_j of its n_j pixels; m = sum n_j m_j / sum n_j; the error
-// is sum n_j |m_j - m| / sum n_j with |.| the Euclidean norm in RGB.
-// kStandardDeviation: the root mean square over the channels of the standard deviation of all
+// How far a voxel's visible pixels are from agreeing on one colour: the interface a new
+// photo-consistency measure implements. Inputs: the per-view statistics (views with count 0 are
+// skipped), the pixel-weighted mean colour and the pixel count (> 0). Output: the error in RGB
+// units.
+class ConsistencyFunction {
+ public:
+  virtual ~ConsistencyFunction() = default;
+  virtual double Error(const std::vector<ViewColourStats>& views,
+                       const Eigen::Vector3d& mean,
+                       int num_pixels) const = 0;
+};
+
+// The seed paper's test: per view j the mean m_j of its n_j pixels; m = sum n_j m_j / sum n_j;
+// the error is sum n_j |m_j - m| / sum n_j with |.| the Euclidean norm in RGB.
+class MeanColourDifference : public ConsistencyFunction {
+ public:
+  double Error(const std::vector<ViewColourStats>& views,
+               const Eigen::Vector3d& mean,
+               int num_pixels) const override;
+};
+
+// Seitz and Dyer's test: the root mean square over the channels of the standard deviation of all
 // visible pixels together.
-// Either way a voxel is inconsistent when its error exceeds `threshold`; a voxel seen by fewer
-// than `min_views` views is not judged and stays.
+class PooledStandardDeviation : public ConsistencyFunction {
+ public:
+  double Error(const std::vector<ViewColourStats>& views,
+               const Eigen::Vector3d& mean,
+               int num_pixels) const override;
+};
+
+std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod method);
+
+// Decides whether a voxel's visible pixels agree on one colour: inconsistent when the function's
+// error exceeds `threshold`; a voxel seen by fewer than `min_views` views is not judged and stays.
 class ConsistencyTest {
  public:
   ConsistencyTest(ConsistencyMethod method, double threshold, int min_views);
   Consistency Evaluate(const std::vector<ViewColourStats>& views) const;
 
  private:
-  ConsistencyMethod method_;
+  std::unique_ptr<ConsistencyFunction> function_;
   double threshold_;
   int min_views_;
 };

@@ -184,28 +184,13 @@ int RunCalibrate(int argc, char** argv) {
   AddBoundsFlags(&parser, &bounds_flags);
   if (!parser.Parse(argc, argv)) return 0;
 
-  const WorkspacePaths paths = ResolveWorkspace(workspace_path, input_path, image_path);
-  if (output_path.empty()) {
-    if (workspace_path.empty()) throw InputError("raycarve calibrate: give --output_path");
-    output_path = (std::filesystem::path(workspace_path) / "raycarve").string();
-  }
-  CheckOutputDoesNotOverwrite(output_path, paths.model_path, "input model");
-  CheckOutputDoesNotOverwrite(output_path, paths.image_path, "photo folder");
-
-  LOG(INFO) << "reading model " << paths.model_path << " (" << paths.layout << ")";
-  const Reconstruction reconstruction = ReadModel(paths.model_path);
-  if (reconstruction.images.empty()) {
-    throw InputError(paths.model_path + ": the model has no registered images");
-  }
-  const Bounds bounds = ResolveBounds(reconstruction, bounds_flags, paths.model_path);
-  LOG(INFO) << bounds.Summary();
-  LOG(INFO) << "loading and undistorting " << reconstruction.images.size() << " photos from "
-            << paths.image_path;
-  ViewReaderSummary view_summary;
-  const std::vector<CalibratedView> views =
-      ReadCalibratedViews(reconstruction, paths.image_path, view_options, &view_summary);
-  LOG(INFO) << view_summary.Summary();
-  const CalibrationReport report = CalibrateProject(reconstruction, views, bounds);
+  const LoadedProject project =
+      LoadProject("calibrate", workspace_path, input_path, image_path, output_path, bounds_flags,
+                  view_options, /*min_images=*/1);
+  output_path = project.output_path;
+  const std::vector<CalibratedView>& views = project.views;
+  const Bounds& bounds = project.bounds;
+  const CalibrationReport report = CalibrateProject(project.reconstruction, views, bounds);
 
   std::error_code error;
   std::filesystem::create_directories(output_path, error);
@@ -226,9 +211,9 @@ int RunCalibrate(int argc, char** argv) {
     }
   }
   const std::string report_path = (std::filesystem::path(output_path) / "report.json").string();
-  WriteTextFileAtomically(report_path, report.Json(paths.model_path, paths.image_path, views));
+  WriteTextFileAtomically(report_path, report.Json(project.model_path, project.image_path, views));
   std::cout << report.Table() << bounds.Summary() << "\n"
-            << view_summary.Summary() << "\n"
+            << project.view_summary.Summary() << "\n"
             << "wrote " << report_path
             << (write_undistorted ? ", undistorted/<name> and masks/<name>.png (valid pixels)" : "")
             << "\n";

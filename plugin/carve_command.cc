@@ -29,43 +29,20 @@ double SecondsSince(Clock::time_point start) {
 
 CarveRun CarveProject(const CarveRequest& request) {
   CarveRun run;
-  const WorkspacePaths paths =
-      ResolveWorkspace(request.workspace_path, request.input_path, request.image_path);
-  run.model_path = paths.model_path;
-  run.image_path = paths.image_path;
-  run.output_path = request.output_path;
-  if (run.output_path.empty()) {
-    if (request.workspace_path.empty()) throw InputError("raycarve carve: give --output_path");
-    run.output_path = (std::filesystem::path(request.workspace_path) / "raycarve").string();
-  }
-  CheckOutputDoesNotOverwrite(run.output_path, paths.model_path, "input model");
-  CheckOutputDoesNotOverwrite(run.output_path, paths.image_path, "photo folder");
   std::string reason;
   if (!request.options.IsValid(&reason)) throw InputError("raycarve carve: " + reason);
-
   Clock::time_point stage = Clock::now();
-  LOG(INFO) << "reading model " << paths.model_path << " (" << paths.layout << ")";
-  const Reconstruction reconstruction = ReadModel(paths.model_path);
-  if (reconstruction.images.size() < 2) {
-    throw InputError(paths.model_path + ": the model has " +
-                     std::to_string(reconstruction.images.size()) +
-                     " registered images; carving needs at least 2");
-  }
-  run.bounds = ResolveBounds(reconstruction, request.bounds, paths.model_path);
-  LOG(INFO) << run.bounds.Summary();
-  run.stage_seconds.emplace_back("read_model", SecondsSince(stage));
-
-  stage = Clock::now();
-  LOG(INFO) << "loading and undistorting " << reconstruction.images.size() << " photos from "
-            << paths.image_path;
-  ViewReaderSummary view_summary;
-  const std::vector<CalibratedView> views =
-      ReadCalibratedViews(reconstruction, paths.image_path, request.view_options, &view_summary);
-  run.num_views = static_cast<int>(views.size());
-  run.num_missing_images = static_cast<int>(view_summary.missing.size());
-  LOG(INFO) << view_summary.Summary();
-  run.stage_seconds.emplace_back("load_views", SecondsSince(stage));
-  if (views.size() < 2) throw InputError(paths.image_path + ": fewer than 2 photos could be loaded");
+  const LoadedProject project =
+      LoadProject("carve", request.workspace_path, request.input_path, request.image_path,
+                  request.output_path, request.bounds, request.view_options, /*min_images=*/2);
+  run.model_path = project.model_path;
+  run.image_path = project.image_path;
+  run.output_path = project.output_path;
+  run.bounds = project.bounds;
+  run.num_views = static_cast<int>(project.views.size());
+  run.num_missing_images = static_cast<int>(project.view_summary.missing.size());
+  run.stage_seconds.emplace_back("load_project", SecondsSince(stage));
+  const std::vector<CalibratedView>& views = project.views;
 
   if (!CheckCarveFits(views, run.bounds.box, request.options, &reason)) {
     throw InputError("raycarve carve: " + reason);

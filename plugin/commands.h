@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "calib/bounds.h"
+#include "calib/calibrated_view.h"
 #include "calib/reconstruction.h"
 #include "calib/view_reader.h"
 #include "carve/carver.h"
@@ -42,6 +43,30 @@ std::string DescribeModelText(const Reconstruction& reconstruction,
 std::string DescribeModelJson(const Reconstruction& reconstruction,
                               const std::string& model_path,
                               const Bounds& bounds);
+
+// What calibrate and carve start from: the project's paths, model, bounds and calibrated views.
+struct LoadedProject {
+  std::string model_path;
+  std::string image_path;
+  std::string output_path;
+  Reconstruction reconstruction;
+  Bounds bounds;
+  std::vector<CalibratedView> views;
+  ViewReaderSummary view_summary;
+};
+
+// Resolves the workspace (see workspace.h) and the output folder (default <workspace>/raycarve,
+// refused when it is the model or photo folder), reads the model (it must have at least
+// `min_images` registered images), bounds it and loads its views, logging each stage. Throws
+// InputError naming `command` or the file on bad input.
+LoadedProject LoadProject(const std::string& command,
+                          const std::string& workspace_path,
+                          const std::string& input_path,
+                          const std::string& image_path,
+                          const std::string& output_path,
+                          const BoundsFlags& bounds_flags,
+                          const ViewReaderOptions& view_options,
+                          int min_images);
 
 // carve: everything `raycarve carve` takes, and what it produced.
 struct CarveRequest {

@@ -2,7 +2,11 @@
 
 #include <filesystem>
 
+#include <glog/logging.h>
+
 #include "calib/input_error.h"
+#include "calib/model_reader.h"
+#include "plugin/commands.h"
 
 namespace raycarve {
 namespace {
@@ -53,6 +57,49 @@ WorkspacePaths ResolveWorkspace(const std::string& workspace_path,
   throw InputError(workspace_path +
                    ": no COLMAP model found in sparse/0, sparse or dense/sparse (looked for "
                    "cameras.bin or cameras.txt); give --input_path");
+}
+
+LoadedProject LoadProject(const std::string& command,
+                          const std::string& workspace_path,
+                          const std::string& input_path,
+                          const std::string& image_path,
+                          const std::string& output_path,
+                          const BoundsFlags& bounds_flags,
+                          const ViewReaderOptions& view_options,
+                          int min_images) {
+  LoadedProject project;
+  const WorkspacePaths paths = ResolveWorkspace(workspace_path, input_path, image_path);
+  project.model_path = paths.model_path;
+  project.image_path = paths.image_path;
+  project.output_path = output_path;
+  if (project.output_path.empty()) {
+    if (workspace_path.empty()) throw InputError("raycarve " + command + ": give --output_path");
+    project.output_path = (std::filesystem::path(workspace_path) / "raycarve").string();
+  }
+  CheckOutputDoesNotOverwrite(project.output_path, paths.model_path, "input model");
+  CheckOutputDoesNotOverwrite(project.output_path, paths.image_path, "photo folder");
+
+  LOG(INFO) << "reading model " << paths.model_path << " (" << paths.layout << ")";
+  project.reconstruction = ReadModel(paths.model_path);
+  const size_t registered = project.reconstruction.images.size();
+  if (registered == 0) throw InputError(paths.model_path + ": the model has no registered images");
+  if (static_cast<int>(registered) < min_images) {
+    throw InputError(paths.model_path + ": the model has " + std::to_string(registered) +
+                     " registered images; raycarve " + command + " needs at least " +
+                     std::to_string(min_images));
+  }
+  project.bounds = ResolveBounds(project.reconstruction, bounds_flags, paths.model_path);
+  LOG(INFO) << project.bounds.Summary();
+  LOG(INFO) << "loading and undistorting " << registered << " photos from " << paths.image_path;
+  project.views = ReadCalibratedViews(project.reconstruction, paths.image_path, view_options,
+                                      &project.view_summary);
+  LOG(INFO) << project.view_summary.Summary();
+  if (static_cast<int>(project.views.size()) < min_images) {
+    throw InputError(paths.image_path + ": only " + std::to_string(project.views.size()) +
+                     " photos could be loaded; raycarve " + command + " needs at least " +
+                     std::to_string(min_images));
+  }
+  return project;
 }
 
 }  // namespace raycarve

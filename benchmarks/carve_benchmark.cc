@@ -33,6 +33,8 @@ int main(int argc, char** argv) {
   scene_options.height = 600;
   scene_options.num_surface_samples = 0;
   std::vector<int> resolutions = {128, 256};
+  std::vector<raycarve::VisLookup> lookups = {raycarve::VisLookup::kFootprint,
+                                              raycarve::VisLookup::kRayLists};
   double threshold = 30.0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
@@ -40,6 +42,14 @@ int main(int argc, char** argv) {
     else if (flag == "--width") scene_options.width = std::stoi(value);
     else if (flag == "--height") scene_options.height = std::stoi(value);
     else if (flag == "--threshold") threshold = std::stod(value);
+    else if (flag == "--vis_lookup") {
+      raycarve::VisLookup lookup;
+      if (value != "both" && !raycarve::VisLookupFromString(value, &lookup)) {
+        std::fprintf(stderr, "--vis_lookup: footprint, ray_lists or both\n");
+        return 1;
+      }
+      if (value != "both") lookups = {lookup};
+    }
     else if (flag == "--resolutions") {
       resolutions.clear();
       std::stringstream list(value);
@@ -64,14 +74,18 @@ int main(int argc, char** argv) {
         scene.reconstruction.cameras.at(image.camera_id), image, scene.photos.at(image_id), image.name));
   }
 
-  std::printf("%-10s %-14s %10s %10s %12s %12s %12s %12s\n", "resolution", "grid", "set-up s",
-              "converge s", "memory MiB", "peak RSS MiB", "carved", "evaluated");
+  std::printf("%-10s %-10s %-14s %10s %10s %12s %12s %12s %12s\n", "resolution", "vis", "grid",
+              "set-up s", "converge s", "memory MiB", "peak RSS MiB", "carved", "evaluated");
   std::ostringstream json;
   json << "[";
+  bool first = true;
   for (size_t k = 0; k < resolutions.size(); ++k) {
+   for (const raycarve::VisLookup lookup : lookups) {
     raycarve::CarveOptions options;
     options.resolution = resolutions[k];
     options.threshold = threshold;
+    options.vis_lookup = lookup;
+    const std::string vis = raycarve::VisLookupToString(lookup);
     if (!raycarve::CheckCarveFits(views, scene.object_box, options, &reason)) {
       std::fprintf(stderr, "resolution %d: %s\n", resolutions[k], reason.c_str());
       return 1;
@@ -81,16 +95,20 @@ int main(int argc, char** argv) {
     char grid[32];
     std::snprintf(grid, sizeof(grid), "%dx%dx%d", s.dimensions.x(), s.dimensions.y(), s.dimensions.z());
     const double memory = s.peak_memory_bytes / (1024.0 * 1024.0);
-    std::printf("%-10d %-14s %10.2f %10.2f %12.1f %12.1f %12lld %12lld\n", resolutions[k], grid,
+    std::printf("%-10d %-10s %-14s %10.2f %10.2f %12.1f %12.1f %12lld %12lld\n", resolutions[k],
+                vis.c_str(), grid,
                 s.setup_seconds, s.carve_seconds, memory, PeakResidentMiB(),
                 static_cast<long long>(s.carved), static_cast<long long>(s.evaluated));
     std::fflush(stdout);
-    json << (k ? "," : "") << "\n  {\"resolution\": " << resolutions[k] << ", \"grid\": \"" << grid
+    json << (first ? "" : ",") << "\n  {\"resolution\": " << resolutions[k]
+         << ", \"vis_lookup\": \"" << vis << "\", \"grid\": \"" << grid
          << "\", \"views\": " << views.size() << ", \"width\": " << scene_options.width
          << ", \"height\": " << scene_options.height << ", \"setup_seconds\": " << s.setup_seconds
          << ", \"convergence_seconds\": " << s.carve_seconds << ", \"memory_mib\": " << memory
          << ", \"peak_rss_mib\": " << PeakResidentMiB() << ", \"carved\": " << s.carved
          << ", \"evaluated\": " << s.evaluated << "}";
+    first = false;
+   }
   }
   json << "\n]\n";
   std::printf("\n%s", json.str().c_str());

@@ -18,8 +18,10 @@ double SecondsSince(Clock::time_point start) {
 }
 
 constexpr double kBytesPerRay = 20.0;
+constexpr double kBytesPerListedRay = 24.0;
 // Solid, surface and in-queue bits, plus a generous byte for the CVSVL's entries.
 constexpr double kBytesPerVoxel = 3.0 / 8.0 + 1.0;
+constexpr double kBytesPerListedVoxel = kBytesPerVoxel + 4.0;
 
 // Groups `vis` (view by view) into per-view colour statistics.
 void GatherColours(const std::vector<CalibratedView>& views,
@@ -74,8 +76,11 @@ bool CheckCarveFits(const std::vector<CalibratedView>& views,
                     const CarveOptions& options,
                     std::string* reason) {
   if (!options.IsValid(reason)) return false;
+  const bool lists = options.vis_lookup == VisLookup::kRayLists;
   double ray_bytes = 0.0;
-  for (const CalibratedView& view : views) ray_bytes += kBytesPerRay * view.width * view.height;
+  for (const CalibratedView& view : views) {
+    ray_bytes += (lists ? kBytesPerListedRay : kBytesPerRay) * view.width * view.height;
+  }
   const double max_bytes = options.max_memory_gib * 1024.0 * 1024.0 * 1024.0;
   if (ray_bytes > max_bytes) {
     std::ostringstream text;
@@ -84,7 +89,8 @@ bool CheckCarveFits(const std::vector<CalibratedView>& views,
     *reason = text.str();
     return false;
   }
-  return CheckGridFits(box, options.resolution, kBytesPerVoxel, max_bytes - ray_bytes, reason);
+  return CheckGridFits(box, options.resolution, lists ? kBytesPerListedVoxel : kBytesPerVoxel,
+                       max_bytes - ray_bytes, reason);
 }
 
 IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
@@ -92,7 +98,7 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                                      const CarveOptions& options)
     : views_(views),
       volume_(VoxelGrid(box, options.resolution)),
-      visibility_(views, volume_),
+      visibility_(views, volume_, options.vis_lookup),
       test_(options.consistency, options.threshold, options.min_views),
       queued_((volume_.grid().num_voxels() + 63) / 64, 0) {
   std::string reason;
@@ -161,7 +167,8 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   const Clock::time_point setup_start = Clock::now();
   IncrementalCarver carver(views, box, options);
   CarveStatistics statistics;
-  statistics.visibility = carver.visibility().Name();
+  statistics.visibility =
+      carver.visibility().Name() + " (" + VisLookupToString(options.vis_lookup) + ")";
   statistics.dimensions = carver.volume().grid().dimensions();
   statistics.voxel_size = carver.volume().grid().voxel_size();
   statistics.num_voxels = carver.volume().grid().num_voxels();

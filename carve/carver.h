@@ -28,6 +28,8 @@ struct CarveOptions {
   int min_views = 2;
   // Refuse a grid whose carving structures would need more memory than this (GiB).
   double max_memory_gib = 8.0;
+  // How Vis(V) is found (see ray_cast_visibility.h); the carving is the same either way.
+  VisLookup vis_lookup = VisLookup::kFootprint;
 
   bool IsValid(std::string* reason) const;
 };
@@ -47,7 +49,7 @@ struct CurveSample {
 };
 
 struct CarveStatistics {
-  std::string visibility;  // "ray"
+  std::string visibility;  // "ray (footprint)" or "ray (ray_lists)"
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   double voxel_size = 0.0;
   int64_t num_voxels = 0;

@@ -3,6 +3,11 @@
 #include <cmath>
 
 namespace raycarve {
+namespace {
+
+constexpr double kSlackPx = 0.01;
+
+}  // namespace
 
 Footprint ComputeFootprint(const Eigen::Matrix<double, 3, 4>& P,
                            int width,
@@ -26,12 +31,14 @@ Footprint ComputeFootprint(const Eigen::Matrix<double, 3, 4>& P,
     y_min = std::min(y_min, y);
     y_max = std::max(y_max, y);
   }
-  // Pixel centres c + 0.5 within [x_min, x_max], with a hair of slack for rays along a face.
+  // Pixel centres c + 0.5 within [x_min, x_max], with kSlackPx to spare: rays are stepped with
+  // float parameters, so a ray grazing an edge may be in a voxel whose exact projection misses
+  // its pixel centre by a hair; without slack such a ray would be missed and never stepped.
   Footprint footprint;
-  footprint.col_min = std::max(0, static_cast<int>(std::ceil(x_min - 0.5 - 1e-9)));
-  footprint.col_max = std::min(width - 1, static_cast<int>(std::floor(x_max - 0.5 + 1e-9)));
-  footprint.row_min = std::max(0, static_cast<int>(std::ceil(y_min - 0.5 - 1e-9)));
-  footprint.row_max = std::min(height - 1, static_cast<int>(std::floor(y_max - 0.5 + 1e-9)));
+  footprint.col_min = std::max(0, static_cast<int>(std::ceil(x_min - 0.5 - kSlackPx)));
+  footprint.col_max = std::min(width - 1, static_cast<int>(std::floor(x_max - 0.5 + kSlackPx)));
+  footprint.row_min = std::max(0, static_cast<int>(std::ceil(y_min - 0.5 - kSlackPx)));
+  footprint.row_max = std::min(height - 1, static_cast<int>(std::floor(y_max - 0.5 + kSlackPx)));
   if (x_max - 0.5 < 0 || y_max - 0.5 < 0 || x_min - 0.5 > width || y_min - 0.5 > height) {
     return Footprint();
   }

@@ -1,23 +1,68 @@
 #include "carve/ray_cast_visibility.h"
 
+#include <algorithm>
+
+#include <glog/logging.h>
+
 #include "carve/footprint.h"
 
 namespace raycarve {
 
+std::string VisLookupToString(VisLookup lookup) {
+  return lookup == VisLookup::kFootprint ? "footprint" : "ray_lists";
+}
+
+bool VisLookupFromString(const std::string& text, VisLookup* lookup) {
+  for (VisLookup candidate : {VisLookup::kFootprint, VisLookup::kRayLists}) {
+    if (text == VisLookupToString(candidate)) {
+      *lookup = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
 RayCastVisibility::RayCastVisibility(const std::vector<CalibratedView>& views,
-                                     const Volume& volume)
-    : views_(views), volume_(volume) {
+                                     const Volume& volume,
+                                     VisLookup lookup)
+    : views_(views), volume_(volume), lookup_(lookup) {
   rays_.reserve(views.size());
+  int64_t total = 0;
   for (const CalibratedView& view : views) {
     const Eigen::Matrix3d world_from_pixel =
         view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse();
     rays_.emplace_back(volume.grid(), world_from_pixel, view.centre, view.width, view.height,
                        view.valid);
     rays_.back().Initialise(volume);
+    view_offset_.push_back(static_cast<int32_t>(total));
+    total += static_cast<int64_t>(view.width) * view.height;
+  }
+  if (lookup_ != VisLookup::kRayLists) return;
+  CHECK_LT(total, int64_t{1} << 31) << "too many rays for 32-bit ray lists";
+  head_.assign(volume.grid().num_voxels(), -1);
+  next_.assign(total, -1);
+  // Linked in reverse so that each list starts in row-major order (ComputeVis sorts anyway).
+  for (int v = static_cast<int>(views.size()) - 1; v >= 0; --v) {
+    for (int pixel = rays_[v].num_pixels() - 1; pixel >= 0; --pixel) {
+      const int64_t current = rays_[v].CurrentVoxel(pixel);
+      if (current != RayImage::kNoVoxel) Link(view_offset_[v] + pixel, current);
+    }
   }
 }
 
 void RayCastVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels) {
+  if (lookup_ == VisLookup::kRayLists) {
+    const size_t first = pixels->size();
+    for (int32_t ray = head_[voxel]; ray != -1; ray = next_[ray]) {
+      const uint32_t view = static_cast<uint32_t>(
+          std::upper_bound(view_offset_.begin(), view_offset_.end(), ray) - view_offset_.begin() - 1);
+      pixels->push_back({view, static_cast<uint32_t>(ray - view_offset_[view])});
+    }
+    std::sort(pixels->begin() + first, pixels->end(), [](const PixelRef& a, const PixelRef& b) {
+      return a.view != b.view ? a.view < b.view : a.pixel < b.pixel;
+    });
+    return;
+  }
   const Eigen::Vector3i coordinates = volume_.grid().Voxel(voxel);
   const uint64_t key = RayImage::Key(coordinates);
   for (size_t v = 0; v < views_.size(); ++v) {
@@ -36,18 +81,22 @@ void RayCastVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels)
   }
 }
 
-void RayCastVisibility::UpdateAfterCarve(int64_t /*voxel*/,
+void RayCastVisibility::UpdateAfterCarve(int64_t voxel,
                                          const std::vector<PixelRef>& vis,
                                          const std::vector<int64_t>& /*newly_exposed*/,
                                          std::vector<int64_t>* changed) {
+  // Vis(V) is every ray that ended in V, so V's list is consumed whole.
+  if (lookup_ == VisLookup::kRayLists) head_[voxel] = -1;
   for (const PixelRef& ref : vis) {
     const int64_t next = rays_[ref.view].Advance(static_cast<int>(ref.pixel), volume_);
-    if (next != RayImage::kNoVoxel) changed->push_back(next);
+    if (next == RayImage::kNoVoxel) continue;
+    changed->push_back(next);
+    if (lookup_ == VisLookup::kRayLists) Link(view_offset_[ref.view] + ref.pixel, next);
   }
 }
 
 size_t RayCastVisibility::MemoryBytes() const {
-  size_t bytes = 0;
+  size_t bytes = (head_.capacity() + next_.capacity()) * sizeof(int32_t);
   for (const RayImage& rays : rays_) bytes += rays.MemoryBytes();
   return bytes;
 }

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "calib/calibrated_view.h"
@@ -9,14 +10,26 @@
 
 namespace raycarve {
 
+// How Vis(V) finds the rays that currently end in V.
+enum class VisLookup {
+  kFootprint,  // the seed paper: scan V's footprint in every view (cost: the footprints' area)
+  kRayLists,   // the paper's "more direct" storage: each voxel keeps the list of rays ending in
+               // it (cost: |Vis(V)| and a sort; 4 more bytes a ray and 4 a voxel)
+};
+std::string VisLookupToString(VisLookup lookup);
+bool VisLookupFromString(const std::string& text, VisLookup* lookup);
+
 // The seed paper's visibility: an image of rays per view as the item buffer.
-// Vis(V) scans V's footprint in each view for pixels whose ray currently ends in V. Carving V
-// steps only the rays of Vis(V) to their next solid voxel, which is reported as changed.
-// Masked-out pixels (view.valid == 0) get no ray.
+// Vis(V) is the pixels whose ray currently ends in V, found by `lookup`; both lookups give the
+// same pixels in the same order (view by view, row-major). Carving V steps only the rays of
+// Vis(V) to their next solid voxel, which is reported as changed. Masked-out pixels
+// (view.valid == 0) get no ray.
 class RayCastVisibility : public Visibility {
  public:
   // `volume` must outlive this object; rays start at its first solid voxels.
-  RayCastVisibility(const std::vector<CalibratedView>& views, const Volume& volume);
+  RayCastVisibility(const std::vector<CalibratedView>& views,
+                    const Volume& volume,
+                    VisLookup lookup = VisLookup::kFootprint);
 
   std::string Name() const override { return "ray"; }
   void ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels) override;
@@ -29,9 +42,19 @@ class RayCastVisibility : public Visibility {
   const RayImage& rays(int view) const { return rays_[view]; }
 
  private:
+  // Ray lists: a ray's global id is view_offset_[view] + pixel.
+  void Link(int32_t ray, int64_t voxel) {
+    next_[ray] = head_[voxel];
+    head_[voxel] = ray;
+  }
+
   const std::vector<CalibratedView>& views_;
   const Volume& volume_;
+  VisLookup lookup_;
   std::vector<RayImage> rays_;
+  std::vector<int32_t> view_offset_;
+  std::vector<int32_t> head_;  // per voxel: a ray ending in it, or -1
+  std::vector<int32_t> next_;  // per ray: the next ray ending in the same voxel, or -1
 };
 
 }  // namespace raycarve

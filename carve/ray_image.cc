@@ -20,6 +20,8 @@ RayImage::RayImage(const VoxelGrid& grid,
                    const cv::Mat& valid)
     : grid_(grid),
       world_from_pixel_(world_from_pixel),
+      grid_from_pixel_(world_from_pixel / grid.voxel_size()),
+      inverse_width_(1.0 / width),
       centre_grid_((centre - grid.origin()) / grid.voxel_size()),
       width_(width),
       height_(height),
@@ -38,7 +40,11 @@ Eigen::Vector3d RayImage::Direction(int pixel) const {
 }
 
 Eigen::Vector3d RayImage::GridDirection(int pixel) const {
-  return Direction(pixel) / grid_.voxel_size();
+  // No integer division on this hot path: (pixel + 0.5) / width is at least 0.5 / width away from
+  // an integer, far beyond the rounding of the product.
+  const int row = static_cast<int>((pixel + 0.5) * inverse_width_);
+  const int col = pixel - row * width_;
+  return grid_from_pixel_ * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
 }
 
 void RayImage::InitialiseRay(int pixel) {
@@ -99,8 +105,7 @@ int64_t RayImage::Advance(int pixel, const Volume& volume) {
   const int64_t stride[3] = {1, n.x(), static_cast<int64_t>(n.x()) * n.y()};
   for (int axis = 0; axis < 3; ++axis) {
     step[axis] = d[axis] > 0.0 ? 1 : -1;
-    t_delta[axis] = d[axis] == 0.0 ? std::numeric_limits<float>::infinity()
-                                   : static_cast<float>(1.0 / std::abs(d[axis]));
+    t_delta[axis] = 1.0f / std::abs(static_cast<float>(d[axis]));  // inf along an axis plane
   }
   float* t_max = t_max_[pixel].axis;
   while (true) {

@@ -88,6 +88,8 @@ class RayImage {
 
   VoxelGrid grid_;
   Eigen::Matrix3d world_from_pixel_;
+  Eigen::Matrix3d grid_from_pixel_;  // world_from_pixel_ in voxel units, for stepping
+  double inverse_width_;             // row = floor((pixel + 0.5) * inverse_width_), exactly
   Eigen::Vector3d centre_grid_;  // camera centre in grid coordinates
   int width_;
   int height_;

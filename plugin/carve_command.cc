@@ -101,6 +101,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("consistency").Value(ConsistencyMethodToString(request.options.consistency))
       .Key("threshold").Value(request.options.threshold)
       .Key("min_views").Value(request.options.min_views)
+      .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
       .Key("max_memory_gib").Value(request.options.max_memory_gib)
       .EndObject();
   json.Key("bounds").BeginObject()
@@ -141,6 +142,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
 int RunCarve(int argc, char** argv) {
   CarveRequest request;
   std::string consistency = ConsistencyMethodToString(request.options.consistency);
+  std::string vis_lookup = VisLookupToString(request.options.vis_lookup);
   OptionParser parser(
       "carve",
       "Carves a coloured voxel model from a COLMAP project by incremental voxel colouring with "
@@ -160,6 +162,10 @@ int RunCarve(int argc, char** argv) {
                     "largest consistent error, RGB units 0-255");
   parser.AddDefault("min_views", &request.options.min_views,
                     "views a voxel must be seen by to be judged");
+  parser.AddDefault("vis_lookup", &vis_lookup,
+                    "how Vis(V) finds its rays: the paper's footprint scan, or per-voxel ray "
+                    "lists (same result, more memory)",
+                    {"footprint", "ray_lists"});
   parser.AddDefault("max_memory_gib", &request.options.max_memory_gib,
                     "refuse grids whose carving structures would need more (GiB)");
   parser.AddDefault("skip_missing_images", &request.view_options.skip_missing_images,
@@ -167,6 +173,7 @@ int RunCarve(int argc, char** argv) {
   AddBoundsFlags(&parser, &request.bounds);
   if (!parser.Parse(argc, argv)) return 0;
   ConsistencyMethodFromString(consistency, &request.options.consistency);
+  VisLookupFromString(vis_lookup, &request.options.vis_lookup);
 
   const CarveRun run = CarveProject(request);
   const CarveStatistics& s = run.result->statistics;

@@ -83,6 +83,26 @@ TEST(CarveVolume, AThresholdSoTightThatNothingIsConsistentCarvesEverythingSeenTw
   }
 }
 
+TEST(CarveVolume, FootprintScansAndRayListsCarveIdentically) {
+  const SyntheticScene scene = Scene(6, 160, 120);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  CarveOptions options = Options(48, 30.0);
+  const CarveResult footprint = CarveVolume(views, scene.object_box, options);
+  options.vis_lookup = VisLookup::kRayLists;
+  const CarveResult lists = CarveVolume(views, scene.object_box, options);
+  EXPECT_GT(footprint.statistics.carved, 1000);
+  EXPECT_EQ(footprint.statistics.carved, lists.statistics.carved);
+  EXPECT_EQ(footprint.statistics.evaluated, lists.statistics.evaluated);
+  for (int64_t i = 0; i < footprint.volume.grid().num_voxels(); ++i) {
+    ASSERT_EQ(footprint.volume.IsSolid(i), lists.volume.IsSolid(i)) << i;
+  }
+  ASSERT_EQ(footprint.surface.size(), lists.surface.size());
+  for (size_t i = 0; i < footprint.surface.size(); ++i) {
+    EXPECT_EQ(footprint.surface[i].colour, lists.surface[i].colour);
+    EXPECT_EQ(footprint.surface[i].num_pixels, lists.surface[i].num_pixels);
+  }
+}
+
 TEST(CarveVolume, CarvesTheGeneratedSceneToItsTrueSurface) {
   const SyntheticScene scene = Scene(8, 320, 240);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);

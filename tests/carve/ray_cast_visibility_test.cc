@@ -10,7 +10,9 @@
 namespace raycarve {
 namespace {
 
-TEST(RayCastVisibility, VisAndRaysMatchABruteForceNearestVoxelSearchAfterRandomCarvings) {
+class RayCastVisibilityTest : public ::testing::TestWithParam<VisLookup> {};
+
+TEST_P(RayCastVisibilityTest, VisAndRaysMatchABruteForceNearestVoxelSearchAfterRandomCarvings) {
   SyntheticSceneOptions options;
   options.num_views = 4;
   options.width = 64;
@@ -19,7 +21,7 @@ TEST(RayCastVisibility, VisAndRaysMatchABruteForceNearestVoxelSearchAfterRandomC
   const SyntheticScene scene = GenerateSyntheticScene(options);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
   Volume volume(VoxelGrid(scene.object_box, 12));
-  RayCastVisibility visibility(views, volume);
+  RayCastVisibility visibility(views, volume, GetParam());
 
   std::mt19937 random(11);
   std::vector<PixelRef> vis;
@@ -66,6 +68,13 @@ TEST(RayCastVisibility, VisAndRaysMatchABruteForceNearestVoxelSearchAfterRandomC
   }
   EXPECT_GT(carved, 300);
 }
+
+INSTANTIATE_TEST_SUITE_P(BothLookups,
+                         RayCastVisibilityTest,
+                         ::testing::Values(VisLookup::kFootprint, VisLookup::kRayLists),
+                         [](const ::testing::TestParamInfo<VisLookup>& info) {
+                           return VisLookupToString(info.param);
+                         });
 
 }  // namespace
 }  // namespace raycarve

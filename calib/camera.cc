@@ -6,15 +6,6 @@
 #include "calib/input_error.h"
 
 namespace raycarve {
-namespace {
-
-bool HasSingleFocal(CameraModelId model) {
-  const std::string info = CameraModelParamsInfo(model);
-  return info.rfind("f,", 0) == 0;
-}
-
-}  // namespace
-
 Eigen::Vector2d Camera::ImgFromCam(const Eigen::Vector2d& normalized) const {
   return raycarve::ImgFromCam(model, params, normalized);
 }
@@ -25,11 +16,13 @@ Eigen::Vector2d Camera::CamFromImg(const Eigen::Vector2d& pixel) const {
 
 double Camera::FocalLengthX() const { return params.at(0); }
 
-double Camera::FocalLengthY() const { return HasSingleFocal(model) ? params.at(0) : params.at(1); }
+double Camera::FocalLengthY() const {
+  return CameraModelHasSingleFocalLength(model) ? params.at(0) : params.at(1);
+}
 
 Eigen::Vector2d Camera::PrincipalPoint() const {
-  return HasSingleFocal(model) ? Eigen::Vector2d(params.at(1), params.at(2))
-                               : Eigen::Vector2d(params.at(2), params.at(3));
+  return CameraModelHasSingleFocalLength(model) ? Eigen::Vector2d(params.at(1), params.at(2))
+                                                : Eigen::Vector2d(params.at(2), params.at(3));
 }
 
 void ValidateCamera(const Camera& camera, const std::string& context) {

@@ -56,12 +56,6 @@ const ModelInfo& Info(CameraModelId model) {
   return kModels[index];
 }
 
-bool HasSingleFocal(CameraModelId model) {
-  return model == CameraModelId::kSimplePinhole || model == CameraModelId::kSimpleRadial ||
-         model == CameraModelId::kRadial || model == CameraModelId::kSimpleRadialFisheye ||
-         model == CameraModelId::kRadialFisheye;
-}
-
 // Equidistant fisheye angle scaling: (u, v) * theta_d(theta) / r with theta = atan(r), where
 // theta_d = theta * (1 + c[0] theta^2 + c[1] theta^4 + ...).
 Eigen::Vector2d FisheyeDistort(const Eigen::Vector2d& uv, const double* coeffs, int num_coeffs) {
@@ -159,7 +153,7 @@ struct Intrinsics {
 Intrinsics Split(CameraModelId model, const std::vector<double>& params) {
   CHECK_EQ(static_cast<int>(params.size()), CameraModelNumParams(model))
       << "wrong number of parameters for " << CameraModelName(model);
-  if (HasSingleFocal(model)) {
+  if (CameraModelHasSingleFocalLength(model)) {
     return {params[0], params[0], params[1], params[2], params.data() + 3};
   }
   return {params[0], params[1], params[2], params[3], params.data() + 4};
@@ -182,6 +176,12 @@ int CameraModelNumParams(CameraModelId model) { return Info(model).num_params; }
 
 bool CameraModelHasDistortion(CameraModelId model) {
   return model != CameraModelId::kSimplePinhole && model != CameraModelId::kPinhole;
+}
+
+bool CameraModelHasSingleFocalLength(CameraModelId model) {
+  return model == CameraModelId::kSimplePinhole || model == CameraModelId::kSimpleRadial ||
+         model == CameraModelId::kRadial || model == CameraModelId::kSimpleRadialFisheye ||
+         model == CameraModelId::kRadialFisheye;
 }
 
 CameraModelId CameraModelIdFromInt(int model_id, const std::string& context) {

@@ -32,6 +32,8 @@ std::string CameraModelParamsInfo(CameraModelId model);
 int CameraModelNumParams(CameraModelId model);
 // False for SIMPLE_PINHOLE and PINHOLE, whose images need no undistortion.
 bool CameraModelHasDistortion(CameraModelId model);
+// True for models with one focal length f (parameters f, cx, cy, ...), false for fx, fy.
+bool CameraModelHasSingleFocalLength(CameraModelId model);
 
 // Conversions from file values. On an unknown or unsupported value they throw InputError whose
 // message starts with `context` (e.g. "cameras.bin: camera 3: model_id") and names the model

@@ -130,17 +130,12 @@ class TextReader {
     T value{};
     const char* begin = token.data();
     const char* end = begin + token.size();
-    if constexpr (std::is_floating_point_v<T>) {
-      // "nan" and "inf" parse; ValidateReconstruction rejects them with the record's name.
-      const auto result = std::from_chars(begin, end, value);
-      if (result.ec != std::errc() || result.ptr != end) {
-        Fail(field, "'" + token + "' is not a number");
-      }
-    } else {
-      const auto result = std::from_chars(begin, end, value);
-      if (result.ec != std::errc() || result.ptr != end) {
-        Fail(field, "'" + token + "' is not a valid integer of this field's range");
-      }
+    // For doubles "nan" and "inf" parse; ValidateReconstruction rejects them with the record.
+    const auto result = std::from_chars(begin, end, value);
+    if (result.ec != std::errc() || result.ptr != end) {
+      Fail(field, "'" + token + (std::is_floating_point_v<T>
+                                     ? "' is not a number"
+                                     : "' is not a valid integer of this field's range"));
     }
     return value;
   }

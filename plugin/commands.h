@@ -24,6 +24,7 @@ int RunImportMiddlebury(int argc, char** argv);
 int RunSynth(int argc, char** argv);
 int RunCalibrate(int argc, char** argv);
 int RunCarve(int argc, char** argv);
+int RunCompare(int argc, char** argv);
 
 // Options shared by every command that bounds the volume.
 struct BoundsFlags {

@@ -26,6 +26,8 @@ const Command kCommands[] = {
      "build calibrated, undistorted views of a COLMAP project and check them"},
     {"carve", raycarve::RunCarve,
      "carve a coloured voxel model (cloud.ply, mesh.ply) from a COLMAP project"},
+    {"compare", raycarve::RunCompare,
+     "accuracy, completeness and F-score of a PLY cloud or mesh against a reference"},
     {"synth", raycarve::RunSynth, "generate a synthetic COLMAP project with ground truth"},
 };
 

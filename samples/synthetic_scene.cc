@@ -13,6 +13,7 @@
 #include "calib/input_error.h"
 #include "calib/model_writer.h"
 #include "calib/pixel.h"
+#include "export/point_cloud_io.h"
 
 namespace raycarve {
 namespace {
@@ -226,6 +227,24 @@ Hit SampleSurface(std::mt19937_64* random) {
   return hit;
 }
 
+// The pixel of `point` in `image` when it is inside the frame and not occluded.
+bool SeenBy(const Eigen::Vector3d& point,
+            const Image& image,
+            const Camera& camera,
+            Eigen::Vector2d* pixel) {
+  const Eigen::Vector3d in_camera = image.cam_from_world * point;
+  if (in_camera.z() <= 0.0) return false;
+  *pixel = camera.ImgFromCam(in_camera.hnormalized());
+  if (!(pixel->x() >= 0.0 && pixel->y() >= 0.0 && pixel->x() < camera.width &&
+        pixel->y() < camera.height)) {
+    return false;
+  }
+  const Eigen::Vector3d centre = image.ProjectionCenter();
+  const Eigen::Vector3d offset = point - centre;
+  const Hit hit = Trace(centre, offset.normalized());
+  return std::abs(hit.t - offset.norm()) <= 1e-6 * offset.norm();
+}
+
 }  // namespace
 
 double TrueSurfaceDistance(const Eigen::Vector3d& point) {
@@ -357,18 +376,8 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
     point3D.xyz = surface.point;
     std::vector<std::pair<image_t, Eigen::Vector2d>> observations;
     for (const auto& [image_id, image] : reconstruction.images) {
-      const Eigen::Vector3d in_camera = image.cam_from_world * surface.point;
-      if (in_camera.z() <= 0.0) continue;
-      const Eigen::Vector2d pixel = camera.ImgFromCam(in_camera.hnormalized());
-      if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < options.width &&
-            pixel.y() < options.height)) {
-        continue;
-      }
-      const Eigen::Vector3d centre = image.ProjectionCenter();
-      const Eigen::Vector3d offset = surface.point - centre;
-      const Hit hit = Trace(centre, offset.normalized());
-      if (std::abs(hit.t - offset.norm()) > 1e-6 * offset.norm()) continue;  // occluded
-      observations.emplace_back(image_id, pixel);
+      Eigen::Vector2d pixel;
+      if (SeenBy(surface.point, image, camera, &pixel)) observations.emplace_back(image_id, pixel);
     }
     if (observations.size() < 2) continue;
     const Eigen::Vector3d colour = SurfaceColour(surface);
@@ -389,6 +398,25 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
   return scene;
 }
 
+std::vector<Eigen::Vector3d> SampleTrueSurface(const SyntheticScene& scene,
+                                               int count,
+                                               uint64_t seed,
+                                               int min_views) {
+  std::mt19937_64 random(seed);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < count; ++i) {
+    const Hit surface = SampleSurface(&random);
+    int views = 0;
+    for (const auto& [image_id, image] : scene.reconstruction.images) {
+      Eigen::Vector2d pixel;
+      views += SeenBy(surface.point, image, scene.reconstruction.cameras.at(image.camera_id), &pixel);
+      if (views >= min_views) break;
+    }
+    if (views >= min_views) points.push_back(surface.point);
+  }
+  return points;
+}
+
 void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path) {
   const std::filesystem::path root(path);
   std::error_code error;
@@ -404,6 +432,13 @@ void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path)
     RenameIntoPlace(temporary, final_path.string());
   }
   WriteModel(scene.reconstruction, (root / "sparse" / "0").string(), ModelFormat::kBinary);
+  std::vector<exporter::ColouredPoint> truth;
+  for (const Eigen::Vector3d& point : SampleTrueSurface(scene, 200000, 7, 2)) {
+    exporter::ColouredPoint coloured;
+    coloured.xyz = point.cast<float>();
+    truth.push_back(coloured);
+  }
+  exporter::WritePointCloudPly(truth, (root / "truth.ply").string());
 }
 
 }  // namespace raycarve

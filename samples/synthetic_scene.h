@@ -49,11 +49,21 @@ std::vector<double> ExampleCameraParams(CameraModelId model, int width, int heig
 // Distance from a world point to the scene's true surface (sphere, box, ground square), exact.
 double TrueSurfaceDistance(const Eigen::Vector3d& point);
 
+// A dense sample of the true surface for measuring reconstructions: `count` candidate points
+// uniform over the surface's area (fixed `seed`), of which those seen (inside the frame, not
+// occluded) by at least `min_views` of the scene's cameras are kept, since no method can recover
+// what the photos do not show.
+std::vector<Eigen::Vector3d> SampleTrueSurface(const SyntheticScene& scene,
+                                               int count,
+                                               uint64_t seed,
+                                               int min_views);
+
 // Generates the scene; the same options always give the same scene, bit for bit.
 SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options);
 
-// Writes a COLMAP project into `path`: images/<name>.png and sparse/0/ (binary). Throws
-// InputError when a file cannot be written.
+// Writes a COLMAP project into `path`: images/<name>.png, sparse/0/ (binary) and truth.ply (the
+// ground truth: SampleTrueSurface with 200,000 candidates, seen by 2 views). Throws InputError
+// when a file cannot be written.
 void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path);
 
 }  // namespace raycarve

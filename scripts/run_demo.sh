@@ -14,11 +14,16 @@ build/plugin/raycarve synth --output_path "$out/scene" --camera_model OPENCV --v
 build/plugin/raycarve model_info --input_path "$out/scene/sparse/0" \
   --output_path "$out/model_info.json" > /dev/null
 build/plugin/raycarve carve --workspace_path "$out/scene" --output_path "$out/carve"
+# Measured against the scene's true surface (truth.ply); 0.05 is about 2 voxels at 128.
+build/plugin/raycarve compare --reference "$out/scene/truth.ply" --input "$out/carve/cloud.ply" \
+  --threshold 0.05 --output_path "$out/carve/compare.json" | head -2
 echo
 echo "Outputs in $out/:"
 echo "  scene/images/*.png, scene/sparse/0/   the generated COLMAP project (colmap gui can open it)"
+echo "  scene/truth.ply                       the true surface, densely sampled (ground truth)"
 echo "  model_info.json                       cameras, images, points and the carving bounds"
 echo "  carve/cloud.ply                       coloured points with normals (COLMAP fused.ply layout)"
 echo "  carve/mesh.ply                        coloured voxel surface mesh"
 echo "  carve/report.json, convergence.csv    statistics, timings per stage, carving curve"
+echo "  carve/compare.json                    accuracy, completeness, F-score against truth.ply"
 echo "Open the PLY files in MeshLab, CloudCompare or Open3D (e.g. meshlab $out/carve/mesh.ply)."

@@ -230,6 +230,40 @@ TEST_F(CommandLine, CarveWritesCloudMeshReportAndCurve) {
   EXPECT_EQ(std::stod(last.substr(last.find(',') + 1)), carved) << last;
 }
 
+TEST_F(CommandLine, CompareMeasuresTheCarvedCloudAgainstTheGroundTruth) {
+  const std::string out = *root_ + "/carved_for_compare";
+  std::string output;
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + out + " --resolution 40",
+                &output),
+            0)
+      << output;
+  ASSERT_TRUE(fs::is_regular_file(Project() + "/truth.ply"));
+  ASSERT_EQ(Run("compare --reference " + Project() + "/truth.ply --input " + out +
+                    "/cloud.ply --threshold 0.2 --output_path " + out + "/compare.json",
+                &output),
+            0)
+      << output;
+  const std::string report = testing::ReadFileBytes(out + "/compare.json");
+  EXPECT_GT(JsonNumber(report, "num_reference_points"), 1000);
+  // The metrics themselves are tested in export/point_cloud_compare_test; on this tiny project
+  // (4 views of 96x72, 40 voxels) completeness at 0.2 measured 0.227.
+  EXPECT_GT(JsonNumber(report, "completeness"), 0.1);
+  EXPECT_LE(JsonNumber(report, "completeness"), 1.0);
+  EXPECT_GT(JsonNumber(report, "f_score"), 0.0);
+  // The mesh is read by sampling its surface.
+  ASSERT_EQ(Run("compare --reference " + Project() + "/truth.ply --input " + out +
+                    "/mesh.ply --mesh_samples 20000",
+                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("\"num_input_points\": 20000"), std::string::npos) << output;
+  ExpectUserError("compare --reference " + out + "/nothing.ply --input " + out + "/cloud.ply",
+                  {out + "/nothing.ply", "not found"});
+  ExpectUserError("compare --reference " + Project() + "/truth.ply --input " + out +
+                      "/cloud.ply --threshold -1",
+                  {"threshold must be a positive distance"});
+}
+
 TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
   const std::string base = "carve --workspace_path " + Project() + " --output_path " + *root_ + "/refused";
   ExpectUserError(base + " --resolution 0", {"resolution must be in [1, 4096]"});

@@ -1,6 +1,7 @@
 #include "calib/calibrated_view.h"
 
 #include <glog/logging.h>
+#include <opencv2/imgproc.hpp>
 
 #include "calib/input_error.h"
 #include "calib/undistortion.h"
@@ -19,7 +20,9 @@ double CalibratedView::Depth(const Eigen::Vector3d& world) const {
 CalibratedView MakeCalibratedView(const Camera& camera,
                                   const Image& image,
                                   const cv::Mat& rgb,
-                                  const std::string& source) {
+                                  const std::string& source,
+                                  const cv::Mat& mask,
+                                  const std::string& mask_source) {
   CHECK_EQ(rgb.type(), CV_8UC3);
   if (static_cast<uint64_t>(rgb.cols) != camera.width ||
       static_cast<uint64_t>(rgb.rows) != camera.height) {
@@ -42,11 +45,27 @@ CalibratedView MakeCalibratedView(const Camera& camera,
       0.0, 0.0, 1.0;
   view.P = view.K * view.cam_from_world.ToMatrix();
 
+  cv::Mat object;
+  if (!mask.empty()) {
+    CHECK_EQ(mask.type(), CV_8UC1);
+    if (mask.size() != rgb.size()) {
+      throw InputError(mask_source + ": mask of image " + std::to_string(image.image_id) + " is " +
+                       std::to_string(mask.cols) + "x" + std::to_string(mask.rows) +
+                       " but its photo is " + std::to_string(rgb.cols) + "x" +
+                       std::to_string(rgb.rows));
+    }
+    object = (mask != 0);
+  }
   if (CameraModelHasDistortion(camera.model)) {
-    UndistortImage(BuildUndistortionMaps(camera), rgb, &view.image, &view.valid);
+    const UndistortionMaps maps = BuildUndistortionMaps(camera);
+    UndistortImage(maps, rgb, &view.image, &view.valid);
+    if (!object.empty()) {
+      cv::remap(object, view.mask, maps.map_x, maps.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+    }
   } else {
     view.image = rgb.clone();
     view.valid = cv::Mat(rgb.rows, rgb.cols, CV_8UC1, cv::Scalar(255));
+    view.mask = object;
   }
   return view;
 }

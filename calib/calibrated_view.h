@@ -24,6 +24,7 @@ struct CalibratedView {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // camera centre in world coordinates
   cv::Mat image;  // CV_8UC3, RGB order, undistorted
   cv::Mat valid;  // CV_8UC1, 255 where `image` holds a photo pixel (0 beyond the distorted frame)
+  cv::Mat mask;   // CV_8UC1, 255 on the object and 0 on background; empty when no mask is known
 
   // Pixel (COLMAP convention) of a world point; meaningless for points with Depth() <= 0.
   Eigen::Vector2d Project(const Eigen::Vector3d& world) const;
@@ -31,12 +32,16 @@ struct CalibratedView {
   double Depth(const Eigen::Vector3d& world) const;
 };
 
-// Builds the view of `image` (seen by `camera`) from its photo `rgb` (CV_8UC3 RGB as decoded).
-// Cameras with distortion are resampled to PinholeCameraFor(camera). Throws InputError naming
-// `source` (the photo's path) when the photo's size differs from the camera's.
+// Builds the view of `image` (seen by `camera`) from its photo `rgb` (CV_8UC3 RGB as decoded)
+// and, optionally, its object mask (CV_8UC1, non-zero = object, in the photo's pixels).
+// Cameras with distortion are resampled to PinholeCameraFor(camera) (the mask by nearest
+// neighbour). Throws InputError naming `source` (the photo's path) when the photo's size differs
+// from the camera's, or `mask_source` when the mask's size differs from the photo's.
 CalibratedView MakeCalibratedView(const Camera& camera,
                                   const Image& image,
                                   const cv::Mat& rgb,
-                                  const std::string& source);
+                                  const std::string& source,
+                                  const cv::Mat& mask = cv::Mat(),
+                                  const std::string& mask_source = "");
 
 }  // namespace raycarve

@@ -48,8 +48,22 @@ std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruc
     }
     cv::Mat rgb;
     cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    cv::Mat mask;
+    std::string mask_file;
+    if (!options.mask_path.empty()) {
+      const std::filesystem::path folder(options.mask_path);
+      const std::string colmap_style = (folder / (image.name + ".png")).string();
+      const std::string same_name = (folder / image.name).string();
+      mask_file = std::filesystem::is_regular_file(colmap_style) ? colmap_style : same_name;
+      if (!std::filesystem::is_regular_file(mask_file)) {
+        throw InputError(colmap_style + ": mask of image " + std::to_string(image_id) +
+                         " not found (nor " + same_name + ")");
+      }
+      mask = cv::imread(mask_file, cv::IMREAD_GRAYSCALE);
+      if (mask.empty()) throw InputError(mask_file + ": mask cannot be decoded as an image");
+    }
     const Camera& camera = reconstruction.cameras.at(image.camera_id);
-    views.push_back(MakeCalibratedView(camera, image, rgb, path));
+    views.push_back(MakeCalibratedView(camera, image, rgb, path, mask, mask_file));
     VLOG(1) << path << ": view built";
   }
   summary->num_loaded = static_cast<int>(views.size());

@@ -11,6 +11,9 @@ namespace raycarve {
 struct ViewReaderOptions {
   // Skip registered images whose photo is missing (counted and logged) instead of failing.
   bool skip_missing_images = false;
+  // Folder of object masks (non-zero = object), one per photo, named as COLMAP names them
+  // (<photo name>.png) or exactly as the photo; empty: no masks.
+  std::string mask_path;
 };
 
 struct ViewReaderSummary {
@@ -21,9 +24,10 @@ struct ViewReaderSummary {
 };
 
 // Loads the photo of every registered image of `reconstruction` from `image_path` / image.name
-// and builds its CalibratedView (undistorted, in image-id order). Throws InputError naming the
-// photo's path and image id when a photo is missing (unless skipped), cannot be decoded, or has
-// the wrong size, and when no view at all could be built.
+// (and its mask from options.mask_path) and builds its CalibratedView (undistorted, in image-id
+// order). Throws InputError naming the photo's path and image id when a photo is missing (unless
+// skipped), cannot be decoded, or has the wrong size; naming the mask paths tried when a mask is
+// missing, undecodable or of the wrong size; and when no view at all could be built.
 std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruction,
                                                 const std::string& image_path,
                                                 const ViewReaderOptions& options,

@@ -38,6 +38,16 @@ void GatherColours(const std::vector<CalibratedView>& views,
   }
 }
 
+// The starting volume: the whole grid, less the visual hull's outside when asked and masked.
+Volume InitialVolume(const std::vector<CalibratedView>& views,
+                     const Eigen::AlignedBox3d& box,
+                     const CarveOptions& options,
+                     VisualHullStatistics* statistics) {
+  Volume volume{VoxelGrid(box, options.resolution)};
+  if (options.visual_hull) *statistics = CarveVisualHull(views, &volume);
+  return volume;
+}
+
 }  // namespace
 
 bool CarveOptions::IsValid(std::string* reason) const {
@@ -97,7 +107,7 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                                      const Eigen::AlignedBox3d& box,
                                      const CarveOptions& options)
     : views_(views),
-      volume_(VoxelGrid(box, options.resolution)),
+      volume_(InitialVolume(views, box, options, &visual_hull_)),
       visibility_(views, volume_, options.vis_lookup),
       test_(options.consistency, options.threshold, options.min_views),
       queued_((volume_.grid().num_voxels() + 63) / 64, 0) {
@@ -173,6 +183,9 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   statistics.voxel_size = carver.volume().grid().voxel_size();
   statistics.num_voxels = carver.volume().grid().num_voxels();
   statistics.initial_surface = carver.volume().num_surface();
+  statistics.views_with_masks = carver.visual_hull().views_with_masks;
+  statistics.visual_hull_carved = carver.visual_hull().carved;
+  statistics.visual_hull_seconds = carver.visual_hull().seconds;
   statistics.setup_seconds = SecondsSince(setup_start);
 
   const Clock::time_point start = Clock::now();
@@ -197,7 +210,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   }
   statistics.carve_seconds = SecondsSince(start);
   sample(statistics.carve_seconds);
-  statistics.carved = carver.carved();
+  statistics.carved = carver.carved() + statistics.visual_hull_carved;
   statistics.evaluated = carver.evaluated();
   statistics.peak_memory_bytes = carver.MemoryBytes();
 

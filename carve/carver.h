@@ -11,6 +11,7 @@
 #include "calib/calibrated_view.h"
 #include "carve/consistency.h"
 #include "carve/ray_cast_visibility.h"
+#include "carve/visual_hull.h"
 #include "carve/volume.h"
 
 namespace raycarve {
@@ -30,6 +31,9 @@ struct CarveOptions {
   double max_memory_gib = 8.0;
   // How Vis(V) is found (see ray_cast_visibility.h); the carving is the same either way.
   VisLookup vis_lookup = VisLookup::kFootprint;
+  // When views carry masks: carve the silhouettes' visual hull before colouring (background
+  // pixels are always left out of Vis(V) and consistency).
+  bool visual_hull = true;
 
   bool IsValid(std::string* reason) const;
 };
@@ -50,6 +54,9 @@ struct CurveSample {
 
 struct CarveStatistics {
   std::string visibility;  // "ray (footprint)" or "ray (ray_lists)"
+  int views_with_masks = 0;
+  int64_t visual_hull_carved = 0;    // voxels removed by the silhouette pre-carve
+  double visual_hull_seconds = 0.0;  // its time (part of set-up)
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   double voxel_size = 0.0;
   int64_t num_voxels = 0;
@@ -101,6 +108,7 @@ class IncrementalCarver {
   std::vector<ColouredVoxel> ColourSurface();
 
   const Volume& volume() const { return volume_; }
+  const VisualHullStatistics& visual_hull() const { return visual_hull_; }
   Volume* mutable_volume() { return &volume_; }
   RayCastVisibility& visibility() { return visibility_; }
   int64_t evaluated() const { return evaluated_; }
@@ -115,6 +123,7 @@ class IncrementalCarver {
   Consistency Evaluate(int64_t voxel);
 
   const std::vector<CalibratedView>& views_;
+  VisualHullStatistics visual_hull_;  // declared before volume_: filled while volume_ is built
   Volume volume_;
   RayCastVisibility visibility_;
   ConsistencyTest test_;

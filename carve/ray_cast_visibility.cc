@@ -31,8 +31,11 @@ RayCastVisibility::RayCastVisibility(const std::vector<CalibratedView>& views,
   for (const CalibratedView& view : views) {
     const Eigen::Matrix3d world_from_pixel =
         view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse();
+    // Rays only where the view holds photo data on the object: background pixels never enter
+    // Vis(V) or consistency.
+    const cv::Mat usable = view.mask.empty() ? view.valid : (view.valid & view.mask);
     rays_.emplace_back(volume.grid(), world_from_pixel, view.centre, view.width, view.height,
-                       view.valid);
+                       usable);
     rays_.back().Initialise(volume);
     view_offset_.push_back(static_cast<int32_t>(total));
     total += static_cast<int64_t>(view.width) * view.height;

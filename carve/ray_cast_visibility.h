@@ -22,8 +22,8 @@ bool VisLookupFromString(const std::string& text, VisLookup* lookup);
 // The seed paper's visibility: an image of rays per view as the item buffer.
 // Vis(V) is the pixels whose ray currently ends in V, found by `lookup`; both lookups give the
 // same pixels in the same order (view by view, row-major). Carving V steps only the rays of
-// Vis(V) to their next solid voxel, which is reported as changed. Masked-out pixels
-// (view.valid == 0) get no ray.
+// Vis(V) to their next solid voxel, which is reported as changed. Pixels without photo data
+// (view.valid == 0) or on background (view.mask == 0 when there is a mask) get no ray.
 class RayCastVisibility : public Visibility {
  public:
   // `volume` must outlive this object; rays start at its first solid voxels.

@@ -49,6 +49,12 @@ CarveRun CarveProject(const CarveRequest& request) {
   }
   stage = Clock::now();
   const VoxelGrid grid(run.bounds.box, request.options.resolution);
+  LOG(INFO) << (request.view_options.mask_path.empty()
+                    ? std::string("no masks: every photo pixel is used (give --mask_path for an "
+                                  "object on a plain backdrop)")
+                    : "masks from " + request.view_options.mask_path +
+                          (request.options.visual_hull ? ", with the visual hull pre-carve"
+                                                       : ", without the visual hull pre-carve"));
   LOG(INFO) << "carving a " << grid.dimensions().x() << "x" << grid.dimensions().y() << "x"
             << grid.dimensions().z() << " grid (voxel " << grid.voxel_size() << ") with "
             << views.size() << " views, " << ConsistencyMethodToString(request.options.consistency)
@@ -103,6 +109,8 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("min_views").Value(request.options.min_views)
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
       .Key("max_memory_gib").Value(request.options.max_memory_gib)
+      .Key("mask_path").Value(request.view_options.mask_path)
+      .Key("visual_hull").Value(request.options.visual_hull)
       .EndObject();
   json.Key("bounds").BeginObject()
       .Key("min").Value(JsonArray(run.bounds.box.min()))
@@ -116,6 +124,9 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
                                               static_cast<double>(s.dimensions.z())})
       .Key("voxel_size").Value(s.voxel_size)
       .Key("num_voxels").Value(s.num_voxels)
+      .Key("views_with_masks").Value(s.views_with_masks)
+      .Key("visual_hull_carved").Value(s.visual_hull_carved)
+      .Key("visual_hull_seconds").Value(s.visual_hull_seconds)
       .Key("initial_surface").Value(s.initial_surface)
       .Key("carved").Value(s.carved)
       .Key("evaluated").Value(s.evaluated)
@@ -170,6 +181,11 @@ int RunCarve(int argc, char** argv) {
                     "refuse grids whose carving structures would need more (GiB)");
   parser.AddDefault("skip_missing_images", &request.view_options.skip_missing_images,
                     "skip registered images whose photo is missing instead of failing");
+  parser.AddDefault("mask_path", &request.view_options.mask_path,
+                    "folder of object masks (<photo name>.png, non-zero = object): background "
+                    "pixels are left out, and the silhouettes pre-carve the volume");
+  parser.AddDefault("visual_hull", &request.options.visual_hull,
+                    "with masks, carve the silhouettes' visual hull before colouring");
   AddBoundsFlags(&parser, &request.bounds);
   if (!parser.Parse(argc, argv)) return 0;
   ConsistencyMethodFromString(consistency, &request.options.consistency);
@@ -180,7 +196,7 @@ int RunCarve(int argc, char** argv) {
   std::printf(
       "\ncarved %s\n"
       "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
-      "  carved          %lld voxels, %lld evaluations\n"
+      "  carved          %lld voxels (%lld by the visual hull of %d masked views), %lld evaluations\n"
       "  convergence     %.2f s (+ %.2f s set-up), peak memory %.1f MiB\n"
       "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more (cloud.ply)\n"
       "  outputs         %s/cloud.ply (%zu points), mesh.ply (%zu triangles),\n"
@@ -188,6 +204,7 @@ int RunCarve(int argc, char** argv) {
       "  open with       meshlab %s/mesh.ply   (or CloudCompare, Open3D, colmap gui)\n",
       run.model_path.c_str(), s.dimensions.x(), s.dimensions.y(), s.dimensions.z(), s.voxel_size,
       static_cast<long long>(s.num_voxels), static_cast<long long>(s.carved),
+      static_cast<long long>(s.visual_hull_carved), s.views_with_masks,
       static_cast<long long>(s.evaluated), s.carve_seconds, s.setup_seconds,
       s.peak_memory_bytes / (1024.0 * 1024.0), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), run.num_cloud_points, request.options.min_views,

@@ -25,12 +25,18 @@ int RunSynth(int argc, char** argv) {
                     "surface samples tried as sparse points (kept when seen by >= 2 views)");
   parser.AddDefault("pixel_noise", &options.pixel_noise,
                     "std. dev. of noise on the 2D observations (px)");
+  std::string backdrop = "patchwork";
+  parser.AddDefault("backdrop", &backdrop,
+                    "behind the scene: a patchwork sky, or a uniform dark backdrop (a studio set-up "
+                    "that needs masks)",
+                    {"patchwork", "uniform"});
   std::vector<std::string> models;
   for (CameraModelId model : SupportedCameraModels()) models.push_back(CameraModelName(model));
   parser.AddDefault("camera_model", &camera_model,
                     "camera model of the photos (with a typical distortion)", models);
   if (!parser.Parse(argc, argv)) return 0;
   options.camera_model = CameraModelIdFromName(camera_model, "--camera_model");
+  options.uniform_backdrop = backdrop == "uniform";
   std::string reason;
   if (!options.IsValid(&reason)) throw InputError("raycarve synth: " + reason);
 

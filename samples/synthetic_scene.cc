@@ -157,12 +157,19 @@ Rigid3d LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
   return cam_from_world;
 }
 
-cv::Mat Render(const Camera& camera, const Rigid3d& cam_from_world, int supersampling) {
+// Renders the photo and the object mask (pixels where most rays hit the scene).
+cv::Mat Render(const Camera& camera,
+               const Rigid3d& cam_from_world,
+               int supersampling,
+               bool uniform_backdrop,
+               cv::Mat* mask) {
   const Rigid3d world_from_cam = cam_from_world.Inverse();
   cv::Mat photo(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC3);
+  mask->create(photo.size(), CV_8UC1);
   for (int row = 0; row < photo.rows; ++row) {
     for (int col = 0; col < photo.cols; ++col) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int hits = 0;
       for (int sy = 0; sy < supersampling; ++sy) {
         for (int sx = 0; sx < supersampling; ++sx) {
           const Eigen::Vector2d pixel(col + (sx + 0.5) / supersampling,
@@ -172,10 +179,14 @@ cv::Mat Render(const Camera& camera, const Rigid3d& cam_from_world, int supersam
           const Eigen::Vector3d direction =
               (world_from_cam.rotation * normalized.homogeneous()).normalized();
           const Hit hit = Trace(world_from_cam.translation, direction);
-          sum += hit.surface == Surface::kNone ? SkyColour(direction) : SurfaceColour(hit);
+          hits += hit.surface != Surface::kNone;
+          sum += hit.surface != Surface::kNone ? SurfaceColour(hit)
+                 : uniform_backdrop            ? kBackdropColour
+                                               : SkyColour(direction);
         }
       }
       const Eigen::Vector3d rgb = sum / (supersampling * supersampling);
+      mask->at<uint8_t>(row, col) = 2 * hits >= supersampling * supersampling ? 255 : 0;
       photo.at<cv::Vec3b>(row, col) = cv::Vec3b(static_cast<uint8_t>(std::lround(rgb[0])),
                                                 static_cast<uint8_t>(std::lround(rgb[1])),
                                                 static_cast<uint8_t>(std::lround(rgb[2])));
@@ -362,8 +373,11 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
     std::snprintf(name, sizeof(name), "view%03d.png", i + 1);
     image.name = name;
     image.cam_from_world = LookAt(centre, target);
+    cv::Mat mask;
     scene.photos.emplace(image.image_id,
-                         Render(camera, image.cam_from_world, options.supersampling));
+                         Render(camera, image.cam_from_world, options.supersampling,
+                                options.uniform_backdrop, &mask));
+    scene.masks.emplace(image.image_id, mask);
     reconstruction.images.emplace(image.image_id, std::move(image));
   }
 
@@ -421,6 +435,7 @@ void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path)
   const std::filesystem::path root(path);
   std::error_code error;
   std::filesystem::create_directories(root / "images", error);
+  std::filesystem::create_directories(root / "masks", error);
   if (error) throw InputError(path + ": cannot create the project folder: " + error.message());
   for (const auto& [image_id, photo] : scene.photos) {
     const std::string name = scene.reconstruction.images.at(image_id).name;
@@ -430,6 +445,12 @@ void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path)
     cv::cvtColor(photo, bgr, cv::COLOR_RGB2BGR);
     if (!cv::imwrite(temporary, bgr)) throw InputError(temporary + ": cannot write the photo");
     RenameIntoPlace(temporary, final_path.string());
+    const std::string mask_path = (root / "masks" / (name + ".png")).string();
+    const std::string mask_temporary = TemporaryPathFor(mask_path);
+    if (!cv::imwrite(mask_temporary, scene.masks.at(image_id))) {
+      throw InputError(mask_temporary + ": cannot write the mask");
+    }
+    RenameIntoPlace(mask_temporary, mask_path);
   }
   WriteModel(scene.reconstruction, (root / "sparse" / "0").string(), ModelFormat::kBinary);
   std::vector<exporter::ColouredPoint> truth;

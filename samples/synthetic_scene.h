@@ -29,6 +29,9 @@ struct SyntheticSceneOptions {
   int num_surface_samples = 3000;  // candidate sparse points before the visibility filter
   double pixel_noise = 0.0;        // std. dev. of Gaussian noise on the 2D observations (px)
   int supersampling = 2;           // rays per pixel along each axis when rendering
+  // Behind the scene: a patchwork sky (empty space is photo-inconsistent) or a uniform backdrop
+  // (kBackdropColour, as a studio backdrop: empty space is consistent unless masks are used).
+  bool uniform_backdrop = false;
 
   bool IsValid(std::string* reason) const;
 };
@@ -39,8 +42,12 @@ struct SyntheticScene {
   // (plus pixel_noise).
   Reconstruction reconstruction;
   std::map<image_t, cv::Mat> photos;  // CV_8UC3 RGB, as the camera model sees them
+  std::map<image_t, cv::Mat> masks;   // CV_8UC1, 255 where most of a pixel's rays hit the scene
   Eigen::AlignedBox3d object_box;     // smallest box holding the ground square and the objects
 };
+
+// The uniform backdrop's colour (RGB).
+const Eigen::Vector3d kBackdropColour(12, 10, 14);
 
 // Parameters of `model` for a camera of the given size and focal length: principal point near
 // the image centre and a mild distortion typical of that model (none for pinhole models).
@@ -61,9 +68,10 @@ std::vector<Eigen::Vector3d> SampleTrueSurface(const SyntheticScene& scene,
 // Generates the scene; the same options always give the same scene, bit for bit.
 SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options);
 
-// Writes a COLMAP project into `path`: images/<name>.png, sparse/0/ (binary) and truth.ply (the
-// ground truth: SampleTrueSurface with 200,000 candidates, seen by 2 views). Throws InputError
-// when a file cannot be written.
+// Writes a COLMAP project into `path`: images/<name>.png, masks/<name>.png (COLMAP's naming:
+// the photo's name plus .png), sparse/0/ (binary) and truth.ply (the ground truth:
+// SampleTrueSurface with 200,000 candidates, seen by 2 views). Throws InputError when a file
+// cannot be written.
 void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path);
 
 }  // namespace raycarve

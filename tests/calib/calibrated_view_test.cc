@@ -190,5 +190,51 @@ TEST(ViewReader, MissingPhotosAreErrorsOrSkippedAndCounted) {
   std::filesystem::remove_all(root);
 }
 
+TEST(ViewReader, ReadsMasksByEitherNameAndNamesMissingOrWrongSizedOnes) {
+  const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kOpenCv));
+  const std::string root = testing::MakeTemporaryDirectory("view_reader_masks");
+  WriteSyntheticProject(scene, root);
+  ViewReaderOptions options;
+  options.mask_path = root + "/masks";  // COLMAP's naming: view001.png.png
+  std::vector<CalibratedView> views =
+      ReadCalibratedViews(scene.reconstruction, root + "/images", options, nullptr);
+  ASSERT_EQ(views.size(), 5u);
+  for (const CalibratedView& view : views) {
+    ASSERT_EQ(view.mask.size(), view.image.size());
+    // Undistorted by nearest neighbour: still binary, and the object covers part of the view.
+    EXPECT_EQ(cv::countNonZero(view.mask) + cv::countNonZero(view.mask == 0), view.width * view.height);
+    const int object = cv::countNonZero(view.mask);
+    EXPECT_GT(object, view.width * view.height / 20);
+    EXPECT_LT(object, view.width * view.height);
+  }
+  // Named exactly as the photos.
+  std::filesystem::create_directories(root + "/same_names");
+  for (const auto& [id, image] : scene.reconstruction.images) {
+    std::filesystem::copy_file(root + "/masks/" + image.name + ".png", root + "/same_names/" + image.name);
+  }
+  options.mask_path = root + "/same_names";
+  views = ReadCalibratedViews(scene.reconstruction, root + "/images", options, nullptr);
+  EXPECT_EQ(views.size(), 5u);
+
+  std::filesystem::remove(root + "/same_names/view002.png");
+  try {
+    ReadCalibratedViews(scene.reconstruction, root + "/images", options, nullptr);
+    FAIL() << "missing mask accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find(root + "/same_names/view002.png"), std::string::npos)
+        << error.what();
+    EXPECT_NE(std::string(error.what()).find("mask of image 2"), std::string::npos);
+  }
+  cv::imwrite(root + "/same_names/view002.png", cv::Mat(10, 10, CV_8UC1, cv::Scalar(255)));
+  try {
+    ReadCalibratedViews(scene.reconstruction, root + "/images", options, nullptr);
+    FAIL() << "wrong-size mask accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("view002.png"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("10x10"), std::string::npos) << error.what();
+  }
+  std::filesystem::remove_all(root);
+}
+
 }  // namespace
 }  // namespace raycarve

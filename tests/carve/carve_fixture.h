@@ -8,12 +8,15 @@
 namespace raycarve {
 namespace testing {
 
-// The synthetic scene's views as carving inputs (undistorted, pinhole).
-inline std::vector<CalibratedView> SceneViews(const SyntheticScene& scene) {
+// The synthetic scene's views as carving inputs (undistorted, pinhole), with the scene's exact
+// object masks when `with_masks`.
+inline std::vector<CalibratedView> SceneViews(const SyntheticScene& scene, bool with_masks = false) {
   std::vector<CalibratedView> views;
   for (const auto& [image_id, image] : scene.reconstruction.images) {
     views.push_back(MakeCalibratedView(scene.reconstruction.cameras.at(image.camera_id), image,
-                                       scene.photos.at(image_id), image.name));
+                                       scene.photos.at(image_id), image.name,
+                                       with_masks ? scene.masks.at(image_id) : cv::Mat(),
+                                       image.name + ".png"));
   }
   return views;
 }

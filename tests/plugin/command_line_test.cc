@@ -264,6 +264,25 @@ TEST_F(CommandLine, CompareMeasuresTheCarvedCloudAgainstTheGroundTruth) {
                   {"threshold must be a positive distance"});
 }
 
+TEST_F(CommandLine, CarveWithMasksPreCarvesTheVisualHullAndSaysSo) {
+  const std::string out = *root_ + "/carved_masked";
+  std::string output;
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + out +
+                    " --resolution 40 --mask_path " + Project() + "/masks",
+                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("masks from " + Project() + "/masks, with the visual hull"), std::string::npos)
+      << output;
+  const std::string report = testing::ReadFileBytes(out + "/report.json");
+  EXPECT_EQ(JsonNumber(report, "views_with_masks"), 4);
+  EXPECT_GT(JsonNumber(report, "visual_hull_carved"), 0);
+  EXPECT_LE(JsonNumber(report, "visual_hull_carved"), JsonNumber(report, "carved"));
+  ExpectUserError("carve --workspace_path " + Project() + " --output_path " + out +
+                      " --mask_path " + *root_ + "/no_masks",
+                  {*root_ + "/no_masks/view001.png.png", "mask of image 1", "not found"});
+}
+
 TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
   const std::string base = "carve --workspace_path " + Project() + " --output_path " + *root_ + "/refused";
   ExpectUserError(base + " --resolution 0", {"resolution must be in [1, 4096]"});

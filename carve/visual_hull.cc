@@ -1,0 +1,79 @@
+#include "carve/visual_hull.h"
+
+#include <chrono>
+
+#include <opencv2/imgproc.hpp>
+
+#include "carve/footprint.h"
+
+namespace raycarve {
+namespace {
+
+// Inclusive-rectangle sums over a CV_32S integral image of size (rows + 1) x (cols + 1).
+int RectSum(const cv::Mat& integral, const Footprint& f) {
+  return integral.at<int>(f.row_max + 1, f.col_max + 1) - integral.at<int>(f.row_min, f.col_max + 1) -
+         integral.at<int>(f.row_max + 1, f.col_min) + integral.at<int>(f.row_min, f.col_min);
+}
+
+// Whether the voxel's projection lies inside the image: its footprint computed without clipping
+// equals the clipped one.
+bool FullyInside(const Eigen::Matrix<double, 3, 4>& P,
+                 int width,
+                 int height,
+                 const VoxelGrid& grid,
+                 const Eigen::Vector3i& voxel,
+                 Footprint* footprint) {
+  *footprint = ComputeFootprint(P, width, height, grid, voxel);
+  if (footprint->empty()) return false;
+  const Footprint unclipped = ComputeFootprint(P, 1 << 20, 1 << 20, grid, voxel);
+  return unclipped.col_min == footprint->col_min && unclipped.row_min == footprint->row_min &&
+         unclipped.col_max == footprint->col_max && unclipped.row_max == footprint->row_max &&
+         footprint->col_min > 0 && footprint->row_min > 0;
+}
+
+}  // namespace
+
+VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views, Volume* volume) {
+  const auto start = std::chrono::steady_clock::now();
+  VisualHullStatistics statistics;
+  struct MaskedView {
+    const CalibratedView* view;
+    cv::Mat object_integral;
+    cv::Mat valid_integral;
+  };
+  std::vector<MaskedView> masked;
+  for (const CalibratedView& view : views) {
+    if (view.mask.empty()) continue;
+    MaskedView m{&view, cv::Mat(), cv::Mat()};
+    // Silhouettes grown by one pixel: a binary mask drops pixels less than half covered, which
+    // would cut slivers of the object (thin parts, corners) out of the hull.
+    cv::Mat object;
+    cv::dilate(view.mask != 0, object, cv::Mat::ones(3, 3, CV_8U));
+    object &= (view.valid != 0);
+    cv::integral(object / 255, m.object_integral, CV_32S);
+    cv::integral(view.valid / 255, m.valid_integral, CV_32S);
+    masked.push_back(std::move(m));
+  }
+  statistics.views_with_masks = static_cast<int>(masked.size());
+  if (masked.empty()) return statistics;
+  const VoxelGrid& grid = volume->grid();
+  for (int64_t index = 0; index < grid.num_voxels(); ++index) {
+    if (!volume->IsSolid(index)) continue;
+    const Eigen::Vector3i voxel = grid.Voxel(index);
+    for (const MaskedView& m : masked) {
+      Footprint footprint;
+      if (!FullyInside(m.view->P, m.view->width, m.view->height, grid, voxel, &footprint)) continue;
+      if (RectSum(m.valid_integral, footprint) == 0) continue;  // no photo data there
+      if (RectSum(m.object_integral, footprint) == 0) {
+        volume->Carve(index, nullptr);
+        ++statistics.carved;
+        break;
+      }
+    }
+  }
+  statistics.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return statistics;
+}
+
+}  // namespace raycarve

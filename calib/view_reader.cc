@@ -15,6 +15,12 @@ std::string ViewReaderSummary::Summary() const {
   std::ostringstream text;
   text << "views: " << num_loaded << " of " << num_registered << " registered images loaded";
   if (!missing.empty()) text << ", " << missing.size() << " skipped (photo missing)";
+  if (masks_from_files > 0) text << "; " << masks_from_files << " masks from files";
+  if (masks_from_backdrop > 0) {
+    text << "; " << masks_from_backdrop << " masks from the backdrop (mean colour "
+         << mean_backdrop.transpose() << ")";
+  }
+  if (no_plain_backdrop > 0) text << "; " << no_plain_backdrop << " photos without a plain backdrop";
   return text.str();
 }
 
@@ -61,12 +67,26 @@ std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruc
       }
       mask = cv::imread(mask_file, cv::IMREAD_GRAYSCALE);
       if (mask.empty()) throw InputError(mask_file + ": mask cannot be decoded as an image");
+      ++summary->masks_from_files;
+    } else if (options.background.mode != BackgroundOptions::Mode::kNone) {
+      Eigen::Vector3d backdrop = options.background.colour;
+      if (options.background.mode == BackgroundOptions::Mode::kAuto &&
+          !EstimateBackdropColour(rgb, options.background.tolerance, &backdrop)) {
+        LOG(WARNING) << path << ": the photo's border is not one colour; no backdrop mask";
+        ++summary->no_plain_backdrop;
+      } else {
+        mask = ObjectMaskFromBackdrop(rgb, backdrop, options.background.tolerance);
+        mask_file = path + " (backdrop mask)";
+        summary->mean_backdrop += backdrop;
+        ++summary->masks_from_backdrop;
+      }
     }
     const Camera& camera = reconstruction.cameras.at(image.camera_id);
     views.push_back(MakeCalibratedView(camera, image, rgb, path, mask, mask_file));
     VLOG(1) << path << ": view built";
   }
   summary->num_loaded = static_cast<int>(views.size());
+  if (summary->masks_from_backdrop > 0) summary->mean_backdrop /= summary->masks_from_backdrop;
   if (views.empty()) {
     throw InputError(image_path + ": no view could be built: the model has " +
                      std::to_string(reconstruction.images.size()) +

@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "calib/background_mask.h"
 #include "calib/calibrated_view.h"
 #include "calib/reconstruction.h"
 
@@ -14,11 +15,17 @@ struct ViewReaderOptions {
   // Folder of object masks (non-zero = object), one per photo, named as COLMAP names them
   // (<photo name>.png) or exactly as the photo; empty: no masks.
   std::string mask_path;
+  // Without mask files: masks computed from a plain backdrop (see background_mask.h).
+  BackgroundOptions background;
 };
 
 struct ViewReaderSummary {
   int num_registered = 0;
   int num_loaded = 0;
+  int masks_from_files = 0;
+  int masks_from_backdrop = 0;
+  int no_plain_backdrop = 0;  // kAuto found no one-coloured border: that view has no mask
+  Eigen::Vector3d mean_backdrop = Eigen::Vector3d::Zero();  // over masks_from_backdrop views
   std::vector<std::string> missing;  // photo paths not found (only with skip_missing_images)
   std::string Summary() const;
 };

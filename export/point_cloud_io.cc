@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include <pcl/console/print.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -70,7 +71,12 @@ std::vector<ColouredPoint> ReadPointCloudPly(const std::string& path) {
   }
   pcl::PointCloud<pcl::PointXYZRGBNormal> cloud;
   pcl::PLYReader reader;
-  if (reader.read(path, cloud) != 0) {
+  // Fields a file lacks (curvature, normals, colours) are expected; only errors are worth saying.
+  const pcl::console::VERBOSITY_LEVEL verbosity = pcl::console::getVerbosityLevel();
+  pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
+  const int status = reader.read(path, cloud);
+  pcl::console::setVerbosityLevel(verbosity);
+  if (status != 0) {
     throw InputError(path + ": PCL could not read it as a PLY point cloud");
   }
   std::vector<ColouredPoint> points;

@@ -6,7 +6,9 @@
 #include <sstream>
 
 #include <glog/logging.h>
+#include <opencv2/imgcodecs.hpp>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
 #include "calib/view_reader.h"
@@ -41,6 +43,8 @@ CarveRun CarveProject(const CarveRequest& request) {
   run.bounds = project.bounds;
   run.num_views = static_cast<int>(project.views.size());
   run.num_missing_images = static_cast<int>(project.view_summary.missing.size());
+  run.masks_from_files = project.view_summary.masks_from_files;
+  run.masks_from_backdrop = project.view_summary.masks_from_backdrop;
   run.stage_seconds.emplace_back("load_project", SecondsSince(stage));
   const std::vector<CalibratedView>& views = project.views;
 
@@ -49,12 +53,16 @@ CarveRun CarveProject(const CarveRequest& request) {
   }
   stage = Clock::now();
   const VoxelGrid grid(run.bounds.box, request.options.resolution);
-  LOG(INFO) << (request.view_options.mask_path.empty()
-                    ? std::string("no masks: every photo pixel is used (give --mask_path for an "
-                                  "object on a plain backdrop)")
-                    : "masks from " + request.view_options.mask_path +
-                          (request.options.visual_hull ? ", with the visual hull pre-carve"
-                                                       : ", without the visual hull pre-carve"));
+  const ViewReaderSummary& masks = project.view_summary;
+  if (masks.masks_from_files + masks.masks_from_backdrop == 0) {
+    LOG(INFO) << "no masks: every photo pixel is used (for an object on a plain backdrop give "
+                 "--mask_path or --background auto)";
+  } else {
+    LOG(INFO) << (masks.masks_from_files > 0 ? "masks from " + request.view_options.mask_path
+                                             : std::string("masks from the backdrop colour"))
+              << (request.options.visual_hull ? ", with the visual hull pre-carve"
+                                              : ", without the visual hull pre-carve");
+  }
   LOG(INFO) << "carving a " << grid.dimensions().x() << "x" << grid.dimensions().y() << "x"
             << grid.dimensions().z() << " grid (voxel " << grid.voxel_size() << ") with "
             << views.size() << " views, " << ConsistencyMethodToString(request.options.consistency)
@@ -84,6 +92,17 @@ CarveRun CarveProject(const CarveRequest& request) {
   run.num_mesh_triangles = mesh.num_triangles;
   run.stage_seconds.emplace_back("export", SecondsSince(stage));
 
+  // The masks used, so that a user can check them: undistorted, as the carving saw them.
+  for (const CalibratedView& view : views) {
+    if (view.mask.empty()) continue;
+    const std::filesystem::path mask_path = out / "masks" / (view.name + ".png");
+    std::filesystem::create_directories(mask_path.parent_path(), error);
+    if (error) throw InputError(mask_path.parent_path().string() + ": cannot create: " + error.message());
+    const std::string temporary = TemporaryPathFor(mask_path.string());
+    if (!cv::imwrite(temporary, view.mask)) throw InputError(temporary + ": cannot write the mask");
+    RenameIntoPlace(temporary, mask_path.string());
+  }
+
   std::ostringstream csv;
   csv << "seconds,carved,evaluated\n";
   for (const CurveSample& sample : run.result->statistics.curve) {
@@ -110,6 +129,9 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
       .Key("max_memory_gib").Value(request.options.max_memory_gib)
       .Key("mask_path").Value(request.view_options.mask_path)
+      .Key("masks_from_files").Value(run.masks_from_files)
+      .Key("masks_from_backdrop").Value(run.masks_from_backdrop)
+      .Key("background_tolerance").Value(request.view_options.background.tolerance)
       .Key("visual_hull").Value(request.options.visual_hull)
       .EndObject();
   json.Key("bounds").BeginObject()
@@ -184,12 +206,22 @@ int RunCarve(int argc, char** argv) {
   parser.AddDefault("mask_path", &request.view_options.mask_path,
                     "folder of object masks (<photo name>.png, non-zero = object): background "
                     "pixels are left out, and the silhouettes pre-carve the volume");
+  std::string background = "none";
+  parser.AddDefault("background", &background,
+                    "without --mask_path, masks from a plain backdrop: none, auto (each photo's "
+                    "border colour) or R,G,B");
+  parser.AddDefault("background_tolerance", &request.view_options.background.tolerance,
+                    "RGB distance from the backdrop colour beyond which a pixel is object");
   parser.AddDefault("visual_hull", &request.options.visual_hull,
                     "with masks, carve the silhouettes' visual hull before colouring");
   AddBoundsFlags(&parser, &request.bounds);
   if (!parser.Parse(argc, argv)) return 0;
   ConsistencyMethodFromString(consistency, &request.options.consistency);
   VisLookupFromString(vis_lookup, &request.options.vis_lookup);
+  request.view_options.background.mode =
+      ParseBackground(background, &request.view_options.background.colour);
+  std::string reason;
+  if (!request.view_options.background.IsValid(&reason)) throw InputError("raycarve carve: " + reason);
 
   const CarveRun run = CarveProject(request);
   const CarveStatistics& s = run.result->statistics;

@@ -88,6 +88,8 @@ struct CarveRun {
   Bounds bounds;
   int num_views = 0;
   int num_missing_images = 0;
+  int masks_from_files = 0;
+  int masks_from_backdrop = 0;
   std::unique_ptr<CarveResult> result;
   std::vector<std::pair<std::string, double>> stage_seconds;
   size_t num_cloud_points = 0;

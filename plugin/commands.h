@@ -25,6 +25,7 @@ int RunSynth(int argc, char** argv);
 int RunCalibrate(int argc, char** argv);
 int RunCarve(int argc, char** argv);
 int RunCompare(int argc, char** argv);
+int RunCheckBackground(int argc, char** argv);
 
 // Options shared by every command that bounds the volume.
 struct BoundsFlags {

@@ -28,6 +28,8 @@ const Command kCommands[] = {
      "carve a coloured voxel model (cloud.ply, mesh.ply) from a COLMAP project"},
     {"compare", raycarve::RunCompare,
      "accuracy, completeness and F-score of a PLY cloud or mesh against a reference"},
+    {"check_background", raycarve::RunCheckBackground,
+     "share of a point cloud that projects onto background in the photos"},
     {"synth", raycarve::RunSynth, "generate a synthetic COLMAP project with ground truth"},
 };
 

@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "calib/calibrated_view.h"
+#include "carve/volume.h"
 #include "samples/synthetic_scene.h"
 
 namespace raycarve {

@@ -55,8 +55,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   const VoxelGrid grid(run.bounds.box, request.options.resolution);
   const ViewReaderSummary& masks = project.view_summary;
   if (masks.masks_from_files + masks.masks_from_backdrop == 0) {
-    LOG(INFO) << "no masks: every photo pixel is used (for an object on a plain backdrop give "
-                 "--mask_path or --background auto)";
+    LOG(INFO) << "no masks (no mask files, no plain backdrop found): every photo pixel is used";
   } else {
     LOG(INFO) << (masks.masks_from_files > 0 ? "masks from " + request.view_options.mask_path
                                              : std::string("masks from the backdrop colour"))
@@ -129,6 +128,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
       .Key("max_memory_gib").Value(request.options.max_memory_gib)
       .Key("mask_path").Value(request.view_options.mask_path)
+      .Key("background").Value(request.background)
       .Key("masks_from_files").Value(run.masks_from_files)
       .Key("masks_from_backdrop").Value(run.masks_from_backdrop)
       .Key("background_tolerance").Value(request.view_options.background.tolerance)
@@ -206,10 +206,11 @@ int RunCarve(int argc, char** argv) {
   parser.AddDefault("mask_path", &request.view_options.mask_path,
                     "folder of object masks (<photo name>.png, non-zero = object): background "
                     "pixels are left out, and the silhouettes pre-carve the volume");
-  std::string background = "none";
+  std::string background = "auto";
   parser.AddDefault("background", &background,
-                    "without --mask_path, masks from a plain backdrop: none, auto (each photo's "
-                    "border colour) or R,G,B");
+                    "without --mask_path, masks from a plain backdrop: auto (a photo whose border "
+                    "is one colour gets a mask; natural scenes are left as they are), none, or "
+                    "R,G,B");
   parser.AddDefault("background_tolerance", &request.view_options.background.tolerance,
                     "RGB distance from the backdrop colour beyond which a pixel is object");
   parser.AddDefault("visual_hull", &request.options.visual_hull,
@@ -220,6 +221,7 @@ int RunCarve(int argc, char** argv) {
   VisLookupFromString(vis_lookup, &request.options.vis_lookup);
   request.view_options.background.mode =
       ParseBackground(background, &request.view_options.background.colour);
+  request.background = background;
   std::string reason;
   if (!request.view_options.background.IsValid(&reason)) throw InputError("raycarve carve: " + reason);
 

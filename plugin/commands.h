@@ -79,7 +79,8 @@ struct CarveRequest {
   CarveOptions options;
   BoundsFlags bounds;
   ViewReaderOptions view_options;
-  double progress_seconds = 2.0;  // between progress lines
+  std::string background = "auto";  // as given on the command line, for the report
+  double progress_seconds = 2.0;     // between progress lines
 };
 
 struct CarveRun {

@@ -283,6 +283,43 @@ TEST_F(CommandLine, CarveWithMasksPreCarvesTheVisualHullAndSaysSo) {
                   {*root_ + "/no_masks/view001.png.png", "mask of image 1", "not found"});
 }
 
+TEST_F(CommandLine, ByDefaultAPlainBackdropGivesMasksAndANaturalSceneNone) {
+  const std::string studio = *root_ + "/studio";
+  std::string output;
+  ASSERT_EQ(Run("synth --output_path " + studio +
+                    " --views 4 --width 96 --height 72 --points 300 --backdrop uniform",
+                &output),
+            0)
+      << output;
+  ASSERT_EQ(Run("carve --workspace_path " + studio + " --output_path " + studio + "/out --resolution 32",
+                &output),
+            0)
+      << output;
+  std::string report = testing::ReadFileBytes(studio + "/out/report.json");
+  EXPECT_EQ(JsonNumber(report, "masks_from_backdrop"), 4);
+  EXPECT_GT(JsonNumber(report, "visual_hull_carved"), 0);
+  EXPECT_TRUE(fs::is_regular_file(studio + "/out/masks/view001.png.png"));  // for the user to check
+  ASSERT_EQ(Run("carve --workspace_path " + studio + " --output_path " + studio +
+                    "/plain --resolution 32 --background none",
+                &output),
+            0)
+      << output;
+  report = testing::ReadFileBytes(studio + "/plain/report.json");
+  EXPECT_EQ(JsonNumber(report, "masks_from_backdrop"), 0);
+  EXPECT_EQ(JsonNumber(report, "visual_hull_carved"), 0);
+  // The patchwork project has no plain backdrop: carved as without masks.
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + *root_ +
+                    "/natural --resolution 32",
+                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("no plain backdrop found"), std::string::npos) << output;
+  EXPECT_EQ(JsonNumber(testing::ReadFileBytes(*root_ + "/natural/report.json"), "masks_from_backdrop"), 0);
+  ExpectUserError("carve --workspace_path " + Project() + " --output_path " + *root_ +
+                      "/natural --background black",
+                  {"--background 'black'"});
+}
+
 TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
   const std::string base = "carve --workspace_path " + Project() + " --output_path " + *root_ + "/refused";
   ExpectUserError(base + " --resolution 0", {"resolution must be in [1, 4096]"});

@@ -6,6 +6,7 @@
 
 #include "calib/input_error.h"
 #include "samples/synthetic_scene.h"
+#include "tests/carve/carve_fixture.h"
 
 namespace raycarve {
 namespace {
@@ -17,13 +18,8 @@ double Iou(const cv::Mat& a, const cv::Mat& b) {
 }
 
 TEST(BackgroundMask, MasksFromTheBackdropColourAgreeWithTheTrueSilhouettes) {
-  SyntheticSceneOptions options;
-  options.num_views = 4;
-  options.width = 240;
-  options.height = 180;
-  options.num_surface_samples = 0;
-  options.uniform_backdrop = true;
-  const SyntheticScene scene = GenerateSyntheticScene(options);
+  const SyntheticScene scene =
+      GenerateSyntheticScene(testing::SceneOptions(4, 240, 180, /*uniform_backdrop=*/true));
   for (const auto& [id, photo] : scene.photos) {
     Eigen::Vector3d backdrop;
     ASSERT_TRUE(EstimateBackdropColour(photo, 30.0, &backdrop)) << "view " << id;
@@ -36,12 +32,7 @@ TEST(BackgroundMask, MasksFromTheBackdropColourAgreeWithTheTrueSilhouettes) {
 }
 
 TEST(BackgroundMask, ASceneWithoutAPlainBackdropIsRecognised) {
-  SyntheticSceneOptions options;
-  options.num_views = 2;
-  options.width = 160;
-  options.height = 120;
-  options.num_surface_samples = 0;  // the patchwork sky
-  const SyntheticScene scene = GenerateSyntheticScene(options);
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(2, 160, 120));
   Eigen::Vector3d backdrop;
   EXPECT_FALSE(EstimateBackdropColour(scene.photos.begin()->second, 30.0, &backdrop));
 }

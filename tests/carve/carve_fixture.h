@@ -9,6 +9,22 @@
 namespace raycarve {
 namespace testing {
 
+// Options of a small synthetic scene for tests: `views` cameras of `width` x `height`, no sparse
+// points unless asked, and a patchwork sky or a uniform backdrop.
+inline SyntheticSceneOptions SceneOptions(int views,
+                                          int width,
+                                          int height,
+                                          bool uniform_backdrop = false,
+                                          int surface_samples = 0) {
+  SyntheticSceneOptions options;
+  options.num_views = views;
+  options.width = width;
+  options.height = height;
+  options.num_surface_samples = surface_samples;
+  options.uniform_backdrop = uniform_backdrop;
+  return options;
+}
+
 // The synthetic scene's views as carving inputs (undistorted, pinhole), with the scene's exact
 // object masks when `with_masks`.
 inline std::vector<CalibratedView> SceneViews(const SyntheticScene& scene, bool with_masks = false) {

@@ -10,12 +10,7 @@ namespace raycarve {
 namespace {
 
 SyntheticScene Scene(int views, int width, int height) {
-  SyntheticSceneOptions options;
-  options.num_views = views;
-  options.width = width;
-  options.height = height;
-  options.num_surface_samples = 2000;
-  return GenerateSyntheticScene(options);
+  return GenerateSyntheticScene(testing::SceneOptions(views, width, height, false, 2000));
 }
 
 CarveOptions Options(int resolution, double threshold) {
@@ -116,13 +111,8 @@ double JudgedSurfaceNearTruth(const CarveResult& result) {
 }
 
 TEST(CarveVolume, OnAUniformBackdropOnlyMasksCarveTheSceneToItsTruth) {
-  SyntheticSceneOptions scene_options;
-  scene_options.num_views = 8;
-  scene_options.width = 320;
-  scene_options.height = 240;
-  scene_options.num_surface_samples = 0;
-  scene_options.uniform_backdrop = true;
-  const SyntheticScene scene = GenerateSyntheticScene(scene_options);
+  const SyntheticScene scene =
+      GenerateSyntheticScene(testing::SceneOptions(8, 320, 240, /*uniform_backdrop=*/true));
   Eigen::AlignedBox3d box = scene.object_box;
   box.extend(box.max() + Eigen::Vector3d(0.2, 0.2, 0.5));
   const CarveResult plain = CarveVolume(testing::SceneViews(scene), box, Options(96, 30.0));

@@ -13,12 +13,7 @@ namespace {
 class RayCastVisibilityTest : public ::testing::TestWithParam<VisLookup> {};
 
 TEST_P(RayCastVisibilityTest, VisAndRaysMatchABruteForceNearestVoxelSearchAfterRandomCarvings) {
-  SyntheticSceneOptions options;
-  options.num_views = 4;
-  options.width = 64;
-  options.height = 48;
-  options.num_surface_samples = 0;
-  const SyntheticScene scene = GenerateSyntheticScene(options);
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(4, 64, 48));
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
   Volume volume(VoxelGrid(scene.object_box, 12));
   RayCastVisibility visibility(views, volume, GetParam());

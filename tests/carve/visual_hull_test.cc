@@ -8,13 +8,7 @@ namespace raycarve {
 namespace {
 
 SyntheticScene BackdropScene() {
-  SyntheticSceneOptions options;
-  options.num_views = 8;
-  options.width = 160;
-  options.height = 120;
-  options.num_surface_samples = 0;
-  options.uniform_backdrop = true;
-  return GenerateSyntheticScene(options);
+  return GenerateSyntheticScene(testing::SceneOptions(8, 160, 120, /*uniform_backdrop=*/true));
 }
 
 TEST(VisualHull, KeepsEveryVoxelOfTheTrueSurfaceAndRemovesMostEmptySpace) {

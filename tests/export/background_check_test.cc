@@ -10,13 +10,8 @@ namespace exporter {
 namespace {
 
 TEST(BackgroundCheck, TrueSurfacePointsAreOnTheObjectAndPointsInTheAirAreNot) {
-  SyntheticSceneOptions options;
-  options.num_views = 6;
-  options.width = 200;
-  options.height = 150;
-  options.num_surface_samples = 0;
-  options.uniform_backdrop = true;
-  const SyntheticScene scene = GenerateSyntheticScene(options);
+  const SyntheticScene scene =
+      GenerateSyntheticScene(testing::SceneOptions(6, 200, 150, /*uniform_backdrop=*/true));
   const std::vector<CalibratedView> views = testing::SceneViews(scene, /*with_masks=*/true);
 
   std::vector<Eigen::Vector3f> surface;

@@ -17,12 +17,7 @@ namespace exporter {
 namespace {
 
 CarveResult SmallCarve() {
-  SyntheticSceneOptions options;
-  options.num_views = 6;
-  options.width = 160;
-  options.height = 120;
-  options.num_surface_samples = 0;
-  const SyntheticScene scene = GenerateSyntheticScene(options);
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(6, 160, 120));
   CarveOptions carve;
   carve.resolution = 48;
   return CarveVolume(testing::SceneViews(scene), scene.object_box, carve);

@@ -37,7 +37,7 @@ BackgroundOptions::Mode ParseBackground(const std::string& text, Eigen::Vector3d
     numbers = numbers && !item.empty() && end == item.c_str() + item.size();
   }
   if (!numbers || values.size() != 3) {
-    throw InputError("--background '" + text + "' is not none, auto or R,G,B (e.g. 0,0,0)");
+    throw InputError("--background_colour '" + text + "' is not none, auto or R,G,B (e.g. 0,0,0)");
   }
   *colour = Eigen::Vector3d(values[0], values[1], values[2]);
   return BackgroundOptions::Mode::kColour;

@@ -23,7 +23,7 @@ struct BackgroundOptions {
   bool IsValid(std::string* reason) const;
 };
 
-// "none", "auto" or "R,G,B"; throws InputError naming --background otherwise.
+// "none", "auto" or "R,G,B"; throws InputError naming --background_colour otherwise.
 BackgroundOptions::Mode ParseBackground(const std::string& text, Eigen::Vector3d* colour);
 
 // The backdrop colour of a photo (CV_8UC3 RGB): the per-channel median of its border pixels

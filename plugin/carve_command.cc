@@ -207,7 +207,7 @@ int RunCarve(int argc, char** argv) {
                     "folder of object masks (<photo name>.png, non-zero = object): background "
                     "pixels are left out, and the silhouettes pre-carve the volume");
   std::string background = "auto";
-  parser.AddDefault("background", &background,
+  parser.AddDefault("background_colour", &background,
                     "without --mask_path, masks from a plain backdrop: auto (a photo whose border "
                     "is one colour gets a mask; natural scenes are left as they are), none, or "
                     "R,G,B");

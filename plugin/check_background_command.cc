@@ -23,7 +23,7 @@ int RunCheckBackground(int argc, char** argv) {
   parser.AddDefault("input_path", &input_path, "model folder, overriding the workspace's");
   parser.AddDefault("image_path", &image_path, "photo folder, overriding the workspace's");
   parser.AddDefault("mask_path", &view_options.mask_path, "folder of object masks");
-  parser.AddDefault("background", &background, "without --mask_path: auto or R,G,B");
+  parser.AddDefault("background_colour", &background, "without --mask_path: auto or R,G,B");
   parser.AddDefault("background_tolerance", &view_options.background.tolerance,
                     "RGB distance from the backdrop colour beyond which a pixel is object");
   parser.AddDefault("output_path", &output_path, "also write the JSON result to this file");
@@ -31,7 +31,7 @@ int RunCheckBackground(int argc, char** argv) {
   view_options.background.mode = ParseBackground(background, &view_options.background.colour);
   if (view_options.mask_path.empty() &&
       view_options.background.mode == BackgroundOptions::Mode::kNone) {
-    throw InputError("raycarve check_background: needs masks: --mask_path, or --background auto|R,G,B");
+    throw InputError("raycarve check_background: needs masks: --mask_path, or --background_colour auto|R,G,B");
   }
   const WorkspacePaths paths = ResolveWorkspace(workspace_path, input_path, image_path);
   const std::vector<CalibratedView> views =

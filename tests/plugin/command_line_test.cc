@@ -300,7 +300,7 @@ TEST_F(CommandLine, ByDefaultAPlainBackdropGivesMasksAndANaturalSceneNone) {
   EXPECT_GT(JsonNumber(report, "visual_hull_carved"), 0);
   EXPECT_TRUE(fs::is_regular_file(studio + "/out/masks/view001.png.png"));  // for the user to check
   ASSERT_EQ(Run("carve --workspace_path " + studio + " --output_path " + studio +
-                    "/plain --resolution 32 --background none",
+                    "/plain --resolution 32 --background_colour none",
                 &output),
             0)
       << output;
@@ -316,8 +316,8 @@ TEST_F(CommandLine, ByDefaultAPlainBackdropGivesMasksAndANaturalSceneNone) {
   EXPECT_NE(output.find("no plain backdrop found"), std::string::npos) << output;
   EXPECT_EQ(JsonNumber(testing::ReadFileBytes(*root_ + "/natural/report.json"), "masks_from_backdrop"), 0);
   ExpectUserError("carve --workspace_path " + Project() + " --output_path " + *root_ +
-                      "/natural --background black",
-                  {"--background 'black'"});
+                      "/natural --background_colour black",
+                  {"--background_colour 'black'"});
 }
 
 TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {

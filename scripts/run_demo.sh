@@ -6,7 +6,7 @@
 # colouring with ray-cast visibility, coloured cloud and mesh exported. Outputs go to out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh raycarve
+scripts/setup.sh raycarve render_cloud
 out=${1:-out/demo}
 mkdir -p "$out"
 build/plugin/raycarve synth --output_path "$out/scene" --camera_model OPENCV --views 8 \

@@ -37,6 +37,20 @@ TEST(BackgroundMask, ASceneWithoutAPlainBackdropIsRecognised) {
   EXPECT_FALSE(EstimateBackdropColour(scene.photos.begin()->second, 30.0, &backdrop));
 }
 
+TEST(BackgroundMask, FindsALightBackdropAsWellAsADarkOne) {
+  cv::Mat photo(120, 160, CV_8UC3, cv::Scalar(245, 246, 250));  // a white sweep
+  cv::circle(photo, cv::Point(80, 60), 30, cv::Scalar(90, 60, 40), cv::FILLED);
+  Eigen::Vector3d backdrop;
+  ASSERT_TRUE(EstimateBackdropColour(photo, 30.0, &backdrop));
+  EXPECT_EQ(backdrop, Eigen::Vector3d(245, 246, 250));
+  const cv::Mat mask = ObjectMaskFromBackdrop(photo, backdrop, 30.0);
+  EXPECT_EQ(mask.at<uint8_t>(60, 80), 255);
+  EXPECT_EQ(mask.at<uint8_t>(5, 5), 0);
+  cv::Mat truth(photo.size(), CV_8UC1, cv::Scalar(0));
+  cv::circle(truth, cv::Point(80, 60), 30, cv::Scalar(255), cv::FILLED);
+  EXPECT_GT(Iou(mask, truth), 0.98);
+}
+
 TEST(BackgroundMask, CleansSpecksAndPinholes) {
   cv::Mat photo(60, 80, CV_8UC3, cv::Scalar(0, 0, 0));
   cv::rectangle(photo, cv::Rect(20, 15, 40, 30), cv::Scalar(200, 180, 160), cv::FILLED);

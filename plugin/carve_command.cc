@@ -172,58 +172,67 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
   return json.str();
 }
 
+void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* text) {
+  text->consistency = ConsistencyMethodToString(request->options.consistency);
+  text->vis_lookup = VisLookupToString(request->options.vis_lookup);
+  parser->AddDefault("workspace_path", &request->workspace_path,
+                     "COLMAP project (sparse/0 or sparse or dense/sparse, with images/)");
+  parser->AddDefault("input_path", &request->input_path, "model folder, overriding the workspace's");
+  parser->AddDefault("image_path", &request->image_path, "photo folder, overriding the workspace's");
+  parser->AddDefault("output_path", &request->output_path,
+                     "output folder (default <workspace>/raycarve)");
+  parser->AddDefault("resolution", &request->options.resolution,
+                     "voxels along the longest axis of the volume");
+  parser->AddDefault("consistency", &text->consistency, "photo-consistency test",
+                     {"mean_colour", "standard_deviation"});
+  parser->AddDefault("threshold", &request->options.threshold,
+                     "largest consistent error, RGB units 0-255");
+  parser->AddDefault("min_views", &request->options.min_views,
+                     "views a voxel must be seen by to be judged");
+  parser->AddDefault("vis_lookup", &text->vis_lookup,
+                     "how Vis(V) finds its rays: the paper's footprint scan, or per-voxel ray "
+                     "lists (same result, more memory)",
+                     {"footprint", "ray_lists"});
+  parser->AddDefault("max_memory_gib", &request->options.max_memory_gib,
+                     "refuse grids whose carving structures would need more (GiB)");
+  parser->AddDefault("skip_missing_images", &request->view_options.skip_missing_images,
+                     "skip registered images whose photo is missing instead of failing");
+  parser->AddDefault("mask_path", &request->view_options.mask_path,
+                     "folder of object masks (<photo name>.png, non-zero = object): background "
+                     "pixels are left out, and the silhouettes pre-carve the volume");
+  parser->AddDefault("background_colour", &text->background,
+                     "without --mask_path, masks from a plain backdrop: auto (a photo whose border "
+                     "is one colour gets a mask; natural scenes are left as they are), none, or "
+                     "R,G,B");
+  parser->AddDefault("background_tolerance", &request->view_options.background.tolerance,
+                     "RGB distance from the backdrop colour beyond which a pixel is object");
+  parser->AddDefault("visual_hull", &request->options.visual_hull,
+                     "with masks, carve the silhouettes' visual hull before colouring");
+  AddBoundsFlags(parser, &request->bounds);
+}
+
+void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
+  ConsistencyMethodFromString(text.consistency, &request->options.consistency);
+  VisLookupFromString(text.vis_lookup, &request->options.vis_lookup);
+  request->view_options.background.mode =
+      ParseBackground(text.background, &request->view_options.background.colour);
+  request->background = text.background;
+  std::string reason;
+  if (!request->view_options.background.IsValid(&reason)) throw InputError(reason);
+  if (!request->options.IsValid(&reason)) throw InputError(reason);
+}
+
 int RunCarve(int argc, char** argv) {
   CarveRequest request;
-  std::string consistency = ConsistencyMethodToString(request.options.consistency);
-  std::string vis_lookup = VisLookupToString(request.options.vis_lookup);
+  CarveFlagText text;
   OptionParser parser(
       "carve",
       "Carves a coloured voxel model from a COLMAP project by incremental voxel colouring with "
       "ray-cast visibility, and writes cloud.ply (points with normals and colours, laid out like "
       "COLMAP's fused.ply), mesh.ply (the voxel surface), report.json and convergence.csv.");
-  parser.AddDefault("workspace_path", &request.workspace_path,
-                    "COLMAP project (sparse/0 or sparse or dense/sparse, with images/)");
-  parser.AddDefault("input_path", &request.input_path, "model folder, overriding the workspace's");
-  parser.AddDefault("image_path", &request.image_path, "photo folder, overriding the workspace's");
-  parser.AddDefault("output_path", &request.output_path,
-                    "output folder (default <workspace>/raycarve)");
-  parser.AddDefault("resolution", &request.options.resolution,
-                    "voxels along the longest axis of the volume");
-  parser.AddDefault("consistency", &consistency, "photo-consistency test",
-                    {"mean_colour", "standard_deviation"});
-  parser.AddDefault("threshold", &request.options.threshold,
-                    "largest consistent error, RGB units 0-255");
-  parser.AddDefault("min_views", &request.options.min_views,
-                    "views a voxel must be seen by to be judged");
-  parser.AddDefault("vis_lookup", &vis_lookup,
-                    "how Vis(V) finds its rays: the paper's footprint scan, or per-voxel ray "
-                    "lists (same result, more memory)",
-                    {"footprint", "ray_lists"});
-  parser.AddDefault("max_memory_gib", &request.options.max_memory_gib,
-                    "refuse grids whose carving structures would need more (GiB)");
-  parser.AddDefault("skip_missing_images", &request.view_options.skip_missing_images,
-                    "skip registered images whose photo is missing instead of failing");
-  parser.AddDefault("mask_path", &request.view_options.mask_path,
-                    "folder of object masks (<photo name>.png, non-zero = object): background "
-                    "pixels are left out, and the silhouettes pre-carve the volume");
-  std::string background = "auto";
-  parser.AddDefault("background_colour", &background,
-                    "without --mask_path, masks from a plain backdrop: auto (a photo whose border "
-                    "is one colour gets a mask; natural scenes are left as they are), none, or "
-                    "R,G,B");
-  parser.AddDefault("background_tolerance", &request.view_options.background.tolerance,
-                    "RGB distance from the backdrop colour beyond which a pixel is object");
-  parser.AddDefault("visual_hull", &request.options.visual_hull,
-                    "with masks, carve the silhouettes' visual hull before colouring");
-  AddBoundsFlags(&parser, &request.bounds);
+  AddCarveFlags(&parser, &request, &text);
   if (!parser.Parse(argc, argv)) return 0;
-  ConsistencyMethodFromString(consistency, &request.options.consistency);
-  VisLookupFromString(vis_lookup, &request.options.vis_lookup);
-  request.view_options.background.mode =
-      ParseBackground(background, &request.view_options.background.colour);
-  request.background = background;
-  std::string reason;
-  if (!request.view_options.background.IsValid(&reason)) throw InputError("raycarve carve: " + reason);
+  ApplyCarveFlags(text, &request);
 
   const CarveRun run = CarveProject(request);
   const CarveStatistics& s = run.result->statistics;

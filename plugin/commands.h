@@ -26,6 +26,7 @@ int RunCalibrate(int argc, char** argv);
 int RunCarve(int argc, char** argv);
 int RunCompare(int argc, char** argv);
 int RunCheckBackground(int argc, char** argv);
+int RunHoldout(int argc, char** argv);
 
 // Options shared by every command that bounds the volume.
 struct BoundsFlags {
@@ -97,6 +98,16 @@ struct CarveRun {
   size_t num_cloud_points = 0;
   size_t num_mesh_triangles = 0;
 };
+
+// The carve flags shared by `carve` and `holdout`: AddCarveFlags declares them (the enum-valued
+// ones as text), ApplyCarveFlags converts and checks them (InputError on bad values).
+struct CarveFlagText {
+  std::string consistency;
+  std::string vis_lookup;
+  std::string background = "auto";
+};
+void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* text);
+void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request);
 
 // Reads the project, carves, and writes cloud.ply, mesh.ply, report.json and convergence.csv
 // into the output folder. Throws InputError on bad input or options.

@@ -30,6 +30,8 @@ const Command kCommands[] = {
      "accuracy, completeness and F-score of a PLY cloud or mesh against a reference"},
     {"check_background", raycarve::RunCheckBackground,
      "share of a point cloud that projects onto background in the photos"},
+    {"holdout", raycarve::RunHoldout,
+     "carve without every k-th view and score renders of the left-out views (PSNR, IoU)"},
     {"synth", raycarve::RunSynth, "generate a synthetic COLMAP project with ground truth"},
 };
 

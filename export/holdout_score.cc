@@ -1,0 +1,52 @@
+#include "export/holdout_score.h"
+
+#include <cmath>
+#include <limits>
+
+#include <opencv2/core.hpp>
+
+namespace raycarve {
+namespace exporter {
+
+HoldoutScore ScoreRendering(const Rendering& rendering, const CalibratedView& view) {
+  HoldoutScore score;
+  cv::Mat region = view.valid.clone();
+  if (!view.mask.empty()) region &= (rendering.silhouette | view.mask);
+  double squared = 0.0;
+  for (int row = 0; row < view.height; ++row) {
+    const cv::Vec3b* photo = view.image.ptr<cv::Vec3b>(row);
+    const cv::Vec3b* render = rendering.image.ptr<cv::Vec3b>(row);
+    const uint8_t* in = region.ptr<uint8_t>(row);
+    for (int col = 0; col < view.width; ++col) {
+      if (!in[col]) continue;
+      ++score.scored_pixels;
+      for (int k = 0; k < 3; ++k) {
+        const double d = static_cast<double>(photo[col][k]) - render[col][k];
+        squared += d * d;
+      }
+    }
+  }
+  const double mse = score.scored_pixels == 0 ? 0.0 : squared / (3.0 * score.scored_pixels);
+  score.psnr = mse == 0.0 ? std::numeric_limits<double>::infinity()
+                          : 10.0 * std::log10(255.0 * 255.0 / mse);
+  if (!view.mask.empty()) {
+    const cv::Mat object = view.mask & view.valid;
+    const cv::Mat drawn = rendering.silhouette & view.valid;
+    const int both = cv::countNonZero(object & drawn);
+    const int either = cv::countNonZero(object | drawn);
+    score.silhouette_iou = either == 0 ? 1.0 : static_cast<double>(both) / either;
+  }
+  return score;
+}
+
+cv::Mat SideBySide(const Rendering& rendering, const CalibratedView& view) {
+  cv::Mat error;
+  cv::absdiff(view.image, rendering.image, error);
+  error.convertTo(error, CV_8UC3, 4.0);
+  cv::Mat strip;
+  cv::hconcat(std::vector<cv::Mat>{view.image, rendering.image, error}, strip);
+  return strip;
+}
+
+}  // namespace exporter
+}  // namespace raycarve

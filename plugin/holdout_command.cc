@@ -1,0 +1,111 @@
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <glog/logging.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/atomic_file.h"
+#include "calib/input_error.h"
+#include "carve/carver.h"
+#include "export/carve_export.h"
+#include "export/holdout_score.h"
+#include "export/point_renderer.h"
+#include "plugin/commands.h"
+#include "plugin/json_writer.h"
+
+namespace raycarve {
+
+int RunHoldout(int argc, char** argv) {
+  CarveRequest request;
+  CarveFlagText text;
+  int every = 4;
+  OptionParser parser(
+      "holdout",
+      "Held-out evaluation: carves the project without every k-th view, renders the carved cloud "
+      "into the left-out views, and reports PSNR (over the rendered and the true silhouette where "
+      "there is a mask, else over the whole photo) and silhouette IoU; writes photo | render | "
+      "error images to <output>/holdout/ and holdout.json.");
+  AddCarveFlags(&parser, &request, &text);
+  parser.AddDefault("every", &every, "leave out views 1, 1 + k, 1 + 2k, ... (k >= 2)");
+  if (!parser.Parse(argc, argv)) return 0;
+  ApplyCarveFlags(text, &request);
+  if (every < 2) throw InputError("raycarve holdout: --every must be at least 2");
+
+  const LoadedProject project =
+      LoadProject("holdout", request.workspace_path, request.input_path, request.image_path,
+                  request.output_path, request.bounds, request.view_options, /*min_images=*/3);
+  std::vector<CalibratedView> training, held_out;
+  for (size_t i = 0; i < project.views.size(); ++i) {
+    (i % every == 0 ? held_out : training).push_back(project.views[i]);
+  }
+  if (training.size() < 2) {
+    throw InputError("raycarve holdout: only " + std::to_string(training.size()) +
+                     " views left to carve with; raise --every");
+  }
+  std::string reason;
+  if (!CheckCarveFits(training, project.bounds.box, request.options, &reason)) {
+    throw InputError("raycarve holdout: " + reason);
+  }
+  LOG(INFO) << "carving with " << training.size() << " views, holding out " << held_out.size();
+  const CarveResult result = CarveVolume(training, project.bounds.box, request.options);
+  LOG(INFO) << result.statistics.Summary();
+  const std::vector<exporter::ColouredPoint> points =
+      exporter::SurfacePoints(result, request.options.min_views);
+  const double point_size = result.volume.grid().voxel_size();
+
+  const std::filesystem::path out = std::filesystem::path(project.output_path) / "holdout";
+  std::error_code error;
+  std::filesystem::create_directories(out, error);
+  if (error) throw InputError(out.string() + ": cannot create: " + error.message());
+  JsonWriter json;
+  json.BeginObject()
+      .Key("model_path").Value(project.model_path)
+      .Key("every").Value(every)
+      .Key("training_views").Value(static_cast<uint64_t>(training.size()))
+      .Key("cloud_points").Value(static_cast<uint64_t>(points.size()))
+      .Key("carve").Value(result.statistics.Summary());
+  json.Key("views").BeginArray();
+  double psnr_sum = 0.0, iou_sum = 0.0;
+  int iou_count = 0;
+  std::printf("%-24s %10s %12s %10s\n", "held-out view", "PSNR dB", "scored px", "sil. IoU");
+  for (const CalibratedView& view : held_out) {
+    const exporter::Rendering rendering = exporter::RenderPoints(points, view, point_size);
+    const exporter::HoldoutScore score = exporter::ScoreRendering(rendering, view);
+    psnr_sum += score.psnr;
+    if (score.silhouette_iou >= 0.0) {
+      iou_sum += score.silhouette_iou;
+      ++iou_count;
+    }
+    std::printf("%-24s %10.2f %12d %10.3f\n", view.name.c_str(), score.psnr, score.scored_pixels,
+                score.silhouette_iou);
+    json.BeginObject()
+        .Key("name").Value(view.name)
+        .Key("psnr_db").Value(score.psnr)
+        .Key("scored_pixels").Value(score.scored_pixels)
+        .Key("silhouette_iou").Value(score.silhouette_iou)
+        .EndObject();
+    cv::Mat bgr;
+    cv::cvtColor(exporter::SideBySide(rendering, view), bgr, cv::COLOR_RGB2BGR);
+    const std::string path = (out / (std::filesystem::path(view.name).stem().string() + ".png")).string();
+    const std::string temporary = TemporaryPathFor(path);
+    if (!cv::imwrite(temporary, bgr)) throw InputError(temporary + ": cannot write the image");
+    RenameIntoPlace(temporary, path);
+  }
+  json.EndArray();
+  const double mean_psnr = psnr_sum / held_out.size();
+  const double mean_iou = iou_count > 0 ? iou_sum / iou_count : -1.0;
+  json.Key("mean_psnr_db").Value(mean_psnr).Key("mean_silhouette_iou").Value(mean_iou).EndObject();
+  const std::string report = (out / "holdout.json").string();
+  WriteTextFileAtomically(report, json.str());
+  std::printf("mean over %zu held-out views: PSNR %.2f dB, silhouette IoU %s\nwrote %s and %s/<view>.png "
+              "(photo | render | error x4)\n",
+              held_out.size(), mean_psnr,
+              iou_count > 0 ? std::to_string(mean_iou).c_str() : "n/a (no masks)", report.c_str(),
+              out.string().c_str());
+  return 0;
+}
+
+}  // namespace raycarve

@@ -1,0 +1,77 @@
+#include "export/point_renderer.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "export/holdout_score.h"
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+// A 100x80 pinhole view at the origin looking down +z, f = 100, principal point (50, 40).
+CalibratedView View() {
+  CalibratedView view;
+  view.width = 100;
+  view.height = 80;
+  view.K << 100, 0, 50, 0, 100, 40, 0, 0, 1;
+  view.P = view.K * view.cam_from_world.ToMatrix();
+  view.image = cv::Mat(80, 100, CV_8UC3, cv::Scalar(10, 20, 30));
+  view.valid = cv::Mat(80, 100, CV_8UC1, cv::Scalar(255));
+  return view;
+}
+
+ColouredPoint Point(float x, float y, float z, uint8_t r) {
+  ColouredPoint point;
+  point.xyz = Eigen::Vector3f(x, y, z);
+  point.rgb << r, 0, 0;
+  return point;
+}
+
+TEST(RenderPoints, SplatsCoverTheProjectedCubeAndTheNearestPointWins) {
+  const CalibratedView view = View();
+  // At depth 10 a 0.4-wide cube projects to 4 px: centre (50, 40) covers centres 48.5 .. 51.5.
+  const Rendering one = RenderPoints({Point(0, 0, 10, 200)}, view, 0.4);
+  EXPECT_EQ(cv::countNonZero(one.silhouette), 16);
+  EXPECT_EQ(one.silhouette.at<uint8_t>(38, 48), 255);
+  EXPECT_EQ(one.silhouette.at<uint8_t>(41, 51), 255);
+  EXPECT_EQ(one.silhouette.at<uint8_t>(42, 52), 0);
+  EXPECT_EQ(one.image.at<cv::Vec3b>(40, 50), cv::Vec3b(200, 0, 0));
+  EXPECT_FLOAT_EQ(one.depth.at<float>(40, 50), 10.0f);
+  // A point behind it, drawn second or first, is hidden; one behind the camera is not drawn.
+  for (const auto& points : {std::vector<ColouredPoint>{Point(0, 0, 10, 200), Point(0, 0, 20, 90)},
+                             std::vector<ColouredPoint>{Point(0, 0, 20, 90), Point(0, 0, 10, 200)}}) {
+    EXPECT_EQ(RenderPoints(points, view, 0.4).image.at<cv::Vec3b>(40, 50), cv::Vec3b(200, 0, 0));
+  }
+  EXPECT_EQ(cv::countNonZero(RenderPoints({Point(0, 0, -5, 9)}, view, 0.4).silhouette), 0);
+  // A tiny point still covers its own pixel.
+  EXPECT_EQ(cv::countNonZero(RenderPoints({Point(0.001f, 0.001f, 10, 9)}, view, 1e-6).silhouette), 1);
+}
+
+TEST(HoldoutScore, PsnrOverTheSilhouettesAndTheirIou) {
+  CalibratedView view = View();
+  Rendering rendering;
+  rendering.image = view.image.clone();
+  rendering.silhouette = cv::Mat(80, 100, CV_8UC1, cv::Scalar(0));
+  rendering.silhouette(cv::Rect(10, 10, 20, 20)).setTo(255);
+  // Without a mask every valid pixel is scored; identical pixels give an infinite PSNR.
+  HoldoutScore score = ScoreRendering(rendering, view);
+  EXPECT_EQ(score.scored_pixels, 8000);
+  EXPECT_TRUE(std::isinf(score.psnr));
+  EXPECT_EQ(score.silhouette_iou, -1.0);
+  // A mask of the same square shifted by 10 px: IoU 200 / 600; scored pixels the union, 600.
+  view.mask = cv::Mat(80, 100, CV_8UC1, cv::Scalar(0));
+  view.mask(cv::Rect(20, 10, 20, 20)).setTo(255);
+  rendering.image.setTo(cv::Scalar(10 + 51, 20, 30));  // off by 51 in red everywhere
+  score = ScoreRendering(rendering, view);
+  EXPECT_EQ(score.scored_pixels, 600);
+  EXPECT_NEAR(score.silhouette_iou, 200.0 / 600.0, 1e-12);
+  // MSE = 51^2 / 3 per channel: PSNR = 10 log10(255^2 * 3 / 51^2).
+  EXPECT_NEAR(score.psnr, 10.0 * std::log10(255.0 * 255.0 * 3.0 / (51.0 * 51.0)), 1e-9);
+  EXPECT_EQ(SideBySide(rendering, view).size(), cv::Size(300, 80));
+}
+
+}  // namespace
+}  // namespace exporter
+}  // namespace raycarve

@@ -7,6 +7,9 @@
 
 #include <glog/logging.h>
 
+#include "carve/item_buffer_visibility.h"
+#include "carve/layered_depth_visibility.h"
+
 
 namespace raycarve {
 namespace {
@@ -19,6 +22,11 @@ double SecondsSince(Clock::time_point start) {
 
 constexpr double kBytesPerRay = 20.0;
 constexpr double kBytesPerListedRay = 24.0;
+// GVC: a 4-byte item per pixel (and one view's depth buffer, counted as 4 more bytes a pixel).
+constexpr double kBytesPerItemPixel = 8.0;
+// GVC-LDI: a 4-byte head per pixel and 12-byte entries; a ray crosses the surface a few times
+// (entering and leaving the object, more on concave parts): estimated at 4 entries a pixel.
+constexpr double kBytesPerLayeredPixel = 4.0 + 4 * 12.0;
 // Solid, surface and in-queue bits, plus a generous byte for the CVSVL's entries.
 constexpr double kBytesPerVoxel = 3.0 / 8.0 + 1.0;
 constexpr double kBytesPerListedVoxel = kBytesPerVoxel + 4.0;
@@ -49,6 +57,42 @@ Volume InitialVolume(const std::vector<CalibratedView>& views,
 }
 
 }  // namespace
+
+std::string CarveMethodToString(CarveMethod method) {
+  switch (method) {
+    case CarveMethod::kRay:
+      return "ray";
+    case CarveMethod::kGvc:
+      return "gvc";
+    case CarveMethod::kGvcLdi:
+      return "gvc_ldi";
+  }
+  return "unknown";
+}
+
+bool CarveMethodFromString(const std::string& text, CarveMethod* method) {
+  for (CarveMethod candidate : {CarveMethod::kRay, CarveMethod::kGvc, CarveMethod::kGvcLdi}) {
+    if (text == CarveMethodToString(candidate)) {
+      *method = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::unique_ptr<Visibility> MakeVisibility(const std::vector<CalibratedView>& views,
+                                           const Volume& volume,
+                                           const CarveOptions& options) {
+  switch (options.method) {
+    case CarveMethod::kGvc:
+      return std::make_unique<ItemBufferVisibility>(views, volume);
+    case CarveMethod::kGvcLdi:
+      return std::make_unique<LayeredDepthVisibility>(views, volume);
+    case CarveMethod::kRay:
+      break;
+  }
+  return std::make_unique<RayCastVisibility>(views, volume, options.vis_lookup);
+}
 
 bool CarveOptions::IsValid(std::string* reason) const {
   if (resolution < 1 || resolution > 4096) {
@@ -86,29 +130,44 @@ bool CheckCarveFits(const std::vector<CalibratedView>& views,
                     const CarveOptions& options,
                     std::string* reason) {
   if (!options.IsValid(reason)) return false;
-  const bool lists = options.vis_lookup == VisLookup::kRayLists;
+  const bool lists =
+      options.method == CarveMethod::kRay && options.vis_lookup == VisLookup::kRayLists;
+  double bytes_per_pixel = lists ? kBytesPerListedRay : kBytesPerRay;
+  if (options.method == CarveMethod::kGvc) bytes_per_pixel = kBytesPerItemPixel;
+  if (options.method == CarveMethod::kGvcLdi) bytes_per_pixel = kBytesPerLayeredPixel;
   double ray_bytes = 0.0;
   for (const CalibratedView& view : views) {
-    ray_bytes += (lists ? kBytesPerListedRay : kBytesPerRay) * view.width * view.height;
+    ray_bytes += bytes_per_pixel * view.width * view.height;
   }
   const double max_bytes = options.max_memory_gib * 1024.0 * 1024.0 * 1024.0;
   if (ray_bytes > max_bytes) {
     std::ostringstream text;
-    text << "the rays of " << views.size() << " views need " << ray_bytes / (1 << 30)
+    text << "the " << (options.method == CarveMethod::kRay ? "rays" : "buffers") << " of "
+         << views.size() << " views need " << ray_bytes / (1 << 30)
          << " GiB, above max_memory_gib " << options.max_memory_gib;
     *reason = text.str();
     return false;
   }
-  return CheckGridFits(box, options.resolution, lists ? kBytesPerListedVoxel : kBytesPerVoxel,
-                       max_bytes - ray_bytes, reason);
+  if (!CheckGridFits(box, options.resolution, lists ? kBytesPerListedVoxel : kBytesPerVoxel,
+                     max_bytes - ray_bytes, reason)) {
+    return false;
+  }
+  if (options.method != CarveMethod::kRay &&
+      VoxelGrid(box, options.resolution).num_voxels() >= (int64_t{1} << 32) - 1) {
+    *reason = CarveMethodToString(options.method) +
+              " keeps 32-bit voxel indices: use fewer than 2^32 voxels (a lower resolution)";
+    return false;
+  }
+  return true;
 }
 
 IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                                      const Eigen::AlignedBox3d& box,
-                                     const CarveOptions& options)
+                                     const CarveOptions& options,
+                                     const VisibilityFactory& factory)
     : views_(views),
       volume_(InitialVolume(views, box, options, &visual_hull_)),
-      visibility_(views, volume_, options.vis_lookup),
+      visibility_(factory ? factory(views, volume_) : MakeVisibility(views, volume_, options)),
       test_(options.consistency, options.threshold, options.min_views),
       queued_((volume_.grid().num_voxels() + 63) / 64, 0) {
   std::string reason;
@@ -127,13 +186,19 @@ void IncrementalCarver::Enqueue(int64_t voxel) {
 
 Consistency IncrementalCarver::Evaluate(int64_t voxel) {
   vis_.clear();
-  visibility_.ComputeVis(voxel, &vis_);
+  visibility_->ComputeVis(voxel, &vis_);
   GatherColours(views_, vis_, &stats_);
   return test_.Evaluate(stats_);
 }
 
 bool IncrementalCarver::Step() {
-  if (queue_.empty()) return false;
+  if (queue_.empty()) {
+    if (!visibility_->StartPass()) return false;
+    ++passes_;
+    for (int64_t voxel : volume_.SurfaceVoxels()) Enqueue(voxel);
+    max_queue_ = std::max(max_queue_, queue_.size());
+    if (queue_.empty()) return false;
+  }
   const int64_t voxel = queue_.front();
   queue_.pop_front();
   queued_[voxel >> 6] &= ~(uint64_t{1} << (voxel & 63));
@@ -143,7 +208,7 @@ bool IncrementalCarver::Step() {
   exposed_.clear();
   changed_.clear();
   volume_.Carve(voxel, &exposed_);
-  visibility_.UpdateAfterCarve(voxel, vis_, exposed_, &changed_);
+  visibility_->UpdateAfterCarve(voxel, vis_, exposed_, &changed_);
   for (int64_t next : changed_) Enqueue(next);
   ++carved_;
   max_queue_ = std::max(max_queue_, queue_.size());
@@ -165,7 +230,7 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
 }
 
 size_t IncrementalCarver::MemoryBytes() const {
-  return volume_.MemoryBytes() + visibility_.MemoryBytes() + queued_.size() * sizeof(uint64_t) +
+  return volume_.MemoryBytes() + visibility_->MemoryBytes() + queued_.size() * sizeof(uint64_t) +
          max_queue_ * sizeof(int64_t);
 }
 
@@ -177,8 +242,10 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   const Clock::time_point setup_start = Clock::now();
   IncrementalCarver carver(views, box, options);
   CarveStatistics statistics;
-  statistics.visibility =
-      carver.visibility().Name() + " (" + VisLookupToString(options.vis_lookup) + ")";
+  statistics.visibility = carver.visibility().Name();
+  if (options.method == CarveMethod::kRay) {
+    statistics.visibility += " (" + VisLookupToString(options.vis_lookup) + ")";
+  }
   statistics.dimensions = carver.volume().grid().dimensions();
   statistics.voxel_size = carver.volume().grid().voxel_size();
   statistics.num_voxels = carver.volume().grid().num_voxels();
@@ -212,6 +279,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   sample(statistics.carve_seconds);
   statistics.carved = carver.carved() + statistics.visual_hull_carved;
   statistics.evaluated = carver.evaluated();
+  statistics.passes = carver.passes();
   statistics.peak_memory_bytes = carver.MemoryBytes();
 
   const Clock::time_point colour_start = Clock::now();

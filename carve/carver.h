@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,8 +17,19 @@
 
 namespace raycarve {
 
+// How visibility is kept: the seed paper's ray casting or one of its two baselines. They share
+// everything else (grid, surface, footprints, consistency, colouring).
+enum class CarveMethod {
+  kRay,     // ray casting: an image of rays per view, stepped only where a voxel was carved
+  kGvc,     // GVC: item buffers re-rendered every pass, every surface voxel judged per pass
+  kGvcLdi,  // GVC-LDI: per-pixel depth-sorted lists of surface voxels, updated incrementally
+};
+std::string CarveMethodToString(CarveMethod method);
+bool CarveMethodFromString(const std::string& text, CarveMethod* method);
+
 // Incremental voxel colouring with ray-cast visibility (Batchelor, Mukundan, Green).
 struct CarveOptions {
+  CarveMethod method = CarveMethod::kRay;
   // Voxels along the longest axis of the box; voxels are cubes.
   int resolution = 128;
   // How visible pixels are judged (see consistency.h).
@@ -29,7 +41,8 @@ struct CarveOptions {
   int min_views = 2;
   // Refuse a grid whose carving structures would need more memory than this (GiB).
   double max_memory_gib = 8.0;
-  // How Vis(V) is found (see ray_cast_visibility.h); the carving is the same either way.
+  // With ray casting, how Vis(V) is found (see ray_cast_visibility.h); the carving is the same
+  // either way.
   VisLookup vis_lookup = VisLookup::kFootprint;
   // When views carry masks: carve the silhouettes' visual hull before colouring (background
   // pixels are always left out of Vis(V) and consistency).
@@ -53,7 +66,8 @@ struct CurveSample {
 };
 
 struct CarveStatistics {
-  std::string visibility;  // "ray (footprint)" or "ray (ray_lists)"
+  std::string visibility;  // "ray (footprint)", "ray (ray_lists)", "gvc" or "gvc_ldi"
+  int passes = 1;          // GVC: item-buffer renders (passes over the surface); others 1
   int views_with_masks = 0;
   int64_t visual_hull_carved = 0;    // voxels removed by the silhouette pre-carve
   double visual_hull_seconds = 0.0;  // its time (part of set-up)
@@ -91,13 +105,20 @@ struct CarveResult {
 
 // The carving loop of the seed paper, one CVSVL entry at a time (CarveVolume runs it to the end;
 // tests step it and look inside). The CVSVL is first in, first out, and holds a voxel at most
-// once at a time; it starts as the whole surface.
+// once at a time; it starts as the whole surface. With GVC, whenever it runs empty after a pass
+// that carved, the buffers are re-rendered and the whole surface is queued again.
 class IncrementalCarver {
  public:
-  // `views` must outlive the carver. Options must pass CheckCarveFits (CHECKed).
+  // Makes the visibility over the carver's volume (which outlives it).
+  using VisibilityFactory = std::function<std::unique_ptr<Visibility>(
+      const std::vector<CalibratedView>& views, const Volume& volume)>;
+
+  // `views` must outlive the carver. Options must pass CheckCarveFits (CHECKed). The visibility
+  // is options.method's, or what `factory` makes (a method of one's own, or an instrumented one).
   IncrementalCarver(const std::vector<CalibratedView>& views,
                     const Eigen::AlignedBox3d& box,
-                    const CarveOptions& options);
+                    const CarveOptions& options,
+                    const VisibilityFactory& factory = {});
 
   // Takes the next voxel from the CVSVL and evaluates it if still solid: computes Vis(V) and its
   // consistency; if inconsistent, carves it, updates the surface and the rays of Vis(V), and
@@ -110,7 +131,10 @@ class IncrementalCarver {
   const Volume& volume() const { return volume_; }
   const VisualHullStatistics& visual_hull() const { return visual_hull_; }
   Volume* mutable_volume() { return &volume_; }
-  RayCastVisibility& visibility() { return visibility_; }
+  Visibility& visibility() { return *visibility_; }
+  // The ray-cast visibility, or nullptr with another method.
+  RayCastVisibility* ray_visibility() { return dynamic_cast<RayCastVisibility*>(visibility_.get()); }
+  int passes() const { return passes_; }
   int64_t evaluated() const { return evaluated_; }
   int64_t carved() const { return carved_; }
   size_t queue_size() const { return queue_.size(); }
@@ -125,13 +149,14 @@ class IncrementalCarver {
   const std::vector<CalibratedView>& views_;
   VisualHullStatistics visual_hull_;  // declared before volume_: filled while volume_ is built
   Volume volume_;
-  RayCastVisibility visibility_;
+  std::unique_ptr<Visibility> visibility_;
   ConsistencyTest test_;
   std::deque<int64_t> queue_;
   std::vector<uint64_t> queued_;
   size_t max_queue_ = 0;
   int64_t evaluated_ = 0;
   int64_t carved_ = 0;
+  int passes_ = 1;
   std::vector<PixelRef> vis_;
   std::vector<ViewColourStats> stats_;
   std::vector<int64_t> exposed_;
@@ -141,6 +166,11 @@ class IncrementalCarver {
 // Estimates the memory of carving `views` over `box` with `options` and returns false, with a
 // reason giving the sizes, when the options are invalid or the estimate exceeds
 // options.max_memory_gib.
+// The visibility of `method` over `volume` (both must outlive it).
+std::unique_ptr<Visibility> MakeVisibility(const std::vector<CalibratedView>& views,
+                                           const Volume& volume,
+                                           const CarveOptions& options);
+
 bool CheckCarveFits(const std::vector<CalibratedView>& views,
                     const Eigen::AlignedBox3d& box,
                     const CarveOptions& options,

@@ -34,6 +34,12 @@ class Visibility {
                                 const std::vector<int64_t>& newly_exposed,
                                 std::vector<int64_t>* changed) = 0;
 
+  // Called when the CVSVL has run empty. An incremental method (ray casting, GVC-LDI) has
+  // nothing left to learn and returns false: the carving has converged. A pass-based method
+  // (GVC) refreshes its structures and returns true when anything was carved since its last
+  // refresh; the carver then queues every surface voxel again for another pass.
+  virtual bool StartPass() { return false; }
+
   // Bytes held by the method's structures.
   virtual size_t MemoryBytes() const = 0;
 };

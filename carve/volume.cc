@@ -77,4 +77,16 @@ std::vector<int64_t> Volume::SurfaceVoxels() const {
   return voxels;
 }
 
+VolumeAgreement CompareVolumes(const Volume& first, const Volume& second) {
+  CHECK(first.grid().dimensions() == second.grid().dimensions()) << "different grids";
+  VolumeAgreement agreement;
+  for (int64_t i = 0; i < first.grid().num_voxels(); ++i) {
+    const bool a = first.IsSolid(i), b = second.IsSolid(i);
+    agreement.solid_in_both += a && b;
+    agreement.only_first += a && !b;
+    agreement.only_second += b && !a;
+  }
+  return agreement;
+}
+
 }  // namespace raycarve

@@ -56,4 +56,19 @@ class Volume {
   int64_t num_surface_ = 0;
 };
 
+// How two carvings of the same grid agree: voxel IoU of their solid sets and the voxels on
+// which they differ.
+struct VolumeAgreement {
+  int64_t solid_in_both = 0;
+  int64_t only_first = 0;   // solid in the first volume only
+  int64_t only_second = 0;  // solid in the second volume only
+  int64_t differing() const { return only_first + only_second; }
+  double iou() const {
+    const int64_t either = solid_in_both + differing();
+    return either == 0 ? 1.0 : static_cast<double>(solid_in_both) / either;
+  }
+};
+// The grids must have the same dimensions (CHECKed).
+VolumeAgreement CompareVolumes(const Volume& first, const Volume& second);
+
 }  // namespace raycarve

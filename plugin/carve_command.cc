@@ -121,6 +121,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("num_views").Value(run.num_views)
       .Key("num_missing_images").Value(run.num_missing_images);
   json.Key("options").BeginObject()
+      .Key("method").Value(CarveMethodToString(request.options.method))
       .Key("resolution").Value(request.options.resolution)
       .Key("consistency").Value(ConsistencyMethodToString(request.options.consistency))
       .Key("threshold").Value(request.options.threshold)
@@ -152,6 +153,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("initial_surface").Value(s.initial_surface)
       .Key("carved").Value(s.carved)
       .Key("evaluated").Value(s.evaluated)
+      .Key("passes").Value(s.passes)
       .Key("final_solid").Value(s.final_solid)
       .Key("final_surface").Value(s.final_surface)
       .Key("visible_surface").Value(s.visible_surface)
@@ -175,12 +177,17 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
 void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* text) {
   text->consistency = ConsistencyMethodToString(request->options.consistency);
   text->vis_lookup = VisLookupToString(request->options.vis_lookup);
+  text->method = CarveMethodToString(request->options.method);
   parser->AddDefault("workspace_path", &request->workspace_path,
                      "COLMAP project (sparse/0 or sparse or dense/sparse, with images/)");
   parser->AddDefault("input_path", &request->input_path, "model folder, overriding the workspace's");
   parser->AddDefault("image_path", &request->image_path, "photo folder, overriding the workspace's");
   parser->AddDefault("output_path", &request->output_path,
                      "output folder (default <workspace>/raycarve)");
+  parser->AddDefault("method", &text->method,
+                     "visibility: ray casting (the seed paper), or its baselines GVC (item "
+                     "buffers, passes) and GVC-LDI (layered depth images)",
+                     {"ray", "gvc", "gvc_ldi"});
   parser->AddDefault("resolution", &request->options.resolution,
                      "voxels along the longest axis of the volume");
   parser->AddDefault("consistency", &text->consistency, "photo-consistency test",
@@ -214,6 +221,7 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
 void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
   ConsistencyMethodFromString(text.consistency, &request->options.consistency);
   VisLookupFromString(text.vis_lookup, &request->options.vis_lookup);
+  CarveMethodFromString(text.method, &request->options.method);
   request->view_options.background.mode =
       ParseBackground(text.background, &request->view_options.background.colour);
   request->background = text.background;

@@ -27,6 +27,7 @@ int RunCarve(int argc, char** argv);
 int RunCompare(int argc, char** argv);
 int RunCheckBackground(int argc, char** argv);
 int RunHoldout(int argc, char** argv);
+int RunBenchmark(int argc, char** argv);
 
 // Options shared by every command that bounds the volume.
 struct BoundsFlags {
@@ -104,6 +105,7 @@ struct CarveRun {
 struct CarveFlagText {
   std::string consistency;
   std::string vis_lookup;
+  std::string method;
   std::string background = "auto";
 };
 void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* text);

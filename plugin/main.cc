@@ -32,6 +32,8 @@ const Command kCommands[] = {
      "share of a point cloud that projects onto background in the photos"},
     {"holdout", raycarve::RunHoldout,
      "carve without every k-th view and score renders of the left-out views (PSNR, IoU)"},
+    {"benchmark", raycarve::RunBenchmark,
+     "the seed paper's Table 1 and Figure 6: ray casting against GVC and GVC-LDI"},
     {"synth", raycarve::RunSynth, "generate a synthetic COLMAP project with ground truth"},
 };
 

@@ -1,9 +1,12 @@
 #include "carve/carver.h"
 
 #include <algorithm>
+#include <memory>
+#include <utility>
 
 #include <gtest/gtest.h>
 
+#include "carve/ray_cast_visibility.h"
 #include "tests/carve/carve_fixture.h"
 
 namespace raycarve {
@@ -42,7 +45,7 @@ TEST(IncrementalCarver, KeepsItsInvariantsWhileCarving) {
     for (size_t v = 0; v < views.size(); ++v) {
       owners[v].assign(views[v].width * views[v].height, 0);
       for (int pixel = 0; pixel < views[v].width * views[v].height; ++pixel) {
-        const int64_t voxel = carver.visibility().rays(v).CurrentVoxel(pixel);
+        const int64_t voxel = carver.ray_visibility()->rays(v).CurrentVoxel(pixel);
         ASSERT_TRUE(voxel == RayImage::kNoVoxel || volume.IsSolid(voxel))
             << "view " << v << " pixel " << pixel << " ends in an empty voxel";
       }
@@ -109,6 +112,128 @@ double JudgedSurfaceNearTruth(const CarveResult& result) {
   }
   return judged == 0 ? 0.0 : static_cast<double>(near) / judged;
 }
+
+
+// Ray casting judged on GVC's schedule: changes are not reported, and every pass re-judges the
+// whole surface, but always with the current visibility (fresh rays) instead of stale buffers.
+class PassScheduledRays : public Visibility {
+ public:
+  PassScheduledRays(const std::vector<CalibratedView>& views, const Volume& volume)
+      : rays_(views, volume) {}
+  std::string Name() const override { return "ray on gvc's schedule"; }
+  void ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels) override {
+    rays_.ComputeVis(voxel, pixels);
+  }
+  void UpdateAfterCarve(int64_t voxel, const std::vector<PixelRef>& vis,
+                        const std::vector<int64_t>& exposed, std::vector<int64_t>*) override {
+    std::vector<int64_t> ignored;
+    rays_.UpdateAfterCarve(voxel, vis, exposed, &ignored);
+    carved_since_pass_ = true;
+  }
+  bool StartPass() override { return std::exchange(carved_since_pass_, false); }
+  size_t MemoryBytes() const override { return rays_.MemoryBytes(); }
+
+ private:
+  RayCastVisibility rays_;
+  bool carved_since_pass_ = false;
+};
+
+// Surface voxels of a final volume that are judged (seen by min_views views) and inconsistent
+// under the volume's true visibility (fresh rays): a converged carving has none.
+int InconsistentSurfaceVoxels(const std::vector<CalibratedView>& views, const Volume& volume,
+                              const CarveOptions& options, int* judged) {
+  RayCastVisibility rays(views, volume);
+  const ConsistencyTest test(options.consistency, options.threshold, options.min_views);
+  int inconsistent = 0;
+  *judged = 0;
+  std::vector<PixelRef> vis;
+  for (int64_t voxel : volume.SurfaceVoxels()) {
+    vis.clear();
+    rays.ComputeVis(voxel, &vis);
+    std::vector<ViewColourStats> stats;
+    for (const PixelRef& ref : vis) {
+      if (stats.empty() || stats.back().view != static_cast<int>(ref.view)) {
+        stats.emplace_back();
+        stats.back().view = static_cast<int>(ref.view);
+      }
+      const uint8_t* rgb = views[ref.view].image.data + 3 * static_cast<size_t>(ref.pixel);
+      stats.back().Add(Eigen::Vector3d(rgb[0], rgb[1], rgb[2]));
+    }
+    const Consistency consistency = test.Evaluate(stats);
+    *judged += consistency.judged;
+    inconsistent += consistency.judged && !consistency.consistent;
+  }
+  return inconsistent;
+}
+
+TEST(CarveVolume, RayCastingGvcAndGvcLdiConvergeToPhotoConsistentVolumes) {
+  const SyntheticScene scene = Scene(6, 160, 120);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  CarveOptions options = Options(40, 30.0);
+  const CarveResult ray = CarveVolume(views, scene.object_box, options);
+  options.method = CarveMethod::kGvcLdi;
+  const CarveResult ldi = CarveVolume(views, scene.object_box, options);
+  options.method = CarveMethod::kGvc;
+  const CarveResult gvc = CarveVolume(views, scene.object_box, options);
+  EXPECT_GT(ray.statistics.carved, 1000);
+  EXPECT_EQ(ray.statistics.passes, 1);
+  EXPECT_EQ(ldi.statistics.visibility, "gvc_ldi");
+  EXPECT_EQ(gvc.statistics.visibility, "gvc");
+
+  // GVC-LDI reports exactly the voxels whose rays ray casting steps to, in the same order, so
+  // with the same first-in first-out CVSVL it makes the same decisions (where float rounding
+  // does not split a grazing ray differently; on this scene nowhere).
+  EXPECT_EQ(ldi.statistics.carved, ray.statistics.carved);
+  EXPECT_EQ(ldi.statistics.evaluated, ray.statistics.evaluated);
+  EXPECT_EQ(CompareVolumes(ray.volume, ldi.volume).differing(), 0);
+
+  // GVC needs passes and re-judges the whole surface in each.
+  EXPECT_GT(gvc.statistics.passes, 2);
+  EXPECT_GT(gvc.statistics.evaluated, ray.statistics.evaluated);
+
+  // Each converged volume is a fixed point: no surface voxel is inconsistent with what it
+  // truly shows. (Different orders reach different fixed points: see the next test.)
+  for (const CarveResult* result : {&ray, &ldi, &gvc}) {
+    int judged = 0;
+    EXPECT_EQ(InconsistentSurfaceVoxels(views, result->volume, options, &judged), 0)
+        << result->statistics.visibility;
+    EXPECT_GT(judged, 200) << result->statistics.visibility;
+    EXPECT_GT(JudgedSurfaceNearTruth(*result), 0.7) << result->statistics.visibility;
+  }
+}
+
+// GVC judges with buffers rendered at the start of each pass: a subset of each voxel's current
+// Vis. The paper's weighted mean-colour test is not monotone in the pixel set (a subset can be
+// inconsistent where the whole is consistent), so stale buffers carve voxels that current
+// visibility keeps. Judged on GVC's very schedule but with current visibility, ray casting keeps
+// about what first-in first-out ray casting keeps; GVC keeps far less.
+TEST(CarveVolume, GvcCarvesMoreThanRayCastingBecauseItsBuffersAreStaleNotBecauseOfItsSchedule) {
+  const SyntheticScene scene = Scene(8, 320, 240);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  CarveOptions options = Options(96, 30.0);
+  const CarveResult ray = CarveVolume(views, scene.object_box, options);
+  options.method = CarveMethod::kGvc;
+  const CarveResult gvc = CarveVolume(views, scene.object_box, options);
+  IncrementalCarver scheduled(views, scene.object_box, Options(96, 30.0),
+                              [](const std::vector<CalibratedView>& v, const Volume& volume) {
+                                return std::make_unique<PassScheduledRays>(v, volume);
+                              });
+  while (scheduled.Step()) {
+  }
+  const double scheduled_iou = CompareVolumes(ray.volume, scheduled.volume()).iou();
+  const double gvc_iou = CompareVolumes(ray.volume, gvc.volume).iou();
+  std::printf("solid voxels: ray %lld, ray on gvc's schedule %lld (%d passes), gvc %lld (%d "
+              "passes); IoU with ray: %.3f and %.3f\n",
+              static_cast<long long>(ray.volume.num_solid()),
+              static_cast<long long>(scheduled.volume().num_solid()), scheduled.passes(),
+              static_cast<long long>(gvc.volume.num_solid()), gvc.statistics.passes,
+              scheduled_iou, gvc_iou);
+  // Measured: 0.833 and 0.309.
+  EXPECT_GT(scheduled_iou, 0.75);
+  EXPECT_LT(gvc_iou, 0.5);
+  EXPECT_LT(gvc.volume.num_solid(), scheduled.volume().num_solid() / 2);
+}
+
 
 TEST(CarveVolume, OnAUniformBackdropOnlyMasksCarveTheSceneToItsTruth) {
   const SyntheticScene scene =

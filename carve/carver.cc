@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <deque>
 #include <sstream>
 
@@ -46,12 +47,20 @@ void GatherColours(const std::vector<CalibratedView>& views,
   }
 }
 
-// The starting volume: the whole grid, less the visual hull's outside when asked and masked.
-Volume InitialVolume(const std::vector<CalibratedView>& views,
-                     const Eigen::AlignedBox3d& box,
-                     const CarveOptions& options,
-                     VisualHullStatistics* statistics) {
-  Volume volume{VoxelGrid(box, options.resolution)};
+// The grid of `options` over `box`, once the carving is known to fit (CHECKed).
+VoxelGrid CheckedGrid(const std::vector<CalibratedView>& views,
+                      const Eigen::AlignedBox3d& box,
+                      const CarveOptions& options) {
+  std::string reason;
+  CHECK(CheckCarveFits(views, box, options, &reason)) << reason;
+  return VoxelGrid(box, options.resolution);
+}
+
+// The starting volume less the visual hull's outside, when asked and masked.
+Volume WithVisualHull(const std::vector<CalibratedView>& views,
+                      Volume volume,
+                      const CarveOptions& options,
+                      VisualHullStatistics* statistics) {
   if (options.visual_hull) *statistics = CarveVisualHull(views, &volume);
   return volume;
 }
@@ -80,6 +89,20 @@ bool CarveMethodFromString(const std::string& text, CarveMethod* method) {
   return false;
 }
 
+std::string CarveOrderToString(CarveOrder order) {
+  return order == CarveOrder::kFifo ? "fifo" : "visible_pixels";
+}
+
+bool CarveOrderFromString(const std::string& text, CarveOrder* order) {
+  for (CarveOrder candidate : {CarveOrder::kFifo, CarveOrder::kVisiblePixels}) {
+    if (text == CarveOrderToString(candidate)) {
+      *order = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
 std::unique_ptr<Visibility> MakeVisibility(const std::vector<CalibratedView>& views,
                                            const Volume& volume,
                                            const CarveOptions& options) {
@@ -91,7 +114,8 @@ std::unique_ptr<Visibility> MakeVisibility(const std::vector<CalibratedView>& vi
     case CarveMethod::kRay:
       break;
   }
-  return std::make_unique<RayCastVisibility>(views, volume, options.vis_lookup);
+  return std::make_unique<RayCastVisibility>(views, volume, options.vis_lookup,
+                                             options.order == CarveOrder::kVisiblePixels);
 }
 
 bool CarveOptions::IsValid(std::string* reason) const {
@@ -103,8 +127,18 @@ bool CarveOptions::IsValid(std::string* reason) const {
     *reason = "threshold must be a finite number";
     return false;
   }
+  if (!std::isfinite(adaptive_threshold) || adaptive_threshold < 0.0) {
+    *reason = "adaptive_threshold must be a finite number >= 0";
+    return false;
+  }
   if (min_views < 1) {
     *reason = "min_views must be >= 1";
+    return false;
+  }
+  std::vector<int> resolutions;
+  if (!LevelResolutions(resolution, lod_levels, &resolutions, reason)) return false;
+  if (lod_band < 0 || lod_band > 8) {
+    *reason = "lod_band must be in [0, 8], got " + std::to_string(lod_band);
     return false;
   }
   if (!(max_memory_gib > 0.0)) {
@@ -130,8 +164,9 @@ bool CheckCarveFits(const std::vector<CalibratedView>& views,
                     const CarveOptions& options,
                     std::string* reason) {
   if (!options.IsValid(reason)) return false;
-  const bool lists =
-      options.method == CarveMethod::kRay && options.vis_lookup == VisLookup::kRayLists;
+  // Levels of detail carve their coarse levels with ray lists.
+  const bool lists = options.method == CarveMethod::kRay &&
+                     (options.vis_lookup == VisLookup::kRayLists || options.lod_levels > 1);
   double bytes_per_pixel = lists ? kBytesPerListedRay : kBytesPerRay;
   if (options.method == CarveMethod::kGvc) bytes_per_pixel = kBytesPerItemPixel;
   if (options.method == CarveMethod::kGvcLdi) bytes_per_pixel = kBytesPerLayeredPixel;
@@ -165,23 +200,55 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                                      const Eigen::AlignedBox3d& box,
                                      const CarveOptions& options,
                                      const VisibilityFactory& factory)
+    : IncrementalCarver(views, Volume(CheckedGrid(views, box, options)), options, factory) {}
+
+IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
+                                     Volume start,
+                                     const CarveOptions& options,
+                                     const VisibilityFactory& factory)
     : views_(views),
-      volume_(InitialVolume(views, box, options, &visual_hull_)),
+      volume_(WithVisualHull(views, std::move(start), options, &visual_hull_)),
       visibility_(factory ? factory(views, volume_) : MakeVisibility(views, volume_, options)),
-      test_(options.consistency, options.threshold, options.min_views),
+      test_(options.consistency, options.threshold, options.min_views, options.adaptive_threshold),
+      order_(options.order),
       queued_((volume_.grid().num_voxels() + 63) / 64, 0) {
   std::string reason;
-  CHECK(CheckCarveFits(views, box, options, &reason)) << reason;
+  CHECK(options.IsValid(&reason)) << reason;
   for (int64_t voxel : volume_.SurfaceVoxels()) Enqueue(voxel);
-  max_queue_ = queue_.size();
+  max_queue_ = queue_size();
 }
 
 void IncrementalCarver::Enqueue(int64_t voxel) {
   uint64_t& word = queued_[voxel >> 6];
   const uint64_t bit = uint64_t{1} << (voxel & 63);
-  if (word & bit) return;
+  if (order_ == CarveOrder::kFifo) {
+    if (word & bit) return;
+    word |= bit;
+    queue_.push_back(voxel);
+    return;
+  }
+  // Queued again with its new count; the older entry is skipped when it comes up.
   word |= bit;
-  queue_.push_back(voxel);
+  heap_.emplace(visibility_->CountVis(voxel), voxel);
+}
+
+bool IncrementalCarver::Pop(int64_t* voxel) {
+  while (true) {
+    if (order_ == CarveOrder::kFifo) {
+      if (queue_.empty()) return false;
+      *voxel = queue_.front();
+      queue_.pop_front();
+    } else {
+      if (heap_.empty()) return false;
+      *voxel = heap_.top().second;
+      heap_.pop();
+    }
+    uint64_t& word = queued_[*voxel >> 6];
+    const uint64_t bit = uint64_t{1} << (*voxel & 63);
+    if (!(word & bit)) continue;  // an older entry of a voxel already handed out
+    word &= ~bit;
+    return true;
+  }
 }
 
 Consistency IncrementalCarver::Evaluate(int64_t voxel) {
@@ -192,16 +259,14 @@ Consistency IncrementalCarver::Evaluate(int64_t voxel) {
 }
 
 bool IncrementalCarver::Step() {
-  if (queue_.empty()) {
+  int64_t voxel = 0;
+  if (!Pop(&voxel)) {
     if (!visibility_->StartPass()) return false;
     ++passes_;
-    for (int64_t voxel : volume_.SurfaceVoxels()) Enqueue(voxel);
-    max_queue_ = std::max(max_queue_, queue_.size());
-    if (queue_.empty()) return false;
+    for (int64_t surface : volume_.SurfaceVoxels()) Enqueue(surface);
+    max_queue_ = std::max(max_queue_, queue_size());
+    if (!Pop(&voxel)) return false;
   }
-  const int64_t voxel = queue_.front();
-  queue_.pop_front();
-  queued_[voxel >> 6] &= ~(uint64_t{1} << (voxel & 63));
   if (!volume_.IsSolid(voxel)) return true;
   ++evaluated_;
   if (Evaluate(voxel).consistent) return true;
@@ -209,9 +274,14 @@ bool IncrementalCarver::Step() {
   changed_.clear();
   volume_.Carve(voxel, &exposed_);
   visibility_->UpdateAfterCarve(voxel, vis_, exposed_, &changed_);
+  if (order_ != CarveOrder::kFifo) {
+    // One entry per voxel, with its count after every ray has arrived.
+    std::sort(changed_.begin(), changed_.end());
+    changed_.erase(std::unique(changed_.begin(), changed_.end()), changed_.end());
+  }
   for (int64_t next : changed_) Enqueue(next);
   ++carved_;
-  max_queue_ = std::max(max_queue_, queue_.size());
+  max_queue_ = std::max(max_queue_, queue_size());
   return true;
 }
 
@@ -230,8 +300,9 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
 }
 
 size_t IncrementalCarver::MemoryBytes() const {
+  const size_t entry = order_ == CarveOrder::kFifo ? sizeof(int64_t) : 2 * sizeof(int64_t);
   return volume_.MemoryBytes() + visibility_->MemoryBytes() + queued_.size() * sizeof(uint64_t) +
-         max_queue_ * sizeof(int64_t);
+         max_queue_ * entry;
 }
 
 CarveResult CarveVolume(const std::vector<CalibratedView>& views,
@@ -239,63 +310,105 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
                         const CarveOptions& options,
                         const std::function<void(const CarveProgress&)>& progress,
                         double progress_interval_seconds) {
-  const Clock::time_point setup_start = Clock::now();
-  IncrementalCarver carver(views, box, options);
-  CarveStatistics statistics;
-  statistics.visibility = carver.visibility().Name();
-  if (options.method == CarveMethod::kRay) {
-    statistics.visibility += " (" + VisLookupToString(options.vis_lookup) + ")";
-  }
-  statistics.dimensions = carver.volume().grid().dimensions();
-  statistics.voxel_size = carver.volume().grid().voxel_size();
-  statistics.num_voxels = carver.volume().grid().num_voxels();
-  statistics.initial_surface = carver.volume().num_surface();
-  statistics.views_with_masks = carver.visual_hull().views_with_masks;
-  statistics.visual_hull_carved = carver.visual_hull().carved;
-  statistics.visual_hull_seconds = carver.visual_hull().seconds;
-  statistics.setup_seconds = SecondsSince(setup_start);
+  std::string reason;
+  CHECK(CheckCarveFits(views, box, options, &reason)) << reason;
+  std::vector<int> resolutions;
+  CHECK(LevelResolutions(options.resolution, options.lod_levels, &resolutions, &reason)) << reason;
+  const int num_levels = static_cast<int>(resolutions.size());
+  const VoxelGrid final_grid(box, options.resolution);
 
-  const Clock::time_point start = Clock::now();
-  auto sample = [&](double seconds) {
-    statistics.curve.push_back({seconds, carver.carved(), carver.evaluated()});
-  };
-  sample(0.0);
+  CarveStatistics statistics;
+  Clock::time_point start;  // when the first level's carving began
   double next_report = progress_interval_seconds;
   double next_sample = 0.0;
-  for (int64_t steps = 1; carver.Step(); ++steps) {
-    if ((steps & 1023) != 0) continue;
-    const double seconds = SecondsSince(start);
-    if (seconds >= next_sample) {
-      sample(seconds);
-      next_sample = seconds + 0.05;
+  int64_t hull_carved = 0;  // the first level's visual hull, in final voxels
+  std::unique_ptr<IncrementalCarver> carver;
+  for (int level = 0; level < num_levels; ++level) {
+    const Clock::time_point level_start = Clock::now();
+    CarveOptions level_options = options;
+    level_options.resolution = resolutions[level];
+    level_options.lod_levels = 1;
+    // Coarse voxels cover many pixels, so scanning their footprints costs far more than their
+    // Vis: coarse levels find Vis(V) through ray lists.
+    if (level + 1 < num_levels) level_options.vis_lookup = VisLookup::kRayLists;
+    if (level == 0) {
+      carver = std::make_unique<IncrementalCarver>(views, box, level_options);
+    } else {
+      Volume start_volume =
+          RefineVolume(carver->volume(), VoxelGrid(box, resolutions[level]), options.lod_band);
+      carver.reset();  // the coarse level's rays and queue go before the fine level's come
+      carver = std::make_unique<IncrementalCarver>(views, std::move(start_volume), level_options);
     }
-    if (progress && seconds >= next_report) {
-      progress({carver.evaluated(), carver.carved(), static_cast<int64_t>(carver.queue_size()),
-                seconds});
-      next_report = seconds + progress_interval_seconds;
+    // A voxel of this level holds `scale` final voxels (up to the grid's edge).
+    const int64_t scale = int64_t{1} << (3 * (num_levels - 1 - level));
+    LevelStatistics level_statistics;
+    level_statistics.resolution = resolutions[level];
+    level_statistics.dimensions = carver->volume().grid().dimensions();
+    level_statistics.start_solid = carver->volume().num_solid();
+    if (level == 0) {
+      statistics.visibility = carver->visibility().Name();
+      if (options.method == CarveMethod::kRay) {
+        statistics.visibility += " (" + VisLookupToString(options.vis_lookup) + ")";
+      }
+      statistics.initial_surface = carver->volume().num_surface();
+      statistics.views_with_masks = carver->visual_hull().views_with_masks;
+      statistics.visual_hull_carved = carver->visual_hull().carved;
+      statistics.visual_hull_seconds = carver->visual_hull().seconds;
+      statistics.setup_seconds = SecondsSince(level_start);
+      hull_carved = std::min(final_grid.num_voxels(), carver->visual_hull().carved * scale);
+      start = Clock::now();
     }
+    auto sample = [&](double seconds) {
+      const int64_t removed = std::max<int64_t>(
+          0, final_grid.num_voxels() - std::min(final_grid.num_voxels(),
+                                                carver->volume().num_solid() * scale));
+      statistics.curve.push_back({seconds, std::max<int64_t>(0, removed - hull_carved),
+                                  statistics.evaluated + carver->evaluated()});
+    };
+    sample(SecondsSince(start));
+    for (int64_t steps = 1; carver->Step(); ++steps) {
+      if ((steps & 1023) != 0) continue;
+      const double seconds = SecondsSince(start);
+      if (seconds >= next_sample) {
+        sample(seconds);
+        next_sample = seconds + 0.05;
+      }
+      if (progress && seconds >= next_report) {
+        progress({level, num_levels, statistics.evaluated + carver->evaluated(), carver->carved(),
+                  static_cast<int64_t>(carver->queue_size()), seconds});
+        next_report = seconds + progress_interval_seconds;
+      }
+    }
+    sample(SecondsSince(start));
+    level_statistics.carved = carver->carved() + carver->visual_hull().carved;
+    level_statistics.evaluated = carver->evaluated();
+    level_statistics.final_solid = carver->volume().num_solid();
+    level_statistics.seconds = SecondsSince(level_start);
+    statistics.levels.push_back(level_statistics);
+    statistics.evaluated += carver->evaluated();
+    statistics.passes = std::max(statistics.passes, carver->passes());
+    statistics.peak_memory_bytes = std::max(statistics.peak_memory_bytes, carver->MemoryBytes());
   }
   statistics.carve_seconds = SecondsSince(start);
-  sample(statistics.carve_seconds);
-  statistics.carved = carver.carved() + statistics.visual_hull_carved;
-  statistics.evaluated = carver.evaluated();
-  statistics.passes = carver.passes();
-  statistics.peak_memory_bytes = carver.MemoryBytes();
+  statistics.dimensions = carver->volume().grid().dimensions();
+  statistics.voxel_size = carver->volume().grid().voxel_size();
+  statistics.num_voxels = carver->volume().grid().num_voxels();
+  statistics.carved = statistics.num_voxels - carver->volume().num_solid();
 
   const Clock::time_point colour_start = Clock::now();
-  CarveResult result{carver.volume().grid()};
-  result.surface = carver.ColourSurface();
+  CarveResult result{carver->volume().grid()};
+  result.surface = carver->ColourSurface();
   for (const ColouredVoxel& voxel : result.surface) {
     if (voxel.num_pixels > 0) ++statistics.visible_surface;
   }
   statistics.colour_seconds = SecondsSince(colour_start);
-  statistics.final_surface = carver.volume().num_surface();
-  statistics.final_solid = carver.volume().num_solid();
-  result.volume = std::move(*carver.mutable_volume());
+  statistics.final_surface = carver->volume().num_surface();
+  statistics.final_solid = carver->volume().num_solid();
+  result.volume = std::move(*carver->mutable_volume());
   result.statistics = std::move(statistics);
   if (progress) {
-    progress({result.statistics.evaluated, result.statistics.carved, 0,
-              result.statistics.carve_seconds});
+    progress({num_levels - 1, num_levels, result.statistics.evaluated, result.statistics.carved,
+              0, result.statistics.carve_seconds});
   }
   return result;
 }

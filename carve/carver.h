@@ -4,13 +4,16 @@
 #include <deque>
 #include <functional>
 #include <memory>
+#include <queue>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
 
 #include "calib/calibrated_view.h"
 #include "carve/consistency.h"
+#include "carve/level_of_detail.h"
 #include "carve/ray_cast_visibility.h"
 #include "carve/visual_hull.h"
 #include "carve/volume.h"
@@ -27,6 +30,14 @@ enum class CarveMethod {
 std::string CarveMethodToString(CarveMethod method);
 bool CarveMethodFromString(const std::string& text, CarveMethod* method);
 
+// The order in which the CVSVL hands out voxels (the seed paper's section 4).
+enum class CarveOrder {
+  kFifo,           // first in, first out
+  kVisiblePixels,  // most visible pixels first: most evidence first
+};
+std::string CarveOrderToString(CarveOrder order);
+bool CarveOrderFromString(const std::string& text, CarveOrder* order);
+
 // Incremental voxel colouring with ray-cast visibility (Batchelor, Mukundan, Green).
 struct CarveOptions {
   CarveMethod method = CarveMethod::kRay;
@@ -37,6 +48,9 @@ struct CarveOptions {
   // Largest consistent error, in RGB units (0-255). Negative: nothing is consistent, so every
   // voxel seen by min_views views is carved.
   double threshold = 30.0;
+  // Adaptive allowance: the threshold grows by this times the voxel's within-view colour spread
+  // (see ConsistencyTest); 0 holds every voxel to `threshold`.
+  double adaptive_threshold = 0.0;
   // Views a voxel must be seen by to be judged; voxels seen by fewer stay.
   int min_views = 2;
   // Refuse a grid whose carving structures would need more memory than this (GiB).
@@ -47,11 +61,19 @@ struct CarveOptions {
   // When views carry masks: carve the silhouettes' visual hull before colouring (background
   // pixels are always left out of Vis(V) and consistency).
   bool visual_hull = true;
+  CarveOrder order = CarveOrder::kFifo;
+  // Levels of detail (Prock and Dyer): 1 carves at `resolution` directly; L > 1 carves at
+  // resolution / 2^(L-1) first, then augments by lod_band voxels, subdivides and carves again, up
+  // to `resolution` (which must be divisible by 2^(L-1)).
+  int lod_levels = 1;
+  int lod_band = 1;
 
   bool IsValid(std::string* reason) const;
 };
 
 struct CarveProgress {
+  int level = 0;   // with levels of detail: the level carving now, 0 the coarsest
+  int levels = 1;
   int64_t evaluated = 0;
   int64_t carved = 0;
   int64_t queued = 0;
@@ -61,6 +83,9 @@ struct CarveProgress {
 // One point of the carving curve (the paper's Figure 6).
 struct CurveSample {
   double seconds = 0.0;
+  // Voxels carved so far, besides the visual hull's. With levels of detail, in voxels of the
+  // final resolution (a coarse voxel counts for the fine voxels it holds), so that the curve
+  // steps back where a refinement's band puts voxels back.
   int64_t carved = 0;
   int64_t evaluated = 0;
 };
@@ -77,14 +102,17 @@ struct CarveStatistics {
   int64_t initial_surface = 0;
   int64_t final_surface = 0;
   int64_t final_solid = 0;
-  int64_t carved = 0;
-  int64_t evaluated = 0;
+  int64_t carved = 0;     // voxels removed: the grid's voxels less the final solid ones
+  int64_t evaluated = 0;  // evaluations, over every level
   int64_t visible_surface = 0;  // final surface voxels seen by at least one pixel
   double setup_seconds = 0.0;   // volume and rays
-  double carve_seconds = 0.0;   // the carving loop: the convergence time
+  // The carving loops: the convergence time. With levels of detail, everything after the first
+  // level's set-up (refinements and later set-ups too).
+  double carve_seconds = 0.0;
   double colour_seconds = 0.0;  // colouring the final surface
   size_t peak_memory_bytes = 0;  // volume, visibility structures and the CVSVL
   std::vector<CurveSample> curve;
+  std::vector<LevelStatistics> levels;  // one per level of detail (one without)
 
   std::string Summary() const;
 };
@@ -119,6 +147,12 @@ class IncrementalCarver {
                     const Eigen::AlignedBox3d& box,
                     const CarveOptions& options,
                     const VisibilityFactory& factory = {});
+  // Starts from `start` instead of the full grid (options.resolution is not used; the visual
+  // hull, when asked, is carved from `start`).
+  IncrementalCarver(const std::vector<CalibratedView>& views,
+                    Volume start,
+                    const CarveOptions& options,
+                    const VisibilityFactory& factory = {});
 
   // Takes the next voxel from the CVSVL and evaluates it if still solid: computes Vis(V) and its
   // consistency; if inconsistent, carves it, updates the surface and the rays of Vis(V), and
@@ -137,12 +171,14 @@ class IncrementalCarver {
   int passes() const { return passes_; }
   int64_t evaluated() const { return evaluated_; }
   int64_t carved() const { return carved_; }
-  size_t queue_size() const { return queue_.size(); }
+  size_t queue_size() const { return queue_.size() + heap_.size(); }
   // Volume, visibility structures and the CVSVL at its largest so far.
   size_t MemoryBytes() const;
 
  private:
   void Enqueue(int64_t voxel);
+  // The next voxel to evaluate, or false when the CVSVL is empty.
+  bool Pop(int64_t* voxel);
   // Vis(V) into vis_ and its consistency.
   Consistency Evaluate(int64_t voxel);
 
@@ -151,7 +187,9 @@ class IncrementalCarver {
   Volume volume_;
   std::unique_ptr<Visibility> visibility_;
   ConsistencyTest test_;
-  std::deque<int64_t> queue_;
+  CarveOrder order_;
+  std::deque<int64_t> queue_;                             // first in, first out
+  std::priority_queue<std::pair<int64_t, int64_t>> heap_;  // (|Vis|, voxel), most first
   std::vector<uint64_t> queued_;
   size_t max_queue_ = 0;
   int64_t evaluated_ = 0;

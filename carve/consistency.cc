@@ -45,8 +45,28 @@ std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod m
   return std::make_unique<PooledStandardDeviation>();
 }
 
-ConsistencyTest::ConsistencyTest(ConsistencyMethod method, double threshold, int min_views)
-    : function_(MakeConsistencyFunction(method)), threshold_(threshold), min_views_(min_views) {}
+ConsistencyTest::ConsistencyTest(ConsistencyMethod method,
+                                 double threshold,
+                                 int min_views,
+                                 double adaptive)
+    : function_(MakeConsistencyFunction(method)),
+      threshold_(threshold),
+      min_views_(min_views),
+      adaptive_(adaptive) {}
+
+double ConsistencyTest::WithinViewSpread(const std::vector<ViewColourStats>& views) {
+  double weighted = 0.0;
+  int pixels = 0;
+  for (const ViewColourStats& view : views) {
+    if (view.count == 0) continue;
+    const Eigen::Vector3d mean = view.sum / view.count;
+    const Eigen::Vector3d variance =
+        (view.sum_squares / view.count - mean.cwiseProduct(mean)).cwiseMax(0.0);
+    weighted += view.count * std::sqrt(variance.sum());
+    pixels += view.count;
+  }
+  return pixels == 0 ? 0.0 : weighted / pixels;
+}
 
 Consistency ConsistencyTest::Evaluate(const std::vector<ViewColourStats>& views) const {
   Consistency result;
@@ -62,7 +82,9 @@ Consistency ConsistencyTest::Evaluate(const std::vector<ViewColourStats>& views)
   if (result.num_views < min_views_) return result;
   result.judged = true;
   result.error = function_->Error(views, result.colour, result.num_pixels);
-  result.consistent = result.error <= threshold_;
+  result.threshold = threshold_;
+  if (adaptive_ != 0.0) result.threshold += adaptive_ * WithinViewSpread(views);
+  result.consistent = result.error <= result.threshold;
   return result;
 }
 

@@ -34,6 +34,7 @@ struct Consistency {
   bool judged = false;      // seen by at least min_views views; otherwise kept unjudged
   bool consistent = true;   // false: carve
   double error = 0.0;       // the method's error (RGB units, 0-255)
+  double threshold = 0.0;   // the threshold it was held to (with the adaptive allowance)
   Eigen::Vector3d colour = Eigen::Vector3d::Zero();  // the voxel's colour: pixel-weighted mean
   int num_views = 0;
   int num_pixels = 0;
@@ -72,16 +73,28 @@ class PooledStandardDeviation : public ConsistencyFunction {
 std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod method);
 
 // Decides whether a voxel's visible pixels agree on one colour: inconsistent when the function's
-// error exceeds `threshold`; a voxel seen by fewer than `min_views` views is not judged and stays.
+// error exceeds `threshold` + `adaptive` x the voxel's within-view spread; a voxel seen by fewer
+// than `min_views` views is not judged and stays.
+//
+// The within-view spread is the pixel-weighted mean over views of each view's RGB standard
+// deviation (the Euclidean norm of the per-channel deviations). A voxel on a texture edge shows
+// both colours within each view, so its per-view means differ with the viewpoint even on the true
+// surface; the allowance grows with that spread (Slabaugh et al.'s adaptive threshold), while a
+// voxel whose views each see one uniform but different colour (empty space in front of a
+// background) gets none.
 class ConsistencyTest {
  public:
-  ConsistencyTest(ConsistencyMethod method, double threshold, int min_views);
+  ConsistencyTest(ConsistencyMethod method, double threshold, int min_views, double adaptive = 0.0);
   Consistency Evaluate(const std::vector<ViewColourStats>& views) const;
+
+  // The within-view spread of `views` (RGB units; 0 without pixels).
+  static double WithinViewSpread(const std::vector<ViewColourStats>& views);
 
  private:
   std::unique_ptr<ConsistencyFunction> function_;
   double threshold_;
   int min_views_;
+  double adaptive_;
 };
 
 }  // namespace raycarve

@@ -1,6 +1,7 @@
 #include "carve/ray_cast_visibility.h"
 
 #include <algorithm>
+#include <cstdint>
 
 #include <glog/logging.h>
 
@@ -24,7 +25,8 @@ bool VisLookupFromString(const std::string& text, VisLookup* lookup) {
 
 RayCastVisibility::RayCastVisibility(const std::vector<CalibratedView>& views,
                                      const Volume& volume,
-                                     VisLookup lookup)
+                                     VisLookup lookup,
+                                     bool count_rays)
     : views_(views), volume_(volume), lookup_(lookup) {
   rays_.reserve(views.size());
   int64_t total = 0;
@@ -39,6 +41,15 @@ RayCastVisibility::RayCastVisibility(const std::vector<CalibratedView>& views,
     rays_.back().Initialise(volume);
     view_offset_.push_back(static_cast<int32_t>(total));
     total += static_cast<int64_t>(view.width) * view.height;
+  }
+  if (count_rays) {
+    counts_.assign(volume.grid().num_voxels(), 0);
+    for (const RayImage& rays : rays_) {
+      for (int pixel = 0; pixel < rays.num_pixels(); ++pixel) {
+        const int64_t current = rays.CurrentVoxel(pixel);
+        if (current != RayImage::kNoVoxel && counts_[current] != UINT16_MAX) ++counts_[current];
+      }
+    }
   }
   if (lookup_ != VisLookup::kRayLists) return;
   CHECK_LT(total, int64_t{1} << 31) << "too many rays for 32-bit ray lists";
@@ -90,16 +101,24 @@ void RayCastVisibility::UpdateAfterCarve(int64_t voxel,
                                          std::vector<int64_t>* changed) {
   // Vis(V) is every ray that ended in V, so V's list is consumed whole.
   if (lookup_ == VisLookup::kRayLists) head_[voxel] = -1;
+  if (!counts_.empty()) counts_[voxel] = 0;
   for (const PixelRef& ref : vis) {
     const int64_t next = rays_[ref.view].Advance(static_cast<int>(ref.pixel), volume_);
     if (next == RayImage::kNoVoxel) continue;
     changed->push_back(next);
+    if (!counts_.empty() && counts_[next] != UINT16_MAX) ++counts_[next];
     if (lookup_ == VisLookup::kRayLists) Link(view_offset_[ref.view] + ref.pixel, next);
   }
 }
 
+int64_t RayCastVisibility::CountVis(int64_t voxel) {
+  if (!counts_.empty()) return counts_[voxel];
+  return Visibility::CountVis(voxel);
+}
+
 size_t RayCastVisibility::MemoryBytes() const {
-  size_t bytes = (head_.capacity() + next_.capacity()) * sizeof(int32_t);
+  size_t bytes = (head_.capacity() + next_.capacity()) * sizeof(int32_t) +
+                 counts_.capacity() * sizeof(uint16_t);
   for (const RayImage& rays : rays_) bytes += rays.MemoryBytes();
   return bytes;
 }

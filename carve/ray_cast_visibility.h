@@ -26,10 +26,13 @@ bool VisLookupFromString(const std::string& text, VisLookup* lookup);
 // (view.valid == 0) or on background (view.mask == 0 when there is a mask) get no ray.
 class RayCastVisibility : public Visibility {
  public:
-  // `volume` must outlive this object; rays start at its first solid voxels.
+  // `volume` must outlive this object; rays start at its first solid voxels. With `count_rays`,
+  // a count per voxel of the rays ending in it is kept (2 bytes a voxel, saturating at 65535)
+  // so that CountVis costs nothing.
   RayCastVisibility(const std::vector<CalibratedView>& views,
                     const Volume& volume,
-                    VisLookup lookup = VisLookup::kFootprint);
+                    VisLookup lookup = VisLookup::kFootprint,
+                    bool count_rays = false);
 
   std::string Name() const override { return "ray"; }
   void ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels) override;
@@ -37,6 +40,7 @@ class RayCastVisibility : public Visibility {
                         const std::vector<PixelRef>& vis,
                         const std::vector<int64_t>& newly_exposed,
                         std::vector<int64_t>* changed) override;
+  int64_t CountVis(int64_t voxel) override;
   size_t MemoryBytes() const override;
 
   const RayImage& rays(int view) const { return rays_[view]; }
@@ -55,6 +59,7 @@ class RayCastVisibility : public Visibility {
   std::vector<int32_t> view_offset_;
   std::vector<int32_t> head_;  // per voxel: a ray ending in it, or -1
   std::vector<int32_t> next_;  // per ray: the next ray ending in the same voxel, or -1
+  std::vector<uint16_t> counts_;  // per voxel, with count_rays: rays ending in it
 };
 
 }  // namespace raycarve

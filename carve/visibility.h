@@ -34,6 +34,14 @@ class Visibility {
                                 const std::vector<int64_t>& newly_exposed,
                                 std::vector<int64_t>* changed) = 0;
 
+  // |Vis(V)|, for ordering the CVSVL by evidence. The default computes Vis(V); a method may
+  // keep counts instead.
+  virtual int64_t CountVis(int64_t voxel) {
+    scratch_.clear();
+    ComputeVis(voxel, &scratch_);
+    return static_cast<int64_t>(scratch_.size());
+  }
+
   // Called when the CVSVL has run empty. An incremental method (ray casting, GVC-LDI) has
   // nothing left to learn and returns false: the carving has converged. A pass-based method
   // (GVC) refreshes its structures and returns true when anything was carved since its last
@@ -42,6 +50,9 @@ class Visibility {
 
   // Bytes held by the method's structures.
   virtual size_t MemoryBytes() const = 0;
+
+ private:
+  std::vector<PixelRef> scratch_;
 };
 
 }  // namespace raycarve

@@ -32,6 +32,21 @@ Volume::Volume(const VoxelGrid& grid) : grid_(grid) {
   }
 }
 
+Volume::Volume(const VoxelGrid& grid, std::vector<uint64_t> solid)
+    : grid_(grid), solid_(std::move(solid)) {
+  CHECK_EQ(static_cast<int64_t>(solid_.size()), (grid.num_voxels() + 63) / 64);
+  const int64_t tail = grid.num_voxels() & 63;
+  if (tail != 0) solid_.back() &= (uint64_t{1} << tail) - 1;
+  surface_.assign(solid_.size(), 0);
+  for (const uint64_t word : solid_) num_solid_ += __builtin_popcountll(word);
+  for (int64_t index = 0; index < grid.num_voxels(); ++index) {
+    if (IsExposed(index)) {
+      Set(&surface_, index);
+      ++num_surface_;
+    }
+  }
+}
+
 bool Volume::IsExposed(int64_t index) const {
   if (!IsSolid(index)) return false;
   const Eigen::Vector3i voxel = grid_.Voxel(index);

@@ -13,6 +13,9 @@ namespace raycarve {
 class Volume {
  public:
   explicit Volume(const VoxelGrid& grid);
+  // A volume whose solid voxels are `solid` (a bit per voxel in index order, as many words as
+  // the grid needs: CHECKed); the surface is computed from it.
+  Volume(const VoxelGrid& grid, std::vector<uint64_t> solid);
 
   const VoxelGrid& grid() const { return grid_; }
 
@@ -35,6 +38,9 @@ class Volume {
   // Whether a solid voxel has an empty 6-neighbour or lies on the border (the definition,
   // computed from the solid set; used to check the incremental surface).
   bool IsExposed(int64_t index) const;
+
+  // The solid bits, a bit per voxel in index order.
+  const std::vector<uint64_t>& solid_bits() const { return solid_; }
 
   size_t MemoryBytes() const { return (solid_.size() + surface_.size()) * sizeof(uint64_t); }
 

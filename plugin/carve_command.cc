@@ -67,7 +67,11 @@ CarveRun CarveProject(const CarveRequest& request) {
             << views.size() << " views, " << ConsistencyMethodToString(request.options.consistency)
             << " threshold " << request.options.threshold;
   auto progress = [](const CarveProgress& p) {
-    LOG(INFO) << "carving " << std::fixed << std::setprecision(1) << p.seconds << " s: evaluated "
+    LOG(INFO) << "carving "
+              << (p.levels > 1 ? "level " + std::to_string(p.level + 1) + "/" +
+                                     std::to_string(p.levels) + " "
+                               : std::string())
+              << std::fixed << std::setprecision(1) << p.seconds << " s: evaluated "
               << p.evaluated << ", carved " << p.carved << ", queue " << p.queued << ", "
               << static_cast<int64_t>(p.seconds > 0 ? p.evaluated / p.seconds : 0)
               << " evaluations/s";
@@ -125,7 +129,11 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("resolution").Value(request.options.resolution)
       .Key("consistency").Value(ConsistencyMethodToString(request.options.consistency))
       .Key("threshold").Value(request.options.threshold)
+      .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
       .Key("min_views").Value(request.options.min_views)
+      .Key("order").Value(CarveOrderToString(request.options.order))
+      .Key("lod_levels").Value(request.options.lod_levels)
+      .Key("lod_band").Value(request.options.lod_band)
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
       .Key("max_memory_gib").Value(request.options.max_memory_gib)
       .Key("mask_path").Value(request.view_options.mask_path)
@@ -160,6 +168,21 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("convergence_seconds").Value(s.carve_seconds)
       .Key("peak_memory_bytes").Value(static_cast<uint64_t>(s.peak_memory_bytes))
       .EndObject();
+  json.Key("levels").BeginArray();
+  for (const LevelStatistics& level : s.levels) {
+    json.BeginObject()
+        .Key("resolution").Value(level.resolution)
+        .Key("grid").Value(std::vector<double>{static_cast<double>(level.dimensions.x()),
+                                                static_cast<double>(level.dimensions.y()),
+                                                static_cast<double>(level.dimensions.z())})
+        .Key("start_solid").Value(level.start_solid)
+        .Key("carved").Value(level.carved)
+        .Key("evaluated").Value(level.evaluated)
+        .Key("final_solid").Value(level.final_solid)
+        .Key("seconds").Value(level.seconds)
+        .EndObject();
+  }
+  json.EndArray();
   json.Key("stage_seconds").BeginObject();
   for (const auto& [name, seconds] : run.stage_seconds) json.Key(name).Value(seconds);
   json.EndObject();
@@ -178,6 +201,7 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   text->consistency = ConsistencyMethodToString(request->options.consistency);
   text->vis_lookup = VisLookupToString(request->options.vis_lookup);
   text->method = CarveMethodToString(request->options.method);
+  text->order = CarveOrderToString(request->options.order);
   parser->AddDefault("workspace_path", &request->workspace_path,
                      "COLMAP project (sparse/0 or sparse or dense/sparse, with images/)");
   parser->AddDefault("input_path", &request->input_path, "model folder, overriding the workspace's");
@@ -194,12 +218,24 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      {"mean_colour", "standard_deviation"});
   parser->AddDefault("threshold", &request->options.threshold,
                      "largest consistent error, RGB units 0-255");
+  parser->AddDefault("adaptive_threshold", &request->options.adaptive_threshold,
+                     "raise the threshold by this times the voxel's within-view colour spread "
+                     "(texture edges); 0: a fixed threshold");
   parser->AddDefault("min_views", &request->options.min_views,
                      "views a voxel must be seen by to be judged");
   parser->AddDefault("vis_lookup", &text->vis_lookup,
                      "how Vis(V) finds its rays: the paper's footprint scan, or per-voxel ray "
                      "lists (same result, more memory)",
                      {"footprint", "ray_lists"});
+  parser->AddDefault("order", &text->order,
+                     "order of the voxels to judge: first in first out, or most visible pixels "
+                     "first",
+                     {"fifo", "visible_pixels"});
+  parser->AddDefault("lod_levels", &request->options.lod_levels,
+                     "levels of detail: carve at resolution / 2^(L-1) first, then refine (the "
+                     "resolution must be divisible by 2^(L-1)); 1: no levels");
+  parser->AddDefault("lod_band", &request->options.lod_band,
+                     "voxels put back around what survived a coarse level before refining");
   parser->AddDefault("max_memory_gib", &request->options.max_memory_gib,
                      "refuse grids whose carving structures would need more (GiB)");
   parser->AddDefault("skip_missing_images", &request->view_options.skip_missing_images,
@@ -222,6 +258,7 @@ void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
   ConsistencyMethodFromString(text.consistency, &request->options.consistency);
   VisLookupFromString(text.vis_lookup, &request->options.vis_lookup);
   CarveMethodFromString(text.method, &request->options.method);
+  CarveOrderFromString(text.order, &request->options.order);
   request->view_options.background.mode =
       ParseBackground(text.background, &request->view_options.background.colour);
   request->background = text.background;

@@ -106,6 +106,7 @@ struct CarveFlagText {
   std::string consistency;
   std::string vis_lookup;
   std::string method;
+  std::string order;
   std::string background = "auto";
 };
 void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* text);

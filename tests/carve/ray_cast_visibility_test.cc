@@ -64,6 +64,38 @@ TEST_P(RayCastVisibilityTest, VisAndRaysMatchABruteForceNearestVoxelSearchAfterR
   EXPECT_GT(carved, 300);
 }
 
+TEST(RayCastVisibility, KeptCountsEqualTheSizeOfVisAfterRandomCarvings) {
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(4, 64, 48));
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  Volume volume(VoxelGrid(scene.object_box, 12));
+  RayCastVisibility counted(views, volume, VisLookup::kFootprint, /*count_rays=*/true);
+  RayCastVisibility plain(views, volume);
+  std::mt19937 random(17);
+  std::vector<PixelRef> vis;
+  std::vector<int64_t> exposed, changed;
+  int checked = 0;
+  for (int round = 0; round < 3; ++round) {
+    for (int64_t voxel : volume.SurfaceVoxels()) {
+      if (random() % 3 != 0) continue;
+      vis.clear();
+      counted.ComputeVis(voxel, &vis);
+      exposed.clear();
+      changed.clear();
+      volume.Carve(voxel, &exposed);
+      counted.UpdateAfterCarve(voxel, vis, exposed, &changed);
+      plain.UpdateAfterCarve(voxel, vis, exposed, &changed);
+    }
+    for (int64_t voxel : volume.SurfaceVoxels()) {
+      vis.clear();
+      plain.ComputeVis(voxel, &vis);
+      ASSERT_EQ(counted.CountVis(voxel), static_cast<int64_t>(vis.size())) << voxel;
+      ASSERT_EQ(plain.CountVis(voxel), static_cast<int64_t>(vis.size())) << voxel;
+      checked += !vis.empty();
+    }
+  }
+  EXPECT_GT(checked, 300);
+}
+
 INSTANTIATE_TEST_SUITE_P(BothLookups,
                          RayCastVisibilityTest,
                          ::testing::Values(VisLookup::kFootprint, VisLookup::kRayLists),

@@ -347,12 +347,55 @@ TEST_F(CommandLine, HoldoutScoresRendersOfLeftOutViews) {
                   {"--every must be at least 2"});
 }
 
+TEST_F(CommandLine, BenchmarkComparesTheThreeMethodsInATableAPlotAndJson) {
+  const std::string out = *root_ + "/benchmark";
+  std::string output;
+  ASSERT_EQ(Run("benchmark --workspace_path " + Project() + " --output_path " + out +
+                    " --resolution 32 --reference " + Project() + "/truth.ply",
+                &output),
+            0)
+      << output;
+  for (const char* method : {"| ray (footprint) |", "| gvc_ldi |", "| gvc |", "ray vs gvc_ldi"}) {
+    EXPECT_NE(output.find(method), std::string::npos) << method << " not in:\n" << output;
+  }
+  const std::string report = testing::ReadFileBytes(out + "/benchmark/benchmark.json");
+  // The first agreement listed is ray casting against GVC-LDI: the same carving here.
+  EXPECT_EQ(JsonNumber(report, "iou"), 1.0) << report;
+  EXPECT_EQ(JsonNumber(report, "differing"), 0.0) << report;
+  // Measured 0.299 for ray casting: 4 views of 96x72 see little of a 32-voxel scene.
+  EXPECT_GT(JsonNumber(report, "completeness"), 0.2) << report;
+  const cv::Mat plot = cv::imread(out + "/benchmark/figure6.png");
+  ASSERT_FALSE(plot.empty());
+  EXPECT_EQ(plot.cols, 960);
+  EXPECT_EQ(plot.rows, 600);
+  for (const char* file : {"figure6.csv", "table.md", "cloud_ray.ply", "cloud_gvc.ply",
+                           "cloud_gvc_ldi.ply"}) {
+    EXPECT_TRUE(fs::is_regular_file(out + "/benchmark/" + file)) << file;
+  }
+  const std::string csv = testing::ReadFileBytes(out + "/benchmark/figure6.csv");
+  EXPECT_EQ(csv.rfind("method,seconds,carved,evaluated\n", 0), 0u);
+  EXPECT_NE(csv.find("\ngvc_ldi,"), std::string::npos);
+  ExpectUserError("benchmark --workspace_path " + Project() + " --output_path " + out +
+                      " --methods ray,zbuffer",
+                  {"--methods", "zbuffer"});
+  // carve takes the method too, and says which it used.
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + out +
+                    "/gvc --resolution 24 --method gvc",
+                &output),
+            0)
+      << output;
+  const std::string carve_report = testing::ReadFileBytes(out + "/gvc/report.json");
+  EXPECT_NE(carve_report.find("\"visibility\": \"gvc\""), std::string::npos) << carve_report;
+  EXPECT_GE(JsonNumber(carve_report, "passes"), 2.0);
+}
+
 TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
   const std::string base = "carve --workspace_path " + Project() + " --output_path " + *root_ + "/refused";
   ExpectUserError(base + " --resolution 0", {"resolution must be in [1, 4096]"});
   ExpectUserError(base + " --resolution 4000 --max_memory_gib 1", {"GiB", "lower the resolution"});
   ExpectUserError(base + " --threshold nan", {"threshold must be a finite number"});
   ExpectUserError(base + " --consistency median", {"not one of: mean_colour, standard_deviation"});
+  ExpectUserError(base + " --method zbuffer", {"not one of: ray, gvc, gvc_ldi"});
 }
 
 }  // namespace

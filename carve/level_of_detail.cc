@@ -1,0 +1,79 @@
+#include "carve/level_of_detail.h"
+
+#include <cmath>
+
+#include <glog/logging.h>
+
+namespace raycarve {
+namespace {
+
+// One step of a 3x3x3 dilation of a byte mask, done as three separable passes.
+void Dilate(const Eigen::Vector3i& n, std::vector<uint8_t>* mask) {
+  const int64_t stride[3] = {1, n.x(), static_cast<int64_t>(n.x()) * n.y()};
+  std::vector<uint8_t> source;
+  for (int axis = 0; axis < 3; ++axis) {
+    source = *mask;
+    for (int z = 0; z < n.z(); ++z) {
+      for (int y = 0; y < n.y(); ++y) {
+        for (int x = 0; x < n.x(); ++x) {
+          const int coordinate = axis == 0 ? x : (axis == 1 ? y : z);
+          const int64_t index = x + stride[1] * y + stride[2] * z;
+          uint8_t value = source[index];
+          if (coordinate > 0) value |= source[index - stride[axis]];
+          if (coordinate + 1 < n[axis]) value |= source[index + stride[axis]];
+          (*mask)[index] = value;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+bool LevelResolutions(int resolution, int levels, std::vector<int>* resolutions,
+                      std::string* reason) {
+  resolutions->clear();
+  if (levels < 1 || levels > 8) {
+    *reason = "lod_levels must be in [1, 8], got " + std::to_string(levels);
+    return false;
+  }
+  const int divisor = 1 << (levels - 1);
+  if (resolution % divisor != 0) {
+    *reason = "with lod_levels " + std::to_string(levels) + " the resolution must be divisible by " +
+              std::to_string(divisor) + ", got " + std::to_string(resolution);
+    return false;
+  }
+  if (levels > 1 && resolution / divisor < 4) {
+    *reason = "with lod_levels " + std::to_string(levels) + " the coarsest level would have " +
+              std::to_string(resolution / divisor) + " voxels along the longest axis (at least 4)";
+    return false;
+  }
+  for (int level = levels - 1; level >= 0; --level) resolutions->push_back(resolution >> level);
+  return true;
+}
+
+Volume RefineVolume(const Volume& coarse, const VoxelGrid& fine, int band) {
+  const VoxelGrid& grid = coarse.grid();
+  const Eigen::Vector3i& n = grid.dimensions();
+  CHECK_NEAR(fine.voxel_size() * 2.0, grid.voxel_size(), 1e-12 * grid.voxel_size());
+  CHECK((fine.origin() - grid.origin()).norm() <= 1e-9 * grid.voxel_size());
+  CHECK((fine.dimensions().array() <= 2 * n.array()).all());
+  std::vector<uint8_t> keep(grid.num_voxels());
+  for (int64_t index = 0; index < grid.num_voxels(); ++index) keep[index] = coarse.IsSolid(index);
+  for (int step = 0; step < band; ++step) Dilate(n, &keep);
+
+  const Eigen::Vector3i& m = fine.dimensions();
+  std::vector<uint64_t> solid((fine.num_voxels() + 63) / 64, 0);
+  for (int z = 0; z < m.z(); ++z) {
+    for (int y = 0; y < m.y(); ++y) {
+      const int64_t parent_row = grid.Index(Eigen::Vector3i(0, y / 2, z / 2));
+      const int64_t row = fine.Index(Eigen::Vector3i(0, y, z));
+      for (int x = 0; x < m.x(); ++x) {
+        if (keep[parent_row + x / 2]) solid[(row + x) >> 6] |= uint64_t{1} << ((row + x) & 63);
+      }
+    }
+  }
+  return Volume(fine, std::move(solid));
+}
+
+}  // namespace raycarve

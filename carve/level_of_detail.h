@@ -1,0 +1,40 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "carve/volume.h"
+#include "carve/voxel_grid.h"
+
+namespace raycarve {
+
+// Prock and Dyer's coarse-to-fine carving, as the seed paper applies it: carve at a coarse
+// resolution, augment what survived by a band of voxels (so that over-eager coarse carving can be
+// undone), split each voxel into 8 and carve again, up to the target resolution.
+
+// One level's figures.
+struct LevelStatistics {
+  int resolution = 0;
+  Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
+  int64_t start_solid = 0;  // solid voxels when the level began (after refinement and hull)
+  int64_t carved = 0;
+  int64_t evaluated = 0;
+  int64_t final_solid = 0;
+  double seconds = 0.0;  // set-up (rays) and carving
+};
+
+// The resolutions of `levels` levels ending at `resolution`, coarsest first, each half the next.
+// False, with a reason, when `resolution` is not divisible by 2^(levels - 1), when the coarsest
+// level would have fewer than 4 voxels along the longest axis, or when levels < 1.
+bool LevelResolutions(int resolution, int levels, std::vector<int>* resolutions,
+                      std::string* reason);
+
+// The next level's starting volume: every voxel of `fine` whose parent in `coarse` (the voxel
+// holding it, at half the resolution) lies within `band` coarse voxels (26-neighbourhood, band
+// steps) of a solid coarse voxel is solid. `fine` must have the coarse grid's origin and half its
+// voxel size, with at most twice its voxels along each axis (CHECKed; VoxelGrid gives this for
+// resolutions r and 2r over one box).
+Volume RefineVolume(const Volume& coarse, const VoxelGrid& fine, int band = 1);
+
+}  // namespace raycarve

@@ -36,7 +36,8 @@ CarveRun CarveProject(const CarveRequest& request) {
   Clock::time_point stage = Clock::now();
   const LoadedProject project =
       LoadProject("carve", request.workspace_path, request.input_path, request.image_path,
-                  request.output_path, request.bounds, request.view_options, /*min_images=*/2);
+                  request.output_path, request.bounds, request.view_options, /*min_images=*/2,
+                  request.model_index);
   run.model_path = project.model_path;
   run.image_path = project.image_path;
   run.output_path = project.output_path;
@@ -205,6 +206,9 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->AddDefault("workspace_path", &request->workspace_path,
                      "COLMAP project (sparse/0 or sparse or dense/sparse, with images/)");
   parser->AddDefault("input_path", &request->input_path, "model folder, overriding the workspace's");
+  parser->AddDefault("model_index", &request->model_index,
+                     "with several models in sparse/ (from colmap mapper): use sparse/<index>; "
+                     "-1: the one with the most registered images");
   parser->AddDefault("image_path", &request->image_path, "photo folder, overriding the workspace's");
   parser->AddDefault("output_path", &request->output_path,
                      "output folder (default <workspace>/raycarve)");

@@ -28,6 +28,7 @@ int RunCompare(int argc, char** argv);
 int RunCheckBackground(int argc, char** argv);
 int RunHoldout(int argc, char** argv);
 int RunBenchmark(int argc, char** argv);
+int RunSfm(int argc, char** argv);
 
 // Options shared by every command that bounds the volume.
 struct BoundsFlags {
@@ -70,7 +71,8 @@ LoadedProject LoadProject(const std::string& command,
                           const std::string& output_path,
                           const BoundsFlags& bounds_flags,
                           const ViewReaderOptions& view_options,
-                          int min_images);
+                          int min_images,
+                          int model_index = -1);
 
 // carve: everything `raycarve carve` takes, and what it produced.
 struct CarveRequest {
@@ -81,6 +83,7 @@ struct CarveRequest {
   CarveOptions options;
   BoundsFlags bounds;
   ViewReaderOptions view_options;
+  int model_index = -1;              // sparse/<index> among several models; -1: the largest
   std::string background = "auto";  // as given on the command line, for the report
   double progress_seconds = 2.0;     // between progress lines
 };

@@ -1,15 +1,48 @@
 #include <iostream>
+#include <map>
+#include <memory>
 
 #include "calib/input_error.h"
+#include "calib/model_reader.h"
 #include "export/point_cloud_compare.h"
+#include "export/similarity_alignment.h"
 #include "plugin/commands.h"
 #include "plugin/json_writer.h"
 
 namespace raycarve {
 
+namespace {
+
+// The similarity from `input_model`'s frame to `reference_model`'s, from the camera centres of
+// the images both hold (matched by name).
+exporter::Alignment AlignModels(const std::string& input_model, const std::string& reference_model) {
+  const Reconstruction input = ReadModel(input_model);
+  const Reconstruction reference = ReadModel(reference_model);
+  std::map<std::string, Eigen::Vector3d> reference_centres;
+  for (const auto& [id, image] : reference.images) {
+    reference_centres[image.name] = image.ProjectionCenter();
+  }
+  std::vector<Eigen::Vector3d> source, target;
+  for (const auto& [id, image] : input.images) {
+    const auto match = reference_centres.find(image.name);
+    if (match == reference_centres.end()) continue;
+    source.push_back(image.ProjectionCenter());
+    target.push_back(match->second);
+  }
+  if (source.size() < 3) {
+    throw InputError("raycarve compare: " + input_model + " and " + reference_model + " share " +
+                     std::to_string(source.size()) +
+                     " image names; aligning their frames needs at least 3");
+  }
+  return exporter::AlignPoints(source, target);
+}
+
+}  // namespace
+
 std::string ComparisonJson(const std::string& reference,
                            const std::string& input,
-                           const exporter::CloudComparison& c) {
+                           const exporter::CloudComparison& c,
+                           const exporter::Alignment* alignment) {
   JsonWriter json;
   json.BeginObject()
       .Key("reference").Value(reference)
@@ -23,13 +56,29 @@ std::string ComparisonJson(const std::string& reference,
       .Key("f_score").Value(c.f_score)
       .Key("mean_input_to_reference").Value(c.mean_reconstruction_to_reference)
       .Key("mean_reference_to_input").Value(c.mean_reference_to_reconstruction)
-      .Key("chamfer").Value(c.chamfer)
-      .EndObject();
+      .Key("chamfer").Value(c.chamfer);
+  if (alignment != nullptr) {
+    const exporter::Similarity3& t = alignment->transform;
+    std::vector<double> rotation;
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col) rotation.push_back(t.rotation(row, col));
+    }
+    json.Key("alignment").BeginObject()
+        .Key("scale").Value(t.scale)
+        .Key("rotation_row_major").Value(rotation)
+        .Key("translation").Value(JsonArray(t.translation))
+        .Key("pairs").Value(alignment->num_pairs)
+        .Key("inliers").Value(alignment->num_inliers)
+        .Key("rms").Value(alignment->rms)
+        .Key("rms_closed_form").Value(alignment->rms_before_refinement)
+        .EndObject();
+  }
+  json.EndObject();
   return json.str();
 }
 
 int RunCompare(int argc, char** argv) {
-  std::string reference, input, output_path;
+  std::string reference, input, output_path, input_model, reference_model;
   int mesh_samples = 500000;
   exporter::CompareOptions options;
   OptionParser parser(
@@ -38,7 +87,9 @@ int RunCompare(int argc, char** argv) {
       "both PLY point clouds or meshes (meshes are sampled over their surface): accuracy (the "
       "distance within which 90% of the input lies from the reference), completeness (share of "
       "the reference within --threshold of the input), precision, F-score and chamfer distance. "
-      "Both must be in the same frame.");
+      "Both must be in the same frame, or give --input_model and --reference_model: the input is "
+      "then moved by the similarity that takes the input model's camera centres onto the "
+      "reference model's (images matched by name; robust, refined with Ceres).");
   parser.AddRequired("reference", &reference, "reference PLY (points or mesh)");
   parser.AddRequired("input", &input, "reconstruction PLY (points or mesh)");
   parser.AddDefault("threshold", &options.threshold,
@@ -47,17 +98,31 @@ int RunCompare(int argc, char** argv) {
                     "share of the input that the accuracy distance covers");
   parser.AddDefault("mesh_samples", &mesh_samples, "points sampled on each mesh");
   parser.AddDefault("output_path", &output_path, "also write the JSON report to this file");
+  parser.AddDefault("input_model", &input_model,
+                    "COLMAP model the input was made from (e.g. COLMAP SfM's sparse/0)");
+  parser.AddDefault("reference_model", &reference_model,
+                    "COLMAP model in the reference's frame (e.g. the given calibration)");
   if (!parser.Parse(argc, argv)) return 0;
+  if (input_model.empty() != reference_model.empty()) {
+    throw InputError("raycarve compare: give both --input_model and --reference_model, or neither");
+  }
   std::string reason;
   if (!options.IsValid(&reason)) throw InputError("raycarve compare: " + reason);
   if (mesh_samples < 1) throw InputError("raycarve compare: --mesh_samples must be >= 1");
-  const exporter::CloudComparison comparison =
-      exporter::CompareClouds(exporter::ReadComparablePoints(reference, mesh_samples),
-                              exporter::ReadComparablePoints(input, mesh_samples), options);
-  const std::string json = ComparisonJson(reference, input, comparison);
-  std::cout << "compare " << input << " against " << reference << "\n  " << comparison.Summary()
-            << "\n"
-            << json;
+  std::vector<Eigen::Vector3f> input_points = exporter::ReadComparablePoints(input, mesh_samples);
+  std::unique_ptr<exporter::Alignment> alignment;
+  if (!input_model.empty()) {
+    alignment = std::make_unique<exporter::Alignment>(AlignModels(input_model, reference_model));
+    for (Eigen::Vector3f& point : input_points) {
+      point = alignment->transform(point.cast<double>()).cast<float>();
+    }
+  }
+  const exporter::CloudComparison comparison = exporter::CompareClouds(
+      exporter::ReadComparablePoints(reference, mesh_samples), input_points, options);
+  const std::string json = ComparisonJson(reference, input, comparison, alignment.get());
+  std::cout << "compare " << input << " against " << reference << "\n";
+  if (alignment) std::cout << "  aligned: " << alignment->Summary() << "\n";
+  std::cout << "  " << comparison.Summary() << "\n" << json;
   if (!output_path.empty()) {
     CheckOutputDoesNotOverwrite(output_path, reference, "reference");
     CheckOutputDoesNotOverwrite(output_path, input, "input");

@@ -24,6 +24,8 @@ const Command kCommands[] = {
      "turn a Middlebury *_par.txt calibration into a COLMAP model"},
     {"calibrate", raycarve::RunCalibrate,
      "build calibrated, undistorted views of a COLMAP project and check them"},
+    {"sfm", raycarve::RunSfm,
+     "run COLMAP structure-from-motion on the CPU: photos to a COLMAP project"},
     {"carve", raycarve::RunCarve,
      "carve a coloured voxel model (cloud.ply, mesh.ply) from a COLMAP project"},
     {"compare", raycarve::RunCompare,

@@ -1,6 +1,8 @@
 #include "plugin/workspace.h"
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
 
 #include <glog/logging.h>
 
@@ -16,11 +18,44 @@ bool HoldsModel(const std::filesystem::path& folder) {
          std::filesystem::exists(folder / "cameras.txt");
 }
 
+// Registered images of a model: images.bin's leading count, or half the data lines of images.txt.
+int64_t CountImages(const std::filesystem::path& model) {
+  std::ifstream binary(model / "images.bin", std::ios::binary);
+  if (binary) {
+    uint64_t count = 0;
+    binary.read(reinterpret_cast<char*>(&count), sizeof(count));
+    return binary ? static_cast<int64_t>(count) : 0;
+  }
+  std::ifstream text(model / "images.txt");
+  int64_t lines = 0;
+  std::string line;
+  while (std::getline(text, line)) lines += !line.empty() && line[0] != '#';
+  return (lines + 1) / 2;
+}
+
 }  // namespace
+
+std::vector<ModelCandidate> NumberedModels(const std::string& sparse_path) {
+  std::vector<ModelCandidate> models;
+  std::error_code error;
+  if (!std::filesystem::is_directory(sparse_path, error)) return models;
+  for (const auto& entry : std::filesystem::directory_iterator(sparse_path, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.empty() || name.size() > 6 ||
+        name.find_first_not_of("0123456789") != std::string::npos || !HoldsModel(entry.path())) {
+      continue;
+    }
+    models.push_back({std::stoi(name), entry.path().string(), CountImages(entry.path())});
+  }
+  std::sort(models.begin(), models.end(),
+            [](const ModelCandidate& a, const ModelCandidate& b) { return a.index < b.index; });
+  return models;
+}
 
 WorkspacePaths ResolveWorkspace(const std::string& workspace_path,
                                 const std::string& input_path,
-                                const std::string& image_path) {
+                                const std::string& image_path,
+                                int model_index) {
   WorkspacePaths paths;
   if (!input_path.empty()) {
     paths.model_path = input_path;
@@ -41,6 +76,30 @@ WorkspacePaths ResolveWorkspace(const std::string& workspace_path,
   const std::filesystem::path root(workspace_path);
   if (!std::filesystem::is_directory(root)) {
     throw InputError(workspace_path + ": workspace folder does not exist");
+  }
+  const std::vector<ModelCandidate> numbered = NumberedModels((root / "sparse").string());
+  if (model_index >= 0 || numbered.size() > 1) {
+    const ModelCandidate* chosen = nullptr;
+    for (const ModelCandidate& model : numbered) {
+      if (model_index >= 0 ? model.index == model_index
+                           : chosen == nullptr || model.num_images > chosen->num_images) {
+        chosen = &model;
+      }
+    }
+    if (chosen == nullptr) {
+      throw InputError(workspace_path + ": --model_index " + std::to_string(model_index) +
+                       ": no model in sparse/" + std::to_string(model_index) + " (" +
+                       std::to_string(numbered.size()) + " numbered models in sparse/)");
+    }
+    if (model_index < 0) {
+      LOG(INFO) << numbered.size() << " models in " << (root / "sparse").string() << ": taking "
+                << chosen->path << " (" << chosen->num_images
+                << " images, the most; --model_index chooses another)";
+    }
+    paths.model_path = chosen->path;
+    paths.image_path = image_path.empty() ? (root / "images").string() : image_path;
+    paths.layout = "sparse/" + std::to_string(chosen->index);
+    return paths;
   }
   const struct {
     const char* model;
@@ -66,9 +125,11 @@ LoadedProject LoadProject(const std::string& command,
                           const std::string& output_path,
                           const BoundsFlags& bounds_flags,
                           const ViewReaderOptions& view_options,
-                          int min_images) {
+                          int min_images,
+                          int model_index) {
   LoadedProject project;
-  const WorkspacePaths paths = ResolveWorkspace(workspace_path, input_path, image_path);
+  const WorkspacePaths paths =
+      ResolveWorkspace(workspace_path, input_path, image_path, model_index);
   project.model_path = paths.model_path;
   project.image_path = paths.image_path;
   project.output_path = output_path;

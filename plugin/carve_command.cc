@@ -14,6 +14,7 @@
 #include "calib/view_reader.h"
 #include "carve/carver.h"
 #include "export/carve_export.h"
+#include "export/point_cloud_compare.h"
 #include "plugin/commands.h"
 #include "plugin/json_writer.h"
 #include "plugin/workspace.h"
@@ -37,7 +38,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   const LoadedProject project =
       LoadProject("carve", request.workspace_path, request.input_path, request.image_path,
                   request.output_path, request.bounds, request.view_options, /*min_images=*/2,
-                  request.model_index);
+                  request.model_index, request.colour_calibration);
   run.model_path = project.model_path;
   run.image_path = project.image_path;
   run.output_path = project.output_path;
@@ -46,6 +47,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   run.num_missing_images = static_cast<int>(project.view_summary.missing.size());
   run.masks_from_files = project.view_summary.masks_from_files;
   run.masks_from_backdrop = project.view_summary.masks_from_backdrop;
+  run.colour = project.colour;
   run.stage_seconds.emplace_back("load_project", SecondsSince(stage));
   const std::vector<CalibratedView>& views = project.views;
 
@@ -96,6 +98,20 @@ CarveRun CarveProject(const CarveRequest& request) {
   run.num_mesh_triangles = mesh.num_triangles;
   run.stage_seconds.emplace_back("export", SecondsSince(stage));
 
+  // COLMAP's sparse points lie on the true surface: how far they are from the carved one.
+  const Eigen::AlignedBox3d grid_box = run.result->volume.grid().Box();
+  std::vector<Eigen::Vector3f> sparse, cloud;
+  for (const auto& [id, point] : project.reconstruction.points3D) {
+    if (grid_box.contains(point.xyz)) sparse.push_back(point.xyz.cast<float>());
+  }
+  for (const exporter::ColouredPoint& point : points) cloud.push_back(point.xyz);
+  if (!sparse.empty() && !cloud.empty()) {
+    exporter::CompareOptions compare;
+    compare.threshold = 2.0 * run.result->volume.grid().voxel_size();
+    run.sparse = exporter::CompareClouds(cloud, sparse, compare);
+    run.has_sparse = true;
+  }
+
   // The masks used, so that a user can check them: undistorted, as the carving saw them.
   for (const CalibratedView& view : views) {
     if (view.mask.empty()) continue;
@@ -144,6 +160,24 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("background_tolerance").Value(request.view_options.background.tolerance)
       .Key("visual_hull").Value(request.options.visual_hull)
       .EndObject();
+  if (request.colour_calibration) {
+    json.Key("colour_calibration").BeginObject()
+        .Key("points_used").Value(run.colour.points_used)
+        .Key("observations_used").Value(run.colour.observations_used)
+        .Key("spread_before").Value(run.colour.spread_before)
+        .Key("spread_after").Value(run.colour.spread_after);
+    json.Key("photos").BeginArray();
+    for (const ColourCorrection& correction : run.colour.corrections) {
+      json.BeginObject()
+          .Key("name").Value(correction.name)
+          .Key("gain").Value(JsonArray(correction.gain))
+          .Key("offset").Value(JsonArray(correction.offset))
+          .Key("observations").Value(correction.observations)
+          .EndObject();
+    }
+    json.EndArray();
+    json.EndObject();
+  }
   json.Key("bounds").BeginObject()
       .Key("min").Value(JsonArray(run.bounds.box.min()))
       .Key("max").Value(JsonArray(run.bounds.box.max()))
@@ -184,6 +218,15 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
         .EndObject();
   }
   json.EndArray();
+  if (run.has_sparse) {
+    const double voxel = run.result->volume.grid().voxel_size();
+    json.Key("sparse_points").BeginObject()
+        .Key("count").Value(static_cast<uint64_t>(run.sparse.num_reconstruction))
+        .Key("within_2_voxels").Value(run.sparse.precision)
+        .Key("distance_90_percent_voxels").Value(run.sparse.accuracy / voxel)
+        .Key("mean_distance_voxels").Value(run.sparse.mean_reconstruction_to_reference / voxel)
+        .EndObject();
+  }
   json.Key("stage_seconds").BeginObject();
   for (const auto& [name, seconds] : run.stage_seconds) json.Key(name).Value(seconds);
   json.EndObject();
@@ -240,6 +283,9 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "resolution must be divisible by 2^(L-1)); 1: no levels");
   parser->AddDefault("lod_band", &request->options.lod_band,
                      "voxels put back around what survived a coarse level before refining");
+  parser->AddDefault("colour_calibration", &request->colour_calibration,
+                     "estimate a gain and offset per photo and channel from the sparse points' "
+                     "colours (Ceres, robust) and correct the photos before carving");
   parser->AddDefault("max_memory_gib", &request->options.max_memory_gib,
                      "refuse grids whose carving structures would need more (GiB)");
   parser->AddDefault("skip_missing_images", &request->view_options.skip_missing_images,
@@ -285,12 +331,21 @@ int RunCarve(int argc, char** argv) {
 
   const CarveRun run = CarveProject(request);
   const CarveStatistics& s = run.result->statistics;
+  std::string sparse_line = "none in the volume";
+  if (run.has_sparse) {
+    char text[160];
+    std::snprintf(text, sizeof(text), "%zu in the volume: %.1f%% within 2 voxels of the cloud, 90%% within %.2f voxels",
+                  run.sparse.num_reconstruction, 100.0 * run.sparse.precision,
+                  run.sparse.accuracy / s.voxel_size);
+    sparse_line = text;
+  }
   std::printf(
       "\ncarved %s\n"
       "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
       "  carved          %lld voxels (%lld by the visual hull of %d masked views), %lld evaluations\n"
       "  convergence     %.2f s (+ %.2f s set-up), peak memory %.1f MiB\n"
       "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more (cloud.ply)\n"
+      "  sparse points   %s\n"
       "  outputs         %s/cloud.ply (%zu points), mesh.ply (%zu triangles),\n"
       "                  report.json, convergence.csv\n"
       "  open with       meshlab %s/mesh.ply   (or CloudCompare, Open3D, colmap gui)\n",
@@ -300,7 +355,7 @@ int RunCarve(int argc, char** argv) {
       static_cast<long long>(s.evaluated), s.carve_seconds, s.setup_seconds,
       s.peak_memory_bytes / (1024.0 * 1024.0), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), run.num_cloud_points, request.options.min_views,
-      run.output_path.c_str(), run.num_cloud_points,
+      sparse_line.c_str(), run.output_path.c_str(), run.num_cloud_points,
       run.num_mesh_triangles, run.output_path.c_str());
   return 0;
 }

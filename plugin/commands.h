@@ -8,9 +8,11 @@
 
 #include "calib/bounds.h"
 #include "calib/calibrated_view.h"
+#include "calib/colour_calibration.h"
 #include "calib/reconstruction.h"
 #include "calib/view_reader.h"
 #include "carve/carver.h"
+#include "export/point_cloud_compare.h"
 #include "plugin/option_parser.h"
 
 namespace raycarve {
@@ -58,6 +60,7 @@ struct LoadedProject {
   Bounds bounds;
   std::vector<CalibratedView> views;
   ViewReaderSummary view_summary;
+  ColourCalibration colour;  // estimated and applied when asked (points_used 0 otherwise)
 };
 
 // Resolves the workspace (see workspace.h) and the output folder (default <workspace>/raycarve,
@@ -72,7 +75,8 @@ LoadedProject LoadProject(const std::string& command,
                           const BoundsFlags& bounds_flags,
                           const ViewReaderOptions& view_options,
                           int min_images,
-                          int model_index = -1);
+                          int model_index = -1,
+                          bool colour_calibration = false);
 
 // carve: everything `raycarve carve` takes, and what it produced.
 struct CarveRequest {
@@ -84,6 +88,7 @@ struct CarveRequest {
   BoundsFlags bounds;
   ViewReaderOptions view_options;
   int model_index = -1;              // sparse/<index> among several models; -1: the largest
+  bool colour_calibration = false;   // per-photo gains and offsets from the sparse points
   std::string background = "auto";  // as given on the command line, for the report
   double progress_seconds = 2.0;     // between progress lines
 };
@@ -97,10 +102,14 @@ struct CarveRun {
   int num_missing_images = 0;
   int masks_from_files = 0;
   int masks_from_backdrop = 0;
+  ColourCalibration colour;
   std::unique_ptr<CarveResult> result;
   std::vector<std::pair<std::string, double>> stage_seconds;
   size_t num_cloud_points = 0;
   size_t num_mesh_triangles = 0;
+  // The model's sparse points inside the grid against the cloud (accuracy: their 90% distance).
+  bool has_sparse = false;
+  exporter::CloudComparison sparse;
 };
 
 // The carve flags shared by `carve` and `holdout`: AddCarveFlags declares them (the enum-valued

@@ -37,7 +37,7 @@ int RunHoldout(int argc, char** argv) {
   const LoadedProject project =
       LoadProject("holdout", request.workspace_path, request.input_path, request.image_path,
                   request.output_path, request.bounds, request.view_options, /*min_images=*/3,
-                  request.model_index);
+                  request.model_index, request.colour_calibration);
   std::vector<CalibratedView> training, held_out;
   for (size_t i = 0; i < project.views.size(); ++i) {
     (i % every == 0 ? held_out : training).push_back(project.views[i]);

@@ -6,6 +6,7 @@
 
 #include <glog/logging.h>
 
+#include "calib/colour_calibration.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
 #include "plugin/commands.h"
@@ -126,7 +127,8 @@ LoadedProject LoadProject(const std::string& command,
                           const BoundsFlags& bounds_flags,
                           const ViewReaderOptions& view_options,
                           int min_images,
-                          int model_index) {
+                          int model_index,
+                          bool colour_calibration) {
   LoadedProject project;
   const WorkspacePaths paths =
       ResolveWorkspace(workspace_path, input_path, image_path, model_index);
@@ -159,6 +161,16 @@ LoadedProject LoadProject(const std::string& command,
     throw InputError(paths.image_path + ": only " + std::to_string(project.views.size()) +
                      " photos could be loaded; raycarve " + command + " needs at least " +
                      std::to_string(min_images));
+  }
+  if (colour_calibration) {
+    project.colour = EstimateColourCalibration(project.reconstruction, project.views);
+    if (project.colour.points_used == 0) {
+      LOG(WARNING) << "colour calibration: no sparse point is seen by 3 or more photos; the "
+                      "photos are used as they are";
+    } else {
+      ApplyColourCalibration(project.colour, &project.views);
+      LOG(INFO) << project.colour.Summary();
+    }
   }
   return project;
 }

@@ -14,8 +14,9 @@ int RunSynth(int argc, char** argv) {
   SyntheticSceneOptions options;
   OptionParser parser("synth",
                       "Generates a synthetic COLMAP project with ground truth: a textured sphere "
-                      "and box on a checkered ground, ray traced from cameras on a ring "
-                      "(images/, sparse/0).");
+                      "and box (--scene simple) or the seed paper's textured teapot, sphere and "
+                      "cube (--scene paper) on a checkered ground, ray traced from cameras on a "
+                      "ring (images/, masks/, sparse/0, truth.ply).");
   parser.AddRequired("output_path", &output_path, "project folder to write (created)");
   parser.AddDefault("views", &options.num_views, "number of cameras on the ring");
   parser.AddDefault("width", &options.width, "photo width in pixels");
@@ -25,6 +26,14 @@ int RunSynth(int argc, char** argv) {
                     "surface samples tried as sparse points (kept when seen by >= 2 views)");
   parser.AddDefault("pixel_noise", &options.pixel_noise,
                     "std. dev. of noise on the 2D observations (px)");
+  std::string scene_kind = "simple";
+  parser.AddDefault("scene", &scene_kind,
+                    "simple (sphere and box) or paper (teapot, sphere and cube; reads the "
+                    "teapot's patches from --teapot_path)",
+                    {"simple", "paper"});
+  parser.AddDefault("teapot_path", &options.teapot_path,
+                    "the Utah teapot's Bezier patches (default: $RAYCARVE_DATA_DIR or "
+                    "../shared/data, then teapot/teapot_bezier.txt)");
   std::string backdrop = "patchwork";
   parser.AddDefault("backdrop", &backdrop,
                     "behind the scene: a patchwork sky, or a uniform dark backdrop (a studio set-up "
@@ -37,6 +46,7 @@ int RunSynth(int argc, char** argv) {
   if (!parser.Parse(argc, argv)) return 0;
   options.camera_model = CameraModelIdFromName(camera_model, "--camera_model");
   options.uniform_backdrop = backdrop == "uniform";
+  SceneKindFromString(scene_kind, &options.scene);
   std::string reason;
   if (!options.IsValid(&reason)) throw InputError("raycarve synth: " + reason);
 

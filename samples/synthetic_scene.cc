@@ -1,7 +1,10 @@
 #include "samples/synthetic_scene.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <limits>
 #include <random>
 
@@ -13,6 +16,7 @@
 #include "calib/input_error.h"
 #include "calib/model_writer.h"
 #include "calib/pixel.h"
+#include "samples/triangle_mesh.h"
 #include "export/point_cloud_io.h"
 
 namespace raycarve {
@@ -25,7 +29,23 @@ const Eigen::Vector3d kBoxMin(-1.05, -0.75, 0.0);
 const Eigen::Vector3d kBoxMax(-0.2, 0.05, 0.8);
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-enum class Surface { kNone, kGround, kSphere, kBox };
+enum class Surface { kNone, kGround, kSphere, kBox, kTeapot };
+
+}  // namespace
+
+// The objects of a scene: the simple scene's sphere and box, or the paper's teapot, sphere and
+// cube; all on the same checkered ground square.
+struct SceneGeometry {
+  Eigen::Vector3d sphere_centre = kSphereCentre;
+  double sphere_radius = kSphereRadius;
+  Eigen::Vector3d box_min = kBoxMin;
+  Eigen::Vector3d box_max = kBoxMax;
+  std::unique_ptr<TriangleMesh> teapot;  // the paper's scene only
+  std::vector<double> teapot_area_cdf;   // cumulative triangle areas, for sampling
+  double top = kSphereCentre.z() + kSphereRadius;  // highest point of the objects
+};
+
+namespace {
 
 struct Hit {
   double t = kInfinity;
@@ -34,10 +54,11 @@ struct Hit {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
 };
 
-void IntersectSphere(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Hit* hit) {
-  const Eigen::Vector3d offset = origin - kSphereCentre;
+void IntersectSphere(const SceneGeometry& g, const Eigen::Vector3d& origin,
+                     const Eigen::Vector3d& direction, Hit* hit) {
+  const Eigen::Vector3d offset = origin - g.sphere_centre;
   const double b = offset.dot(direction);
-  const double c = offset.squaredNorm() - kSphereRadius * kSphereRadius;
+  const double c = offset.squaredNorm() - g.sphere_radius * g.sphere_radius;
   const double discriminant = b * b - c;
   if (discriminant < 0.0) return;
   const double t = -b - std::sqrt(discriminant);
@@ -45,20 +66,21 @@ void IntersectSphere(const Eigen::Vector3d& origin, const Eigen::Vector3d& direc
     hit->t = t;
     hit->surface = Surface::kSphere;
     hit->point = origin + t * direction;
-    hit->normal = (hit->point - kSphereCentre) / kSphereRadius;
+    hit->normal = (hit->point - g.sphere_centre) / g.sphere_radius;
   }
 }
 
-void IntersectBox(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Hit* hit) {
+void IntersectBox(const SceneGeometry& g, const Eigen::Vector3d& origin,
+                  const Eigen::Vector3d& direction, Hit* hit) {
   double t_near = -kInfinity, t_far = kInfinity;
   int near_axis = 0;
   for (int axis = 0; axis < 3; ++axis) {
     if (direction[axis] == 0.0) {
-      if (origin[axis] < kBoxMin[axis] || origin[axis] > kBoxMax[axis]) return;
+      if (origin[axis] < g.box_min[axis] || origin[axis] > g.box_max[axis]) return;
       continue;
     }
-    double t0 = (kBoxMin[axis] - origin[axis]) / direction[axis];
-    double t1 = (kBoxMax[axis] - origin[axis]) / direction[axis];
+    double t0 = (g.box_min[axis] - origin[axis]) / direction[axis];
+    double t1 = (g.box_max[axis] - origin[axis]) / direction[axis];
     if (t0 > t1) std::swap(t0, t1);
     if (t0 > t_near) {
       t_near = t0;
@@ -86,11 +108,23 @@ void IntersectGround(const Eigen::Vector3d& origin, const Eigen::Vector3d& direc
   hit->normal = Eigen::Vector3d::UnitZ();
 }
 
-Hit Trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
+void IntersectTeapot(const SceneGeometry& g, const Eigen::Vector3d& origin,
+                     const Eigen::Vector3d& direction, Hit* hit) {
+  if (!g.teapot) return;
+  TriangleMesh::RayHit mesh_hit;
+  if (!g.teapot->Intersect(origin, direction, 1e-9, hit->t, &mesh_hit)) return;
+  hit->t = mesh_hit.t;
+  hit->surface = Surface::kTeapot;
+  hit->point = origin + mesh_hit.t * direction;
+  hit->normal = mesh_hit.normal;
+}
+
+Hit Trace(const SceneGeometry& g, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
   Hit hit;
-  IntersectSphere(origin, direction, &hit);
-  IntersectBox(origin, direction, &hit);
+  IntersectSphere(g, origin, direction, &hit);
+  IntersectBox(g, origin, direction, &hit);
   IntersectGround(origin, direction, &hit);
+  IntersectTeapot(g, origin, direction, &hit);
   return hit;
 }
 
@@ -135,6 +169,17 @@ Eigen::Vector3d SurfaceColour(const Hit& hit) {
       albedo = stripe ? Eigen::Vector3d(40, 150, 80) : Eigen::Vector3d(170, 230, 240);
       break;
     }
+    case Surface::kTeapot: {
+      // Porcelain with a blue 3D check of 0.1 and a soft band: texture at every scale.
+      const Eigen::Vector3d& p = hit.point;
+      const int check = static_cast<int>(std::floor(p.x() / 0.1)) +
+                        static_cast<int>(std::floor(p.y() / 0.1)) +
+                        static_cast<int>(std::floor(p.z() / 0.1));
+      albedo = (check & 1) ? Eigen::Vector3d(45, 70, 170) : Eigen::Vector3d(235, 232, 215);
+      albedo += Eigen::Vector3d(10, -20, -40) * (0.5 + 0.5 * std::sin(9.0 * p.z()));
+      albedo = albedo.cwiseMax(0.0);
+      break;
+    }
     case Surface::kNone:
       LOG(FATAL) << "no surface: use SkyColour";
   }
@@ -158,7 +203,8 @@ Rigid3d LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
 }
 
 // Renders the photo and the object mask (pixels where most rays hit the scene).
-cv::Mat Render(const Camera& camera,
+cv::Mat Render(const SceneGeometry& geometry,
+               const Camera& camera,
                const Rigid3d& cam_from_world,
                int supersampling,
                bool uniform_backdrop,
@@ -178,7 +224,7 @@ cv::Mat Render(const Camera& camera,
           if (!normalized.allFinite()) continue;
           const Eigen::Vector3d direction =
               (world_from_cam.rotation * normalized.homogeneous()).normalized();
-          const Hit hit = Trace(world_from_cam.translation, direction);
+          const Hit hit = Trace(geometry, world_from_cam.translation, direction);
           hits += hit.surface != Surface::kNone;
           sum += hit.surface != Surface::kNone ? SurfaceColour(hit)
                  : uniform_backdrop            ? kBackdropColour
@@ -195,23 +241,33 @@ cv::Mat Render(const Camera& camera,
   return photo;
 }
 
-// A uniformly distributed point on one of the three surfaces, by area.
-Hit SampleSurface(std::mt19937_64* random) {
+// A uniformly distributed point on the scene's surfaces, by area.
+Hit SampleSurface(const SceneGeometry& g, std::mt19937_64* random) {
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  const double sphere_area = 4.0 * M_PI * kSphereRadius * kSphereRadius;
-  const Eigen::Vector3d box_size = kBoxMax - kBoxMin;
+  const double sphere_area = 4.0 * M_PI * g.sphere_radius * g.sphere_radius;
+  const Eigen::Vector3d box_size = g.box_max - g.box_min;
   const double box_area = 2.0 * (box_size.x() * box_size.y() + box_size.y() * box_size.z() +
                                  box_size.x() * box_size.z());
   const double ground_area = 4.0 * kGroundHalfSize * kGroundHalfSize;
-  const double pick = uniform(*random) * (sphere_area + box_area + ground_area);
+  const double teapot_area = g.teapot_area_cdf.empty() ? 0.0 : g.teapot_area_cdf.back();
+  const double pick = uniform(*random) * (sphere_area + box_area + ground_area + teapot_area);
   Hit hit;
-  if (pick < sphere_area) {
+  if (pick >= sphere_area + box_area + ground_area) {
+    const double at = pick - (sphere_area + box_area + ground_area);
+    const int triangle = static_cast<int>(
+        std::upper_bound(g.teapot_area_cdf.begin(), g.teapot_area_cdf.end(), at) -
+        g.teapot_area_cdf.begin());
+    const double r1 = uniform(*random), r2 = uniform(*random);
+    hit.surface = Surface::kTeapot;
+    hit.point = g.teapot->PointOn(std::min(triangle, g.teapot->num_triangles() - 1), r1, r2,
+                                  &hit.normal);
+  } else if (pick < sphere_area) {
     const double z = 2.0 * uniform(*random) - 1.0;
     const double phi = 2.0 * M_PI * uniform(*random);
     const double s = std::sqrt(1.0 - z * z);
     hit.surface = Surface::kSphere;
     hit.normal = Eigen::Vector3d(s * std::cos(phi), s * std::sin(phi), z);
-    hit.point = kSphereCentre + kSphereRadius * hit.normal;
+    hit.point = g.sphere_centre + g.sphere_radius * hit.normal;
   } else if (pick < sphere_area + box_area) {
     // A face picked in proportion to its area (faces normal to x, y, z), then a uniform point.
     const double face_areas[3] = {box_size.y() * box_size.z(),
@@ -221,10 +277,10 @@ Hit SampleSurface(std::mt19937_64* random) {
     const int axis = face_pick < face_areas[0]                   ? 0
                      : face_pick < face_areas[0] + face_areas[1] ? 1
                                                                  : 2;
-    hit.point = kBoxMin + box_size.cwiseProduct(
-                              Eigen::Vector3d(uniform(*random), uniform(*random), uniform(*random)));
+    hit.point = g.box_min + box_size.cwiseProduct(Eigen::Vector3d(
+                                uniform(*random), uniform(*random), uniform(*random)));
     const bool upper = uniform(*random) < 0.5;
-    hit.point[axis] = upper ? kBoxMax[axis] : kBoxMin[axis];
+    hit.point[axis] = upper ? g.box_max[axis] : g.box_min[axis];
     hit.normal = Eigen::Vector3d::Zero();
     hit.normal[axis] = upper ? 1.0 : -1.0;
     hit.surface = Surface::kBox;
@@ -239,7 +295,8 @@ Hit SampleSurface(std::mt19937_64* random) {
 }
 
 // The pixel of `point` in `image` when it is inside the frame and not occluded.
-bool SeenBy(const Eigen::Vector3d& point,
+bool SeenBy(const SceneGeometry& geometry,
+            const Eigen::Vector3d& point,
             const Image& image,
             const Camera& camera,
             Eigen::Vector2d* pixel) {
@@ -252,7 +309,7 @@ bool SeenBy(const Eigen::Vector3d& point,
   }
   const Eigen::Vector3d centre = image.ProjectionCenter();
   const Eigen::Vector3d offset = point - centre;
-  const Hit hit = Trace(centre, offset.normalized());
+  const Hit hit = Trace(geometry, centre, offset.normalized());
   return std::abs(hit.t - offset.norm()) <= 1e-6 * offset.norm();
 }
 
@@ -298,6 +355,10 @@ bool SyntheticSceneOptions::IsValid(std::string* reason) const {
               CameraModelParamsInfo(camera_model) + ")";
     return false;
   }
+  if (teapot_tessellation < 1 || teapot_tessellation > 64) {
+    *reason = "teapot_tessellation must be in [1, 64]";
+    return false;
+  }
   if (supersampling < 1 || supersampling > 8) {
     *reason = "supersampling must be in [1, 8]";
     return false;
@@ -337,13 +398,56 @@ std::vector<double> ExampleCameraParams(CameraModelId model, int width, int heig
   return {};
 }
 
+std::string SceneKindToString(SceneKind kind) {
+  return kind == SceneKind::kSimple ? "simple" : "paper";
+}
+
+bool SceneKindFromString(const std::string& text, SceneKind* kind) {
+  for (SceneKind candidate : {SceneKind::kSimple, SceneKind::kPaper}) {
+    if (text == SceneKindToString(candidate)) {
+      *kind = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string DefaultTeapotPath() {
+  const char* data = std::getenv("RAYCARVE_DATA_DIR");
+  const std::string root = data != nullptr && *data != '\0' ? data : "../shared/data";
+  return root + "/teapot/teapot_bezier.txt";
+}
+
+std::shared_ptr<const SceneGeometry> MakeSceneGeometry(const SyntheticSceneOptions& options) {
+  auto geometry = std::make_shared<SceneGeometry>();
+  if (options.scene == SceneKind::kSimple) return geometry;
+  // The seed paper's scene: a textured teapot, a sphere and a cube on the checkered ground.
+  geometry->sphere_centre = Eigen::Vector3d(-0.75, 0.65, 0.35);
+  geometry->sphere_radius = 0.35;
+  geometry->box_min = Eigen::Vector3d(0.55, 0.55, 0.0);
+  geometry->box_max = Eigen::Vector3d(1.15, 1.15, 0.6);
+  const std::string path = options.teapot_path.empty() ? DefaultTeapotPath() : options.teapot_path;
+  geometry->teapot = std::make_unique<TriangleMesh>(ReadBezierTeapot(
+      path, options.teapot_tessellation, 0.3, Eigen::Vector3d(0.25, -0.35, 0.0)));
+  double total = 0.0;
+  for (int t = 0; t < geometry->teapot->num_triangles(); ++t) {
+    total += geometry->teapot->Area(t);
+    geometry->teapot_area_cdf.push_back(total);
+  }
+  geometry->top = std::max({geometry->sphere_centre.z() + geometry->sphere_radius,
+                            geometry->box_max.z(), geometry->teapot->BoxMax().z()});
+  return geometry;
+}
+
 SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
   std::string reason;
   CHECK(options.IsValid(&reason)) << reason;
   SyntheticScene scene;
+  scene.geometry = MakeSceneGeometry(options);
+  const SceneGeometry& geometry = *scene.geometry;
   scene.object_box = Eigen::AlignedBox3d(Eigen::Vector3d(-kGroundHalfSize, -kGroundHalfSize, 0.0),
                                          Eigen::Vector3d(kGroundHalfSize, kGroundHalfSize,
-                                                         kSphereCentre.z() + kSphereRadius));
+                                                         geometry.top));
   Reconstruction& reconstruction = scene.reconstruction;
 
   // One camera shared by all views; the focal length frames the ground square from the ring.
@@ -375,7 +479,7 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
     image.cam_from_world = LookAt(centre, target);
     cv::Mat mask;
     scene.photos.emplace(image.image_id,
-                         Render(camera, image.cam_from_world, options.supersampling,
+                         Render(geometry, camera, image.cam_from_world, options.supersampling,
                                 options.uniform_backdrop, &mask));
     scene.masks.emplace(image.image_id, mask);
     reconstruction.images.emplace(image.image_id, std::move(image));
@@ -385,13 +489,15 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
   std::normal_distribution<double> noise(0.0, options.pixel_noise);
   point3D_t next_point3D_id = 1;
   for (int sample = 0; sample < options.num_surface_samples; ++sample) {
-    const Hit surface = SampleSurface(&random);
+    const Hit surface = SampleSurface(geometry, &random);
     Point3D point3D;
     point3D.xyz = surface.point;
     std::vector<std::pair<image_t, Eigen::Vector2d>> observations;
     for (const auto& [image_id, image] : reconstruction.images) {
       Eigen::Vector2d pixel;
-      if (SeenBy(surface.point, image, camera, &pixel)) observations.emplace_back(image_id, pixel);
+      if (SeenBy(geometry, surface.point, image, camera, &pixel)) {
+        observations.emplace_back(image_id, pixel);
+      }
     }
     if (observations.size() < 2) continue;
     const Eigen::Vector3d colour = SurfaceColour(surface);
@@ -419,11 +525,12 @@ std::vector<Eigen::Vector3d> SampleTrueSurface(const SyntheticScene& scene,
   std::mt19937_64 random(seed);
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < count; ++i) {
-    const Hit surface = SampleSurface(&random);
+    const Hit surface = SampleSurface(*scene.geometry, &random);
     int views = 0;
     for (const auto& [image_id, image] : scene.reconstruction.images) {
       Eigen::Vector2d pixel;
-      views += SeenBy(surface.point, image, scene.reconstruction.cameras.at(image.camera_id), &pixel);
+      views += SeenBy(*scene.geometry, surface.point, image,
+                      scene.reconstruction.cameras.at(image.camera_id), &pixel);
       if (views >= min_views) break;
     }
     if (views >= min_views) points.push_back(surface.point);

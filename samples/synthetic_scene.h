@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,22 @@ namespace raycarve {
 // photos carry that model's distortion.
 //
 // World frame: z up, ground at z = 0, the scene inside [-1.5, 1.5]^2 x [0, 1.1]; units arbitrary.
+// Which objects: the simple scene (a sphere and a striped box), or the seed paper's scene (a
+// textured Utah teapot, a sphere and a cube), both on the checkered ground square.
+enum class SceneKind { kSimple, kPaper };
+std::string SceneKindToString(SceneKind kind);
+bool SceneKindFromString(const std::string& text, SceneKind* kind);
+
+// Where the paper's scene reads the teapot's Bezier patches: $RAYCARVE_DATA_DIR or
+// ../shared/data, then teapot/teapot_bezier.txt.
+std::string DefaultTeapotPath();
+
+struct SceneGeometry;
+
 struct SyntheticSceneOptions {
+  SceneKind scene = SceneKind::kSimple;
+  std::string teapot_path;      // the paper's scene: empty for DefaultTeapotPath()
+  int teapot_tessellation = 12;  // quads per patch side
   int num_views = 8;           // cameras on the ring
   int width = 320;             // photo width in pixels
   int height = 240;            // photo height in pixels
@@ -44,6 +60,7 @@ struct SyntheticScene {
   std::map<image_t, cv::Mat> photos;  // CV_8UC3 RGB, as the camera model sees them
   std::map<image_t, cv::Mat> masks;   // CV_8UC1, 255 where most of a pixel's rays hit the scene
   Eigen::AlignedBox3d object_box;     // smallest box holding the ground square and the objects
+  std::shared_ptr<const SceneGeometry> geometry;  // what the photos show
 };
 
 // The uniform backdrop's colour (RGB).
@@ -53,7 +70,8 @@ const Eigen::Vector3d kBackdropColour(12, 10, 14);
 // the image centre and a mild distortion typical of that model (none for pinhole models).
 std::vector<double> ExampleCameraParams(CameraModelId model, int width, int height, double focal);
 
-// Distance from a world point to the scene's true surface (sphere, box, ground square), exact.
+// Distance from a world point to the simple scene's true surface (sphere, box, ground square),
+// exact. (The paper's scene is measured against its truth.ply.)
 double TrueSurfaceDistance(const Eigen::Vector3d& point);
 
 // A dense sample of the true surface for measuring reconstructions: `count` candidate points

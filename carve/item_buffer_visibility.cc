@@ -51,14 +51,8 @@ void ItemBufferVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pixe
     const Footprint footprint =
         ComputeFootprint(view.P, view.width, view.height, volume_.grid(), coordinates);
     const uint32_t* items = items_[v].data();
-    for (int row = footprint.row_min; row <= footprint.row_max; ++row) {
-      const int base = row * view.width;
-      for (int col = footprint.col_min; col <= footprint.col_max; ++col) {
-        if (items[base + col] == item) {
-          pixels->push_back({static_cast<uint32_t>(v), static_cast<uint32_t>(base + col)});
-        }
-      }
-    }
+    AppendMatchingPixels(footprint, view.width, static_cast<uint32_t>(v),
+                         [&](int pixel) { return items[pixel] == item; }, pixels);
   }
 }
 

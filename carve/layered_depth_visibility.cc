@@ -70,15 +70,10 @@ void LayeredDepthVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pi
     const Footprint footprint =
         ComputeFootprint(view.P, view.width, view.height, volume_.grid(), coordinates);
     const int32_t* heads = heads_[v].data();
-    for (int row = footprint.row_min; row <= footprint.row_max; ++row) {
-      const int base = row * view.width;
-      for (int col = footprint.col_min; col <= footprint.col_max; ++col) {
-        const int32_t node = heads[base + col];
-        if (node != -1 && nodes_[node].voxel == item) {
-          pixels->push_back({static_cast<uint32_t>(v), static_cast<uint32_t>(base + col)});
-        }
-      }
-    }
+    AppendMatchingPixels(
+        footprint, view.width, static_cast<uint32_t>(v),
+        [&](int pixel) { return heads[pixel] != -1 && nodes_[heads[pixel]].voxel == item; },
+        pixels);
   }
 }
 

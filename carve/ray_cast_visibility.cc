@@ -84,14 +84,8 @@ void RayCastVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels)
     const Footprint footprint =
         ComputeFootprint(view.P, view.width, view.height, volume_.grid(), coordinates);
     const uint64_t* keys = rays_[v].keys();
-    for (int row = footprint.row_min; row <= footprint.row_max; ++row) {
-      const int base = row * view.width;
-      for (int col = footprint.col_min; col <= footprint.col_max; ++col) {
-        if (keys[base + col] == key) {
-          pixels->push_back({static_cast<uint32_t>(v), static_cast<uint32_t>(base + col)});
-        }
-      }
-    }
+    AppendMatchingPixels(footprint, view.width, static_cast<uint32_t>(v),
+                         [&](int pixel) { return keys[pixel] == key; }, pixels);
   }
 }
 

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "carve/footprint.h"
+
 namespace raycarve {
 
 // One pixel of one view.
@@ -11,6 +13,20 @@ struct PixelRef {
   uint32_t view;
   uint32_t pixel;  // row * width + col
 };
+
+// Appends to `pixels` every pixel of `footprint` (in an image `width` wide, row by row) for which
+// matches(pixel) holds, as pixels of `view`: how each method reads its per-pixel structure (ray
+// keys, item buffer, list heads) for Vis(V).
+template <typename Matches>
+void AppendMatchingPixels(const Footprint& footprint, int width, uint32_t view, Matches&& matches,
+                          std::vector<PixelRef>* pixels) {
+  for (int row = footprint.row_min; row <= footprint.row_max; ++row) {
+    const int base = row * width;
+    for (int col = footprint.col_min; col <= footprint.col_max; ++col) {
+      if (matches(base + col)) pixels->push_back({view, static_cast<uint32_t>(base + col)});
+    }
+  }
+}
 
 // How the carver learns which pixels see which voxel: the one thing in which ray casting, GVC
 // and GVC-LDI differ. Everything else (grid, surface, footprints, consistency, colouring) is

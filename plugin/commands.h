@@ -31,6 +31,7 @@ int RunCheckBackground(int argc, char** argv);
 int RunHoldout(int argc, char** argv);
 int RunBenchmark(int argc, char** argv);
 int RunSfm(int argc, char** argv);
+int RunRender(int argc, char** argv);
 
 // Options shared by every command that bounds the volume.
 struct BoundsFlags {

@@ -36,6 +36,8 @@ const Command kCommands[] = {
      "carve without every k-th view and score renders of the left-out views (PSNR, IoU)"},
     {"benchmark", raycarve::RunBenchmark,
      "the seed paper's Table 1 and Figure 6: ray casting against GVC and GVC-LDI"},
+    {"render", raycarve::RunRender,
+     "draw a coloured cloud into the cameras of a COLMAP model (render and silhouette)"},
     {"synth", raycarve::RunSynth, "generate a synthetic COLMAP project with ground truth"},
 };
 

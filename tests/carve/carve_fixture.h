@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "calib/calibrated_view.h"
+#include "carve/visibility.h"
 #include "carve/volume.h"
 #include "samples/synthetic_scene.h"
 
@@ -38,6 +39,24 @@ inline std::vector<CalibratedView> SceneViews(const SyntheticScene& scene, bool 
   return views;
 }
 
+// Brute force: whether the ray from `origin` along `direction` (t > 0) passes through the
+// voxel's cube with non-zero length, and the ray parameter where it enters.
+inline bool RayEntersVoxel(const VoxelGrid& grid, const Eigen::Vector3i& voxel,
+                           const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                           double* t_enter) {
+  const Eigen::Vector3d lo = grid.Corner(voxel, 0), hi = grid.Corner(voxel, 7);
+  double t0 = 0.0, t1 = 1e300;
+  for (int axis = 0; axis < 3; ++axis) {
+    double a = (lo[axis] - origin[axis]) / direction[axis];
+    double b = (hi[axis] - origin[axis]) / direction[axis];
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+  }
+  *t_enter = t0;
+  return t1 - t0 > 1e-9;
+}
+
 // Brute force: the nearest solid voxel of `volume` on the ray from `origin` along `direction`
 // (only voxels the ray passes through with non-zero length), or -1.
 inline int64_t NearestSolidVoxel(const Volume& volume,
@@ -48,22 +67,22 @@ inline int64_t NearestSolidVoxel(const Volume& volume,
   double best_t = 1e300;
   for (int64_t index = 0; index < grid.num_voxels(); ++index) {
     if (!volume.IsSolid(index)) continue;
-    const Eigen::Vector3i voxel = grid.Voxel(index);
-    const Eigen::Vector3d lo = grid.Corner(voxel, 0), hi = grid.Corner(voxel, 7);
-    double t0 = 0.0, t1 = 1e300;
-    for (int axis = 0; axis < 3; ++axis) {
-      double a = (lo[axis] - origin[axis]) / direction[axis];
-      double b = (hi[axis] - origin[axis]) / direction[axis];
-      if (a > b) std::swap(a, b);
-      t0 = std::max(t0, a);
-      t1 = std::min(t1, b);
-    }
-    if (t1 - t0 > 1e-9 && t0 < best_t) {
-      best_t = t0;
+    double t = 0.0;
+    if (RayEntersVoxel(grid, grid.Voxel(index), origin, direction, &t) && t < best_t) {
+      best_t = t;
       best = index;
     }
   }
   return best;
+}
+
+// Vis(V) as (view, pixel) pairs.
+inline std::vector<std::pair<uint32_t, uint32_t>> VisOf(Visibility* visibility, int64_t voxel) {
+  std::vector<PixelRef> vis;
+  visibility->ComputeVis(voxel, &vis);
+  std::vector<std::pair<uint32_t, uint32_t>> pixels;
+  for (const PixelRef& ref : vis) pixels.emplace_back(ref.view, ref.pixel);
+  return pixels;
 }
 
 inline Eigen::Vector3d PixelDirection(const CalibratedView& view, int pixel) {

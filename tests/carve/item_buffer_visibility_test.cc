@@ -12,14 +12,7 @@ namespace raycarve {
 namespace {
 
 using PixelList = std::vector<std::pair<uint32_t, uint32_t>>;
-
-PixelList VisOf(Visibility* visibility, int64_t voxel) {
-  std::vector<PixelRef> vis;
-  visibility->ComputeVis(voxel, &vis);
-  PixelList pixels;
-  for (const PixelRef& ref : vis) pixels.emplace_back(ref.view, ref.pixel);
-  return pixels;
-}
+using testing::VisOf;
 
 TEST(ItemBufferVisibilityTest, FreshBuffersGiveRayCastingsVisAndStaleOnesASubsetOfIt) {
   const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(4, 64, 48));

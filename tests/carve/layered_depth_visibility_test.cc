@@ -14,14 +14,7 @@ namespace raycarve {
 namespace {
 
 using PixelList = std::vector<std::pair<uint32_t, uint32_t>>;
-
-PixelList VisOf(Visibility* visibility, int64_t voxel) {
-  std::vector<PixelRef> vis;
-  visibility->ComputeVis(voxel, &vis);
-  PixelList pixels;
-  for (const PixelRef& ref : vis) pixels.emplace_back(ref.view, ref.pixel);
-  return pixels;
-}
+using testing::VisOf;
 
 // Brute force: the surface voxels whose cube the pixel's ray passes through with non-zero length,
 // nearest first.
@@ -31,17 +24,10 @@ std::vector<int64_t> SurfaceVoxelsAlongRay(const Volume& volume,
                                            const Eigen::Vector3d& direction) {
   std::vector<std::pair<double, int64_t>> hits;
   for (const int64_t index : surface) {
-    const Eigen::Vector3i voxel = volume.grid().Voxel(index);
-    const Eigen::Vector3d lo = volume.grid().Corner(voxel, 0), hi = volume.grid().Corner(voxel, 7);
-    double t0 = 0.0, t1 = 1e300;
-    for (int axis = 0; axis < 3; ++axis) {
-      double a = (lo[axis] - origin[axis]) / direction[axis];
-      double b = (hi[axis] - origin[axis]) / direction[axis];
-      if (a > b) std::swap(a, b);
-      t0 = std::max(t0, a);
-      t1 = std::min(t1, b);
+    double t = 0.0;
+    if (testing::RayEntersVoxel(volume.grid(), volume.grid().Voxel(index), origin, direction, &t)) {
+      hits.emplace_back(t, index);
     }
-    if (t1 - t0 > 1e-9) hits.emplace_back(t0, index);
   }
   std::sort(hits.begin(), hits.end());
   std::vector<int64_t> voxels;

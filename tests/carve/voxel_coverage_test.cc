@@ -10,23 +10,6 @@
 namespace raycarve {
 namespace {
 
-// Brute force: whether the ray of a pixel passes through the voxel's cube with non-zero length,
-// and where it enters (world units along the pixel direction of carve_fixture.h).
-bool RayEnters(const VoxelGrid& grid, const Eigen::Vector3i& voxel, const Eigen::Vector3d& origin,
-               const Eigen::Vector3d& direction, double* t_enter) {
-  const Eigen::Vector3d lo = grid.Corner(voxel, 0), hi = grid.Corner(voxel, 7);
-  double t0 = 0.0, t1 = 1e300;
-  for (int axis = 0; axis < 3; ++axis) {
-    double a = (lo[axis] - origin[axis]) / direction[axis];
-    double b = (hi[axis] - origin[axis]) / direction[axis];
-    if (a > b) std::swap(a, b);
-    t0 = std::max(t0, a);
-    t1 = std::min(t1, b);
-  }
-  *t_enter = t0;
-  return t1 - t0 > 1e-9;
-}
-
 TEST(VoxelCoverage, DrawsExactlyThePixelsWhoseRaysEnterTheVoxelWithTheirEntryDepth) {
   const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(3, 80, 60));
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
@@ -40,7 +23,7 @@ TEST(VoxelCoverage, DrawsExactlyThePixelsWhoseRaysEnterTheVoxelWithTheirEntryDep
       coverage.ForEach(voxel, [&](int pixel, double t) {
         drawn.push_back(pixel);
         double t_world = 0.0;
-        ASSERT_TRUE(RayEnters(grid, voxel, view.centre, testing::PixelDirection(view, pixel),
+        ASSERT_TRUE(testing::RayEntersVoxel(grid, voxel, view.centre, testing::PixelDirection(view, pixel),
                               &t_world));
         // Grid units scale the origin and the direction alike: the same ray parameter.
         EXPECT_NEAR(t, t_world, 1e-6 * std::max(1.0, t_world)) << "pixel " << pixel;
@@ -53,7 +36,7 @@ TEST(VoxelCoverage, DrawsExactlyThePixelsWhoseRaysEnterTheVoxelWithTheirEntryDep
           const int pixel = row * view.width + col;
           if (std::find(drawn.begin(), drawn.end(), pixel) != drawn.end()) continue;
           double t = 0.0;
-          EXPECT_FALSE(RayEnters(grid, voxel, view.centre, testing::PixelDirection(view, pixel), &t))
+          EXPECT_FALSE(testing::RayEntersVoxel(grid, voxel, view.centre, testing::PixelDirection(view, pixel), &t))
               << "pixel " << pixel << " of voxel " << index << " not drawn";
           ++outside_projection_in_box;
         }

@@ -387,6 +387,23 @@ TEST_F(CommandLine, BenchmarkComparesTheThreeMethodsInATableAPlotAndJson) {
   const std::string carve_report = testing::ReadFileBytes(out + "/gvc/report.json");
   EXPECT_NE(carve_report.find("\"visibility\": \"gvc\""), std::string::npos) << carve_report;
   EXPECT_GE(JsonNumber(carve_report, "passes"), 2.0);
+
+  // render draws a cloud into chosen cameras of the model.
+  ASSERT_EQ(Run("render --input " + out + "/benchmark/cloud_ray.ply --input_path " + Project() +
+                    "/sparse/0 --image_path " + Project() + "/images --output_path " + out +
+                    "/render --image_names view002.png --point_size 0.1",
+                &output),
+            0)
+      << output;
+  const cv::Mat silhouette = cv::imread(out + "/render/view002.png.silhouette.png", cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(silhouette.empty());
+  EXPECT_EQ(silhouette.cols, 96);
+  EXPECT_GT(cv::countNonZero(silhouette), 200);  // the carved scene covers much of the view
+  EXPECT_TRUE(fs::is_regular_file(out + "/render/view002.png.side.png"));
+  EXPECT_FALSE(fs::exists(out + "/render/view001.png.render.png"));
+  ExpectUserError("render --input " + out + "/benchmark/cloud_ray.ply --input_path " + Project() +
+                      "/sparse/0 --output_path " + out + "/render --image_names nope.png",
+                  {"no image named 'nope.png'"});
 }
 
 TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {

@@ -1,0 +1,95 @@
+// raycarve render: a coloured cloud drawn into the cameras of a COLMAP model.
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/atomic_file.h"
+#include "calib/input_error.h"
+#include "calib/model_reader.h"
+#include "export/point_cloud_io.h"
+#include "export/point_renderer.h"
+#include "plugin/commands.h"
+
+namespace raycarve {
+namespace {
+
+void WriteImage(const std::string& path, const cv::Mat& image) {
+  const std::string temporary = TemporaryPathFor(path);
+  if (!cv::imwrite(temporary, image)) throw InputError(temporary + ": cannot write the image");
+  RenameIntoPlace(temporary, path);
+}
+
+}  // namespace
+
+int RunRender(int argc, char** argv) {
+  std::string input, model_path, image_path, output_path, names;
+  double point_size = 0.0;
+  OptionParser parser(
+      "render",
+      "Draws a coloured point cloud (raycarve's cloud.ply, COLMAP's fused.ply) into cameras of a "
+      "COLMAP model, z-buffered splats: writes <name>.render.png and <name>.silhouette.png per "
+      "camera (undistorted, pinhole), and with --image_path <name>.side.png (photo | render).");
+  parser.AddRequired("input", &input, "PLY point cloud to draw");
+  parser.AddRequired("input_path", &model_path, "COLMAP model whose cameras draw it");
+  parser.AddRequired("output_path", &output_path, "folder for the images (created)");
+  parser.AddDefault("image_path", &image_path, "the model's photos, for side-by-side images");
+  parser.AddDefault("image_names", &names, "comma-separated image names (default: every image)");
+  parser.AddDefault("point_size", &point_size,
+                    "splat size in world units (a carved cloud's voxel size); 0: one pixel");
+  if (!parser.Parse(argc, argv)) return 0;
+  if (!(point_size >= 0.0)) throw InputError("raycarve render: --point_size must be >= 0");
+  const Reconstruction model = ReadModel(model_path);
+  const std::vector<exporter::ColouredPoint> points = exporter::ReadPointCloudPly(input);
+  std::set<std::string> wanted;
+  std::stringstream list(names);
+  std::string name;
+  while (std::getline(list, name, ',')) {
+    if (!name.empty()) wanted.insert(name);
+  }
+  std::error_code error;
+  std::filesystem::create_directories(output_path, error);
+  if (error) throw InputError(output_path + ": cannot create: " + error.message());
+  CheckOutputDoesNotOverwrite(output_path, model_path, "input model");
+  int rendered = 0;
+  for (const auto& [id, image] : model.images) {
+    if (!wanted.empty() && !wanted.count(image.name)) continue;
+    wanted.erase(image.name);
+    const Camera& camera = model.cameras.at(image.camera_id);
+    cv::Mat rgb(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC3,
+                cv::Scalar(0, 0, 0));
+    std::string source = "(no photo)";
+    if (!image_path.empty()) {
+      source = image_path + "/" + image.name;
+      const cv::Mat bgr = cv::imread(source, cv::IMREAD_COLOR);
+      if (bgr.empty()) throw InputError(source + ": cannot read the photo of image " + image.name);
+      cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    }
+    const CalibratedView view = MakeCalibratedView(camera, image, rgb, source);
+    const exporter::Rendering rendering = exporter::RenderPoints(points, view, point_size);
+    const std::string stem =
+        (std::filesystem::path(output_path) / std::filesystem::path(image.name).filename()).string();
+    cv::Mat bgr;
+    cv::cvtColor(rendering.image, bgr, cv::COLOR_RGB2BGR);
+    WriteImage(stem + ".render.png", bgr);
+    WriteImage(stem + ".silhouette.png", rendering.silhouette);
+    if (!image_path.empty()) {
+      cv::Mat side;
+      cv::hconcat(view.image, rendering.image, side);
+      cv::cvtColor(side, side, cv::COLOR_RGB2BGR);
+      WriteImage(stem + ".side.png", side);
+    }
+    ++rendered;
+  }
+  if (!wanted.empty()) {
+    throw InputError(model_path + ": no image named '" + *wanted.begin() + "' in the model");
+  }
+  std::printf("render: drew %zu points into %d cameras of %s; images in %s\n", points.size(),
+              rendered, model_path.c_str(), output_path.c_str());
+  return 0;
+}
+
+}  // namespace raycarve

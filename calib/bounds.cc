@@ -27,6 +27,10 @@ bool BoundsOptions::IsValid(std::string* reason) const {
     *reason = "min_track_length must be >= 0";
     return false;
   }
+  if (min_points < 1) {
+    *reason = "min_points must be >= 1";
+    return false;
+  }
   if (!(trim_fraction >= 0.0 && trim_fraction < 0.5)) {
     *reason = "trim_fraction must be in [0, 0.5)";
     return false;
@@ -88,6 +92,13 @@ Bounds ComputeBounds(const Reconstruction& reconstruction,
             << ", " << bounds.num_high_error << " with error > " << options.max_reprojection_error
             << " px); relax the filters or give an explicit box (--bbox)";
     throw InputError(message.str());
+  }
+  if (bounds.num_used < options.min_points) {
+    throw InputError(source + ": only " + std::to_string(bounds.num_used) + " usable 3D points (of " +
+                     std::to_string(bounds.num_points) + "), fewer than " +
+                     std::to_string(options.min_points) +
+                     ": too few to bound the volume reliably; give an explicit box (--bbox "
+                     "x0,y0,z0,x1,y1,z1) or lower --min_points");
   }
   Eigen::Vector3d min, max;
   std::vector<double> values(used.size());

@@ -21,6 +21,9 @@ struct BoundsOptions {
   double trim_fraction = 0.01;
   // Added on every side, as a fraction of the trimmed box's largest extent.
   double margin = 0.1;
+  // Fewer usable points than this cannot be trusted to span the object: an error asking for an
+  // explicit box.
+  int min_points = 20;
 
   // False, with the reason, when a field is out of its range.
   bool IsValid(std::string* reason) const;

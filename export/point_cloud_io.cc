@@ -1,5 +1,7 @@
 #include "export/point_cloud_io.h"
 
+#include <fstream>
+
 #include <filesystem>
 
 #include <pcl/console/print.h>
@@ -58,6 +60,19 @@ void WritePointCloudPly(const std::vector<ColouredPoint>& points, const std::str
   cloud.width = static_cast<uint32_t>(cloud.size());
   cloud.height = 1;
   const std::string temporary = TemporaryPathFor(path);
+  if (cloud.empty()) {
+    // PCL refuses to write an empty cloud; an empty carve still gets a valid PLY, with the same
+    // properties, that every reader opens.
+    std::ofstream file(temporary, std::ios::binary);
+    file << "ply\nformat binary_little_endian 1.0\ncomment raycarve: no points\nelement vertex 0\n"
+            "property float x\nproperty float y\nproperty float z\nproperty float nx\n"
+            "property float ny\nproperty float nz\nproperty uchar red\nproperty uchar green\n"
+            "property uchar blue\nend_header\n";
+    if (!file) throw InputError(temporary + ": cannot write the point cloud");
+    file.close();
+    RenameIntoPlace(temporary, path);
+    return;
+  }
   pcl::PLYWriter writer;
   if (writer.write(temporary, cloud, /*binary=*/true, /*use_camera=*/false) != 0) {
     throw InputError(temporary + ": PCL could not write the point cloud");

@@ -48,6 +48,8 @@ void AddBoundsFlags(OptionParser* parser, BoundsFlags* flags) {
                      "<= 0 keeps all");
   parser->AddDefault("trim_fraction", &flags->options.trim_fraction,
                      "fraction of points dropped at each end of each axis (outliers)");
+  parser->AddDefault("min_points", &flags->options.min_points,
+                     "fewest usable sparse points that may bound the volume (else --bbox is asked for)");
   parser->AddDefault("margin", &flags->options.margin,
                      "added on every side, as a fraction of the largest extent");
   parser->AddDefault("bbox", &flags->bbox,

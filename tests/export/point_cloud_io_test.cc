@@ -51,6 +51,16 @@ TEST(PointCloudIo, WritesBinaryPlyWithFusedPlyPropertiesAndReadsItBack) {
   std::filesystem::remove_all(folder);
 }
 
+TEST(PointCloudIo, AnEmptyCloudIsWrittenAsAValidEmptyPly) {
+  const std::string path = testing::MakeTemporaryDirectory("empty_ply") + "/empty.ply";
+  WritePointCloudPly({}, path);
+  const std::string bytes = testing::ReadFileBytes(path);
+  EXPECT_EQ(bytes.rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+  EXPECT_NE(bytes.find("element vertex 0\n"), std::string::npos);
+  EXPECT_NE(bytes.find("property uchar blue\nend_header\n"), std::string::npos);
+  EXPECT_TRUE(ReadPointCloudPly(path).empty());
+}
+
 TEST(PointCloudIo, MissingOrBrokenFilesAreNamed) {
   const std::string folder = testing::MakeTemporaryDirectory("ply_bad");
   EXPECT_THROW(ReadPointCloudPly(folder + "/none.ply"), InputError);

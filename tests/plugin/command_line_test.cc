@@ -413,6 +413,22 @@ TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
   ExpectUserError(base + " --threshold nan", {"threshold must be a finite number"});
   ExpectUserError(base + " --consistency median", {"not one of: mean_colour, standard_deviation"});
   ExpectUserError(base + " --method zbuffer", {"not one of: ray, gvc, gvc_ldi"});
+
+  // A model with very few points asks for an explicit box, and carves with one.
+  const std::string few = *root_ + "/few_points";
+  std::string output;
+  ASSERT_EQ(Run("synth --output_path " + few + " --views 3 --width 64 --height 48 --points 6",
+                &output),
+            0)
+      << output;
+  ExpectUserError("carve --workspace_path " + few + " --output_path " + few + "/out",
+                  {"few_points/sparse/0: only", "too few to bound the volume", "--bbox"});
+  EXPECT_EQ(Run("carve --workspace_path " + few + " --output_path " + few +
+                    "/out --resolution 16 --bbox=-1.5,-1.5,0,1.5,1.5,1.1",
+                &output),
+            0)
+      << output;
+  EXPECT_TRUE(fs::is_regular_file(few + "/out/cloud.ply"));
 }
 
 }  // namespace

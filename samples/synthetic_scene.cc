@@ -413,9 +413,26 @@ bool SceneKindFromString(const std::string& text, SceneKind* kind) {
 }
 
 std::string DefaultTeapotPath() {
+  const std::string relative = "teapot/teapot_bezier.txt";
   const char* data = std::getenv("RAYCARVE_DATA_DIR");
-  const std::string root = data != nullptr && *data != '\0' ? data : "../shared/data";
-  return root + "/teapot/teapot_bezier.txt";
+  if (data != nullptr && *data != '\0') return std::string(data) + "/" + relative;
+  // ../shared/data beside the working folder, or beside the source tree the program was built
+  // in (build/plugin/raycarve: three folders up).
+  std::vector<std::filesystem::path> candidates = {std::filesystem::path("../shared/data")};
+  std::error_code error;
+  const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    for (std::filesystem::path folder = program.parent_path(); folder.has_relative_path();
+         folder = folder.parent_path()) {
+      candidates.push_back(folder / "../shared/data");
+    }
+  }
+  for (const std::filesystem::path& candidate : candidates) {
+    if (std::filesystem::exists(candidate / relative, error)) {
+      return (candidate / relative).lexically_normal().string();
+    }
+  }
+  return (candidates.front() / relative).string();
 }
 
 std::shared_ptr<const SceneGeometry> MakeSceneGeometry(const SyntheticSceneOptions& options) {
@@ -427,6 +444,10 @@ std::shared_ptr<const SceneGeometry> MakeSceneGeometry(const SyntheticSceneOptio
   geometry->box_min = Eigen::Vector3d(0.55, 0.55, 0.0);
   geometry->box_max = Eigen::Vector3d(1.15, 1.15, 0.6);
   const std::string path = options.teapot_path.empty() ? DefaultTeapotPath() : options.teapot_path;
+  if (!std::filesystem::exists(path)) {
+    throw InputError(path + ": the teapot's Bezier patches are not there; give --teapot_path or "
+                            "set RAYCARVE_DATA_DIR to the shared data folder");
+  }
   geometry->teapot = std::make_unique<TriangleMesh>(ReadBezierTeapot(
       path, options.teapot_tessellation, 0.3, Eigen::Vector3d(0.25, -0.35, 0.0)));
   double total = 0.0;

@@ -26,8 +26,9 @@ enum class SceneKind { kSimple, kPaper };
 std::string SceneKindToString(SceneKind kind);
 bool SceneKindFromString(const std::string& text, SceneKind* kind);
 
-// Where the paper's scene reads the teapot's Bezier patches: $RAYCARVE_DATA_DIR or
-// ../shared/data, then teapot/teapot_bezier.txt.
+// Where the paper's scene reads the teapot's Bezier patches: teapot/teapot_bezier.txt in
+// $RAYCARVE_DATA_DIR, else in the first ../shared/data found beside the working folder or beside
+// a folder holding the program.
 std::string DefaultTeapotPath();
 
 struct SceneGeometry;

@@ -17,9 +17,12 @@ namespace fs = std::filesystem;
 
 std::string Raycarve() { return "'" + testing::RaycarveBinary() + "' "; }
 
-// The generated scene is not used here: its renders give COLMAP 750-1200 SIFT features a photo
-// and at most 61 inliers a pair (12 views of 480x360), too few for the mapper to grow a model
-// (measured). The real temple photos work.
+// COLMAP on the generated scene does not give usable cameras, so the real temple ring is the
+// reference here. Measured: on the plain renders (12 views of 480x360) SIFT finds 750-1200
+// features a photo and at most 61 inliers a pair, and the mapper grows no model; with a fine
+// speckle added to every texture it registers all 12 photos, but in two clusters on opposite
+// sides (the repeating checkers and sky patches mislead the matching), which no similarity maps
+// onto the generated ring.
 TEST(ColmapSfm, RegistersTheTempleRingWhereItsCalibrationPutsItAndTheProjectCarves) {
   RAYCARVE_REQUIRE_COLMAP();
   RAYCARVE_REQUIRE_DATA("middlebury/templeSparseRing");

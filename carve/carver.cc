@@ -89,6 +89,20 @@ bool CarveMethodFromString(const std::string& text, CarveMethod* method) {
   return false;
 }
 
+std::string CarveDecisionToString(CarveDecision decision) {
+  return decision == CarveDecision::kThreshold ? "threshold" : "reprojection";
+}
+
+bool CarveDecisionFromString(const std::string& text, CarveDecision* decision) {
+  for (CarveDecision candidate : {CarveDecision::kThreshold, CarveDecision::kReprojection}) {
+    if (text == CarveDecisionToString(candidate)) {
+      *decision = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
 std::string CarveOrderToString(CarveOrder order) {
   return order == CarveOrder::kFifo ? "fifo" : "visible_pixels";
 }
@@ -133,6 +147,10 @@ bool CarveOptions::IsValid(std::string* reason) const {
   }
   if (min_views < 1) {
     *reason = "min_views must be >= 1";
+    return false;
+  }
+  if (decision == CarveDecision::kReprojection && method != CarveMethod::kRay) {
+    *reason = "the reprojection decision needs ray casting (--method ray)";
     return false;
   }
   std::vector<int> resolutions;
@@ -211,9 +229,16 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
       visibility_(factory ? factory(views, volume_) : MakeVisibility(views, volume_, options)),
       test_(options.consistency, options.threshold, options.min_views, options.adaptive_threshold),
       order_(options.order),
+      decision_(options.decision),
+      threshold_(options.threshold),
       queued_((volume_.grid().num_voxels() + 63) / 64, 0) {
   std::string reason;
   CHECK(options.IsValid(&reason)) << reason;
+  for (const CalibratedView& view : views) {
+    const cv::Mat usable = view.mask.empty() ? view.valid : (view.valid & view.mask);
+    usable_pixels_ += usable.empty() ? static_cast<int64_t>(view.width) * view.height
+                                     : cv::countNonZero(usable);
+  }
   for (int64_t voxel : volume_.SurfaceVoxels()) Enqueue(voxel);
   max_queue_ = queue_size();
 }
@@ -269,7 +294,14 @@ bool IncrementalCarver::Step() {
   }
   if (!volume_.IsSolid(voxel)) return true;
   ++evaluated_;
-  if (Evaluate(voxel).consistent) return true;
+  const Consistency consistency = Evaluate(voxel);
+  // The threshold carves what is inconsistent; the reprojection decision also carves consistent
+  // voxels whose pixels the voxels behind them explain better (floaters consistent by chance).
+  if (consistency.consistent &&
+      (decision_ == CarveDecision::kThreshold || !consistency.judged ||
+       ReprojectionChange(voxel, consistency.colour) >= 0.0)) {
+    return true;
+  }
   exposed_.clear();
   changed_.clear();
   volume_.Carve(voxel, &exposed_);
@@ -287,6 +319,8 @@ bool IncrementalCarver::Step() {
 
 std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
   std::vector<ColouredVoxel> surface;
+  double error = 0.0;
+  int64_t explained = 0;
   for (int64_t voxel : volume_.SurfaceVoxels()) {
     const Consistency consistency = Evaluate(voxel);
     ColouredVoxel coloured;
@@ -295,8 +329,59 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
     coloured.num_views = consistency.num_views;
     coloured.num_pixels = consistency.num_pixels;
     surface.push_back(coloured);
+    for (const PixelRef& ref : vis_) error += (PixelColour(ref) - consistency.colour).norm();
+    explained += static_cast<int64_t>(vis_.size());
   }
+  error += threshold_ * static_cast<double>(std::max<int64_t>(0, usable_pixels_ - explained));
+  surface_reprojection_error_ = usable_pixels_ == 0 ? 0.0 : error / usable_pixels_;
   return surface;
+}
+
+double IncrementalCarver::ReprojectionChange(int64_t voxel, const Eigen::Vector3d& colour) {
+  RayCastVisibility* rays = ray_visibility();
+  CHECK(rays != nullptr) << "the reprojection decision needs ray casting";
+  (void)voxel;
+  double change = 0.0;
+  arrivals_.clear();
+  for (size_t i = 0; i < vis_.size(); ++i) {
+    change -= (PixelColour(vis_[i]) - colour).norm();
+    const int64_t next =
+        rays->rays(vis_[i].view).PeekBeyondCurrent(static_cast<int>(vis_[i].pixel), volume_);
+    if (next == RayImage::kNoVoxel) {
+      change += threshold_;  // the pixel would be explained by nothing
+    } else {
+      arrivals_.emplace_back(next, static_cast<int>(i));
+    }
+  }
+  std::sort(arrivals_.begin(), arrivals_.end());
+  for (size_t begin = 0; begin < arrivals_.size();) {
+    size_t end = begin;
+    while (end < arrivals_.size() && arrivals_[end].first == arrivals_[begin].first) ++end;
+    next_vis_.clear();
+    visibility_->ComputeVis(arrivals_[begin].first, &next_vis_);
+    Eigen::Vector3d old_sum = Eigen::Vector3d::Zero(), new_sum;
+    for (const PixelRef& ref : next_vis_) old_sum += PixelColour(ref);
+    new_sum = old_sum;
+    for (size_t k = begin; k < end; ++k) new_sum += PixelColour(vis_[arrivals_[k].second]);
+    const Eigen::Vector3d new_mean = new_sum / static_cast<double>(next_vis_.size() + end - begin);
+    if (!next_vis_.empty()) {
+      const Eigen::Vector3d old_mean = old_sum / static_cast<double>(next_vis_.size());
+      for (const PixelRef& ref : next_vis_) {
+        const Eigen::Vector3d c = PixelColour(ref);
+        change += (c - new_mean).norm() - (c - old_mean).norm();
+      }
+    }
+    for (size_t k = begin; k < end; ++k) {
+      change += (PixelColour(vis_[arrivals_[k].second]) - new_mean).norm();
+    }
+    begin = end;
+  }
+  return change;
+}
+
+double IncrementalCarver::MeanReprojectionError() {
+  ColourSurface();
+  return surface_reprojection_error_;
 }
 
 size_t IncrementalCarver::MemoryBytes() const {
@@ -356,6 +441,9 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       statistics.visual_hull_seconds = carver->visual_hull().seconds;
       statistics.setup_seconds = SecondsSince(level_start);
       hull_carved = std::min(final_grid.num_voxels(), carver->visual_hull().carved * scale);
+      if (options.decision == CarveDecision::kReprojection) {
+        statistics.reprojection_error_before = carver->MeanReprojectionError();
+      }
       start = Clock::now();
     }
     auto sample = [&](double seconds) {
@@ -398,6 +486,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   const Clock::time_point colour_start = Clock::now();
   CarveResult result{carver->volume().grid()};
   result.surface = carver->ColourSurface();
+  statistics.reprojection_error_after = carver->surface_reprojection_error();
   for (const ColouredVoxel& voxel : result.surface) {
     if (voxel.num_pixels > 0) ++statistics.visible_surface;
   }

@@ -38,6 +38,14 @@ enum class CarveOrder {
 std::string CarveOrderToString(CarveOrder order);
 bool CarveOrderFromString(const std::string& text, CarveOrder* order);
 
+// How a voxel is judged (the seed paper's section 4).
+enum class CarveDecision {
+  kThreshold,     // carve when the consistency error exceeds the threshold
+  kReprojection,  // also carve consistent voxels when that lowers the pixels' reprojection error
+};
+std::string CarveDecisionToString(CarveDecision decision);
+bool CarveDecisionFromString(const std::string& text, CarveDecision* decision);
+
 // Incremental voxel colouring with ray-cast visibility (Batchelor, Mukundan, Green).
 struct CarveOptions {
   CarveMethod method = CarveMethod::kRay;
@@ -62,6 +70,14 @@ struct CarveOptions {
   // pixels are always left out of Vis(V) and consistency).
   bool visual_hull = true;
   CarveOrder order = CarveOrder::kFifo;
+  // kReprojection (ray casting only; after Slabaugh et al., carving only): besides what the
+  // threshold carves, a consistent V is carved when the pixels of Vis(V) would be explained
+  // better by the voxels their rays reach next (each such voxel's colour recomputed with them)
+  // than by V: the summed |pixel - colour| of the pixels involved drops. A pixel whose ray would
+  // leave the volume costs `threshold`. Voxels seen by fewer than min_views views are kept.
+  // (Alone, the reprojection test stalls in empty space, where V and the voxels behind it
+  // explain the pixels equally badly: measured, it carved 4% of the demo volume.)
+  CarveDecision decision = CarveDecision::kThreshold;
   // Levels of detail (Prock and Dyer): 1 carves at `resolution` directly; L > 1 carves at
   // resolution / 2^(L-1) first, then augments by lod_band voxels, subdivides and carves again, up
   // to `resolution` (which must be divisible by 2^(L-1)).
@@ -113,6 +129,11 @@ struct CarveStatistics {
   size_t peak_memory_bytes = 0;  // volume, visibility structures and the CVSVL
   std::vector<CurveSample> curve;
   std::vector<LevelStatistics> levels;  // one per level of detail (one without)
+  // The mean over usable pixels of |pixel - colour of the voxel it sees| (RGB), a pixel seeing
+  // no voxel counting `threshold`: after carving, and (with the reprojection decision, as it
+  // costs a pass over the surface) before; -1 when not computed.
+  double reprojection_error_before = -1.0;
+  double reprojection_error_after = -1.0;
 
   std::string Summary() const;
 };
@@ -159,8 +180,10 @@ class IncrementalCarver {
   // queues the voxels those rays reach. Returns false once the CVSVL is empty (converged).
   bool Step();
 
-  // Colours every surface voxel from its current visible pixels.
+  // Colours every surface voxel from its current visible pixels (and measures the mean
+  // reprojection error, surface_reprojection_error()).
   std::vector<ColouredVoxel> ColourSurface();
+  double surface_reprojection_error() const { return surface_reprojection_error_; }
 
   const Volume& volume() const { return volume_; }
   const VisualHullStatistics& visual_hull() const { return visual_hull_; }
@@ -174,6 +197,9 @@ class IncrementalCarver {
   size_t queue_size() const { return queue_.size() + heap_.size(); }
   // Volume, visibility structures and the CVSVL at its largest so far.
   size_t MemoryBytes() const;
+  // The mean reprojection error over usable pixels (see CarveStatistics); costs an evaluation of
+  // every surface voxel.
+  double MeanReprojectionError();
 
  private:
   void Enqueue(int64_t voxel);
@@ -181,6 +207,13 @@ class IncrementalCarver {
   bool Pop(int64_t* voxel);
   // Vis(V) into vis_ and its consistency.
   Consistency Evaluate(int64_t voxel);
+  // With vis_ holding Vis(V) and `colour` V's colour: the change of the reprojection error of
+  // the pixels involved if V were carved (negative: carving explains them better).
+  double ReprojectionChange(int64_t voxel, const Eigen::Vector3d& colour);
+  Eigen::Vector3d PixelColour(const PixelRef& ref) const {
+    const uint8_t* rgb = views_[ref.view].image.data + 3 * static_cast<size_t>(ref.pixel);
+    return Eigen::Vector3d(rgb[0], rgb[1], rgb[2]);
+  }
 
   const std::vector<CalibratedView>& views_;
   VisualHullStatistics visual_hull_;  // declared before volume_: filled while volume_ is built
@@ -188,6 +221,12 @@ class IncrementalCarver {
   std::unique_ptr<Visibility> visibility_;
   ConsistencyTest test_;
   CarveOrder order_;
+  CarveDecision decision_;
+  double threshold_;
+  int64_t usable_pixels_ = 0;
+  double surface_reprojection_error_ = -1.0;
+  std::vector<std::pair<int64_t, int>> arrivals_;  // (voxel reached next, index into vis_)
+  std::vector<PixelRef> next_vis_;
   std::deque<int64_t> queue_;                             // first in, first out
   std::priority_queue<std::pair<int64_t, int64_t>> heap_;  // (|Vis|, voxel), most first
   std::vector<uint64_t> queued_;

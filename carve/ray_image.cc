@@ -91,14 +91,11 @@ void RayImage::Initialise(const Volume& volume) {
   }
 }
 
-int64_t RayImage::Advance(int pixel, const Volume& volume) {
-  const uint64_t key = keys_[pixel];
-  if (key == kInactive) return kNoVoxel;
+int64_t RayImage::Step(int pixel, const Volume& volume, int voxel[3], float t_max[3],
+                       bool skip_current) const {
   const Eigen::Vector3i& n = grid_.dimensions();
-  int voxel[3] = {static_cast<int>(key & 0xffff), static_cast<int>((key >> 16) & 0xffff),
-                  static_cast<int>((key >> 32) & 0xffff)};
   int64_t index = voxel[0] + static_cast<int64_t>(n.x()) * (voxel[1] + static_cast<int64_t>(n.y()) * voxel[2]);
-  if (volume.IsSolid(index)) return index;
+  if (!skip_current && volume.IsSolid(index)) return index;
   const Eigen::Vector3d d = GridDirection(pixel);
   int step[3];
   float t_delta[3];
@@ -107,22 +104,34 @@ int64_t RayImage::Advance(int pixel, const Volume& volume) {
     step[axis] = d[axis] > 0.0 ? 1 : -1;
     t_delta[axis] = 1.0f / std::abs(static_cast<float>(d[axis]));  // inf along an axis plane
   }
-  float* t_max = t_max_[pixel].axis;
   while (true) {
     const int axis = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2)
                                          : (t_max[1] < t_max[2] ? 1 : 2);
     voxel[axis] += step[axis];
-    if (voxel[axis] < 0 || voxel[axis] >= n[axis]) {
-      keys_[pixel] = kInactive;
-      return kNoVoxel;
-    }
+    if (voxel[axis] < 0 || voxel[axis] >= n[axis]) return kNoVoxel;
     t_max[axis] += t_delta[axis];
     index += step[axis] * stride[axis];
-    if (volume.IsSolid(index)) {
-      keys_[pixel] = Key(Eigen::Vector3i(voxel[0], voxel[1], voxel[2]));
-      return index;
-    }
+    if (volume.IsSolid(index)) return index;
   }
+}
+
+int64_t RayImage::Advance(int pixel, const Volume& volume) {
+  const uint64_t key = keys_[pixel];
+  if (key == kInactive) return kNoVoxel;
+  int voxel[3] = {static_cast<int>(key & 0xffff), static_cast<int>((key >> 16) & 0xffff),
+                  static_cast<int>((key >> 32) & 0xffff)};
+  const int64_t index = Step(pixel, volume, voxel, t_max_[pixel].axis, /*skip_current=*/false);
+  keys_[pixel] = index == kNoVoxel ? kInactive : Key(Eigen::Vector3i(voxel[0], voxel[1], voxel[2]));
+  return index;
+}
+
+int64_t RayImage::PeekBeyondCurrent(int pixel, const Volume& volume) const {
+  const uint64_t key = keys_[pixel];
+  if (key == kInactive) return kNoVoxel;
+  int voxel[3] = {static_cast<int>(key & 0xffff), static_cast<int>((key >> 16) & 0xffff),
+                  static_cast<int>((key >> 32) & 0xffff)};
+  float t_max[3] = {t_max_[pixel].axis[0], t_max_[pixel].axis[1], t_max_[pixel].axis[2]};
+  return Step(pixel, volume, voxel, t_max, /*skip_current=*/true);
 }
 
 }  // namespace raycarve

@@ -64,6 +64,10 @@ class RayImage {
   // Cost: one step per voxel passed (Amanatides-Woo).
   int64_t Advance(int pixel, const Volume& volume);
 
+  // The voxel the ray at `pixel` would reach if its current voxel were carved: the first solid
+  // voxel of `volume` beyond it, or kNoVoxel. Changes nothing.
+  int64_t PeekBeyondCurrent(int pixel, const Volume& volume) const;
+
   // The ray parameter convention: world point = centre + t * Direction(pixel).
   Eigen::Vector3d Direction(int pixel) const;
 
@@ -83,6 +87,9 @@ class RayImage {
   }
 
   void InitialiseRay(int pixel);
+  // Steps from voxel/t_max (updated in place) until a solid voxel (returned, its index) or the
+  // box's edge (kNoVoxel). With `skip_current`, the starting voxel counts as empty.
+  int64_t Step(int pixel, const Volume& volume, int voxel[3], float t_max[3], bool skip_current) const;
   // The direction in grid units (voxel size 1) for `pixel`.
   Eigen::Vector3d GridDirection(int pixel) const;
 

@@ -149,6 +149,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
       .Key("min_views").Value(request.options.min_views)
       .Key("order").Value(CarveOrderToString(request.options.order))
+      .Key("decision").Value(CarveDecisionToString(request.options.decision))
       .Key("lod_levels").Value(request.options.lod_levels)
       .Key("lod_band").Value(request.options.lod_band)
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
@@ -197,6 +198,8 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("carved").Value(s.carved)
       .Key("evaluated").Value(s.evaluated)
       .Key("passes").Value(s.passes)
+      .Key("reprojection_error_before").Value(s.reprojection_error_before)
+      .Key("reprojection_error_after").Value(s.reprojection_error_after)
       .Key("final_solid").Value(s.final_solid)
       .Key("final_surface").Value(s.final_surface)
       .Key("visible_surface").Value(s.visible_surface)
@@ -246,6 +249,7 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   text->vis_lookup = VisLookupToString(request->options.vis_lookup);
   text->method = CarveMethodToString(request->options.method);
   text->order = CarveOrderToString(request->options.order);
+  text->decision = CarveDecisionToString(request->options.decision);
   parser->AddDefault("workspace_path", &request->workspace_path,
                      "COLMAP project (sparse/0 or sparse or dense/sparse, with images/)");
   parser->AddDefault("input_path", &request->input_path, "model folder, overriding the workspace's");
@@ -278,6 +282,10 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "order of the voxels to judge: first in first out, or most visible pixels "
                      "first",
                      {"fifo", "visible_pixels"});
+  parser->AddDefault("decision", &text->decision,
+                     "carve when the error exceeds --threshold, or when carving lowers the "
+                     "reprojection error of the pixels involved (ray casting only)",
+                     {"threshold", "reprojection"});
   parser->AddDefault("lod_levels", &request->options.lod_levels,
                      "levels of detail: carve at resolution / 2^(L-1) first, then refine (the "
                      "resolution must be divisible by 2^(L-1)); 1: no levels");
@@ -309,6 +317,7 @@ void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
   VisLookupFromString(text.vis_lookup, &request->options.vis_lookup);
   CarveMethodFromString(text.method, &request->options.method);
   CarveOrderFromString(text.order, &request->options.order);
+  CarveDecisionFromString(text.decision, &request->options.decision);
   request->view_options.background.mode =
       ParseBackground(text.background, &request->view_options.background.colour);
   request->background = text.background;

@@ -120,6 +120,7 @@ struct CarveFlagText {
   std::string vis_lookup;
   std::string method;
   std::string order;
+  std::string decision;
   std::string background = "auto";
 };
 void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* text);

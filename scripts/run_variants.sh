@@ -30,6 +30,7 @@ run() {
 }
 run fifo
 run visible_pixels --order visible_pixels
+run reprojection --decision reprojection
 for levels in 2 3 4; do
   for band in 1 2; do run "lod${levels}_band${band}" --lod_levels "$levels" --lod_band "$band"; done
 done

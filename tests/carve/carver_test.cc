@@ -247,6 +247,34 @@ TEST(CarveVolume, LevelsOfDetailAndEvidenceOrderReachPhotoConsistentVolumesOfThe
   }
 }
 
+TEST(CarveVolume, TheReprojectionDecisionCarvesMoreAndLowersTheReprojectionError) {
+  const SyntheticScene scene = Scene(6, 160, 120);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  CarveOptions options = Options(48, 30.0);
+  const CarveResult threshold = CarveVolume(views, scene.object_box, options);
+  options.decision = CarveDecision::kReprojection;
+  const CarveResult reprojection = CarveVolume(views, scene.object_box, options);
+  std::printf("carved %lld and %lld; mean reprojection error: threshold %.3f, reprojection %.3f "
+              "(from %.3f)\n",
+              static_cast<long long>(threshold.statistics.carved),
+              static_cast<long long>(reprojection.statistics.carved),
+              threshold.statistics.reprojection_error_after,
+              reprojection.statistics.reprojection_error_after,
+              reprojection.statistics.reprojection_error_before);
+  EXPECT_EQ(threshold.statistics.reprojection_error_before, -1.0);
+  EXPECT_GT(threshold.statistics.reprojection_error_after, 0.0);
+  EXPECT_GT(reprojection.statistics.reprojection_error_before,
+            reprojection.statistics.reprojection_error_after);
+  // It carves what the threshold carves and more; the pixels end up explained at least as well.
+  EXPECT_GT(reprojection.statistics.carved, threshold.statistics.carved);
+  EXPECT_LE(reprojection.statistics.reprojection_error_after,
+            threshold.statistics.reprojection_error_after);
+  std::string reason;
+  options.method = CarveMethod::kGvc;
+  EXPECT_FALSE(options.IsValid(&reason));
+  EXPECT_NE(reason.find("needs ray casting"), std::string::npos) << reason;
+}
+
 // GVC judges with buffers rendered at the start of each pass: a subset of each voxel's current
 // Vis. The paper's weighted mean-colour test is not monotone in the pixel set (a subset can be
 // inconsistent where the whole is consistent), so stale buffers carve voxels that current

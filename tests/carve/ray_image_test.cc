@@ -158,5 +158,32 @@ TEST(RayImage, StepsToTheNextSolidVoxelAfterCarving) {
   EXPECT_EQ(rays.Advance(0, volume), next);  // already solid: stays
 }
 
+TEST(RayImage, PeekingBeyondTheCurrentVoxelChangesNothingAndFindsWhatAdvanceWouldReach) {
+  Volume volume(kGrid);
+  Eigen::Matrix3d down = Eigen::Matrix3d::Zero();
+  down.col(2) = Eigen::Vector3d(0, 0, -1);
+  RayImage rays(kGrid, down, Eigen::Vector3d(0.1, 0.1, 2), 1, 1);
+  rays.Initialise(volume);
+  const int64_t top = rays.CurrentVoxel(0);
+  const int64_t below = kGrid.Index(kGrid.Voxel(top) - Eigen::Vector3i(0, 0, 1));
+  EXPECT_EQ(rays.PeekBeyondCurrent(0, volume), below);
+  volume.Carve(below, nullptr);  // then the one after it
+  const int64_t two_below = kGrid.Index(kGrid.Voxel(top) - Eigen::Vector3i(0, 0, 2));
+  EXPECT_EQ(rays.PeekBeyondCurrent(0, volume), two_below);
+  EXPECT_EQ(rays.CurrentVoxel(0), top);  // unchanged
+  volume.Carve(top, nullptr);
+  EXPECT_EQ(rays.Advance(0, volume), two_below);
+  // The last voxel of the column: nothing beyond it.
+  for (int64_t voxel = rays.CurrentVoxel(0); voxel != RayImage::kNoVoxel;
+       voxel = rays.Advance(0, volume)) {
+    if (rays.PeekBeyondCurrent(0, volume) == RayImage::kNoVoxel) {
+      EXPECT_EQ(kGrid.Voxel(voxel).z(), 0);
+      return;
+    }
+    volume.Carve(voxel, nullptr);
+  }
+  FAIL() << "the column ended without a voxel with nothing beyond it";
+}
+
 }  // namespace
 }  // namespace raycarve

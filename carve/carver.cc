@@ -227,6 +227,7 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
     : views_(views),
       volume_(WithVisualHull(views, std::move(start), options, &visual_hull_)),
       visibility_(factory ? factory(views, volume_) : MakeVisibility(views, volume_, options)),
+      ray_visibility_(dynamic_cast<RayCastVisibility*>(visibility_.get())),
       test_(options.consistency, options.threshold, options.min_views, options.adaptive_threshold),
       order_(options.order),
       decision_(options.decision),
@@ -299,7 +300,7 @@ bool IncrementalCarver::Step() {
   // voxels whose pixels the voxels behind them explain better (floaters consistent by chance).
   if (consistency.consistent &&
       (decision_ == CarveDecision::kThreshold || !consistency.judged ||
-       ReprojectionChange(voxel, consistency.colour) >= 0.0)) {
+       ReprojectionChange(consistency.colour) >= 0.0)) {
     return true;
   }
   exposed_.clear();
@@ -337,10 +338,9 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
   return surface;
 }
 
-double IncrementalCarver::ReprojectionChange(int64_t voxel, const Eigen::Vector3d& colour) {
-  RayCastVisibility* rays = ray_visibility();
+double IncrementalCarver::ReprojectionChange(const Eigen::Vector3d& colour) {
+  RayCastVisibility* rays = ray_visibility_;
   CHECK(rays != nullptr) << "the reprojection decision needs ray casting";
-  (void)voxel;
   double change = 0.0;
   arrivals_.clear();
   for (size_t i = 0; i < vis_.size(); ++i) {

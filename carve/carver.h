@@ -190,7 +190,7 @@ class IncrementalCarver {
   Volume* mutable_volume() { return &volume_; }
   Visibility& visibility() { return *visibility_; }
   // The ray-cast visibility, or nullptr with another method.
-  RayCastVisibility* ray_visibility() { return dynamic_cast<RayCastVisibility*>(visibility_.get()); }
+  RayCastVisibility* ray_visibility() { return ray_visibility_; }
   int passes() const { return passes_; }
   int64_t evaluated() const { return evaluated_; }
   int64_t carved() const { return carved_; }
@@ -209,7 +209,7 @@ class IncrementalCarver {
   Consistency Evaluate(int64_t voxel);
   // With vis_ holding Vis(V) and `colour` V's colour: the change of the reprojection error of
   // the pixels involved if V were carved (negative: carving explains them better).
-  double ReprojectionChange(int64_t voxel, const Eigen::Vector3d& colour);
+  double ReprojectionChange(const Eigen::Vector3d& colour);
   Eigen::Vector3d PixelColour(const PixelRef& ref) const {
     const uint8_t* rgb = views_[ref.view].image.data + 3 * static_cast<size_t>(ref.pixel);
     return Eigen::Vector3d(rgb[0], rgb[1], rgb[2]);
@@ -219,6 +219,7 @@ class IncrementalCarver {
   VisualHullStatistics visual_hull_;  // declared before volume_: filled while volume_ is built
   Volume volume_;
   std::unique_ptr<Visibility> visibility_;
+  RayCastVisibility* ray_visibility_;  // visibility_ when it is ray casting, else nullptr
   ConsistencyTest test_;
   CarveOrder order_;
   CarveDecision decision_;

@@ -84,6 +84,18 @@ std::vector<ColouredPoint> ReadPointCloudPly(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) {
     throw InputError(path + ": point cloud file not found");
   }
+  {
+    // A PLY with no vertices (an empty carve) is valid; PCL's reader would index its empty
+    // buffer, so it is answered here from the header.
+    std::ifstream file(path, std::ios::binary);
+    std::string line;
+    while (std::getline(file, line) && line.rfind("end_header", 0) != 0) {
+      if (line.rfind("element vertex ", 0) != 0) continue;
+      std::string count = line.substr(15);
+      count.erase(count.find_last_not_of(" \t\r") + 1);
+      if (count == "0") return {};
+    }
+  }
   pcl::PointCloud<pcl::PointXYZRGBNormal> cloud;
   pcl::PLYReader reader;
   // Fields a file lacks (curvature, normals, colours) are expected; only errors are worth saying.

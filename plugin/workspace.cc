@@ -19,7 +19,8 @@ bool HoldsModel(const std::filesystem::path& folder) {
          std::filesystem::exists(folder / "cameras.txt");
 }
 
-// Registered images of a model: images.bin's leading count, or half the data lines of images.txt.
+// Registered images of a model: images.bin's leading count, or half the lines of images.txt
+// after its comments.
 int64_t CountImages(const std::filesystem::path& model) {
   std::ifstream binary(model / "images.bin", std::ios::binary);
   if (binary) {
@@ -30,8 +31,9 @@ int64_t CountImages(const std::filesystem::path& model) {
   std::ifstream text(model / "images.txt");
   int64_t lines = 0;
   std::string line;
-  while (std::getline(text, line)) lines += !line.empty() && line[0] != '#';
-  return (lines + 1) / 2;
+  // Two lines an image; the second (its points) is empty for an image without observations.
+  while (std::getline(text, line)) lines += line.empty() || line[0] != '#';
+  return lines / 2;
 }
 
 }  // namespace

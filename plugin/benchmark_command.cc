@@ -4,9 +4,7 @@
 #include <sstream>
 
 #include <glog/logging.h>
-#include <opencv2/imgcodecs.hpp>
 
-#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "carve/carver.h"
 #include "export/carve_export.h"
@@ -41,12 +39,6 @@ std::vector<CarveMethod> ParseMethods(const std::string& text) {
   }
   if (methods.empty()) throw InputError("raycarve benchmark: --methods is empty");
   return methods;
-}
-
-void WritePng(const std::string& path, const cv::Mat& image) {
-  const std::string temporary = TemporaryPathFor(path);
-  if (!cv::imwrite(temporary, image)) throw InputError(temporary + ": cannot write the image");
-  RenameIntoPlace(temporary, path);
 }
 
 }  // namespace
@@ -223,7 +215,7 @@ int RunBenchmark(int argc, char** argv) {
   title << "Voxels carved against time: " << project.views.size() << " views, "
         << first.dimensions.x() << "x" << first.dimensions.y() << "x" << first.dimensions.z()
         << " voxels";
-  WritePng((out / "figure6.png").string(),
+  WriteImageAtomically((out / "figure6.png").string(),
            exporter::DrawLinePlot(series, {title.str(), "seconds", "voxels carved (colouring)"}));
   WriteTextFileAtomically((out / "figure6.csv").string(), csv.str());
   WriteTextFileAtomically((out / "table.md").string(),

@@ -5,10 +5,8 @@
 #include <iostream>
 
 #include <glog/logging.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
 #include "calib/view_reader.h"
@@ -25,13 +23,6 @@ double Median(std::vector<double> values) {
   const size_t middle = values.size() / 2;
   std::nth_element(values.begin(), values.begin() + middle, values.end());
   return values[middle];
-}
-
-// Writes in the format of the path's extension, through a temporary name and a rename.
-void WriteImageAtomically(const std::string& path, const cv::Mat& image) {
-  const std::string temporary = TemporaryPathFor(path);
-  if (!cv::imwrite(temporary, image)) throw InputError(temporary + ": cannot write the image");
-  RenameIntoPlace(temporary, path);
 }
 
 }  // namespace

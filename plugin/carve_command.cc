@@ -6,9 +6,7 @@
 #include <sstream>
 
 #include <glog/logging.h>
-#include <opencv2/imgcodecs.hpp>
 
-#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
 #include "calib/view_reader.h"
@@ -118,9 +116,7 @@ CarveRun CarveProject(const CarveRequest& request) {
     const std::filesystem::path mask_path = out / "masks" / (view.name + ".png");
     std::filesystem::create_directories(mask_path.parent_path(), error);
     if (error) throw InputError(mask_path.parent_path().string() + ": cannot create: " + error.message());
-    const std::string temporary = TemporaryPathFor(mask_path.string());
-    if (!cv::imwrite(temporary, view.mask)) throw InputError(temporary + ": cannot write the mask");
-    RenameIntoPlace(temporary, mask_path.string());
+    WriteImageAtomically(mask_path.string(), view.mask);
   }
 
   std::ostringstream csv;

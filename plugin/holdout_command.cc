@@ -4,10 +4,8 @@
 #include <iostream>
 
 #include <glog/logging.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "carve/carver.h"
 #include "export/carve_export.h"
@@ -91,9 +89,7 @@ int RunHoldout(int argc, char** argv) {
     cv::Mat bgr;
     cv::cvtColor(exporter::SideBySide(rendering, view), bgr, cv::COLOR_RGB2BGR);
     const std::string path = (out / (std::filesystem::path(view.name).stem().string() + ".png")).string();
-    const std::string temporary = TemporaryPathFor(path);
-    if (!cv::imwrite(temporary, bgr)) throw InputError(temporary + ": cannot write the image");
-    RenameIntoPlace(temporary, path);
+    WriteImageAtomically(path, bgr);
   }
   json.EndArray();
   const double mean_psnr = psnr_sum / held_out.size();

@@ -7,6 +7,7 @@
 #include <locale>
 
 #include <glog/logging.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
@@ -173,5 +174,11 @@ void WriteTextFileAtomically(const std::string& path, const std::string& text) {
 }
 
 std::vector<double> JsonArray(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+void WriteImageAtomically(const std::string& path, const cv::Mat& image) {
+  const std::string temporary = TemporaryPathFor(path);
+  if (!cv::imwrite(temporary, image)) throw InputError(temporary + ": cannot write the image");
+  RenameIntoPlace(temporary, path);
+}
 
 }  // namespace raycarve

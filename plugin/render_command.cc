@@ -7,24 +7,14 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
 #include "export/point_cloud_io.h"
 #include "export/point_renderer.h"
 #include "plugin/commands.h"
+#include "plugin/json_writer.h"
 
 namespace raycarve {
-namespace {
-
-void WriteImage(const std::string& path, const cv::Mat& image) {
-  const std::string temporary = TemporaryPathFor(path);
-  if (!cv::imwrite(temporary, image)) throw InputError(temporary + ": cannot write the image");
-  RenameIntoPlace(temporary, path);
-}
-
-}  // namespace
-
 int RunRender(int argc, char** argv) {
   std::string input, model_path, image_path, output_path, names;
   double point_size = 0.0;
@@ -74,13 +64,13 @@ int RunRender(int argc, char** argv) {
         (std::filesystem::path(output_path) / std::filesystem::path(image.name).filename()).string();
     cv::Mat bgr;
     cv::cvtColor(rendering.image, bgr, cv::COLOR_RGB2BGR);
-    WriteImage(stem + ".render.png", bgr);
-    WriteImage(stem + ".silhouette.png", rendering.silhouette);
+    WriteImageAtomically(stem + ".render.png", bgr);
+    WriteImageAtomically(stem + ".silhouette.png", rendering.silhouette);
     if (!image_path.empty()) {
       cv::Mat side;
       cv::hconcat(view.image, rendering.image, side);
       cv::cvtColor(side, side, cv::COLOR_RGB2BGR);
-      WriteImage(stem + ".side.png", side);
+      WriteImageAtomically(stem + ".side.png", side);
     }
     ++rendered;
   }

@@ -36,6 +36,9 @@ int main(int argc, char** argv) {
   std::vector<raycarve::VisLookup> lookups = {raycarve::VisLookup::kFootprint,
                                               raycarve::VisLookup::kRayLists};
   double threshold = 30.0;
+  // One thread (the paper's setting) and every hardware thread; ray lists always use one.
+  std::vector<int> thread_counts = {1};
+  if (raycarve::ResolveNumThreads(-1) > 1) thread_counts.push_back(raycarve::ResolveNumThreads(-1));
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
     if (flag == "--views") scene_options.num_views = std::stoi(value);
@@ -50,11 +53,12 @@ int main(int argc, char** argv) {
       }
       if (value != "both") lookups = {lookup};
     }
-    else if (flag == "--resolutions") {
-      resolutions.clear();
+    else if (flag == "--resolutions" || flag == "--threads") {
+      std::vector<int>& numbers = flag == "--threads" ? thread_counts : resolutions;
+      numbers.clear();
       std::stringstream list(value);
       std::string item;
-      while (std::getline(list, item, ',')) resolutions.push_back(std::stoi(item));
+      while (std::getline(list, item, ',')) numbers.push_back(std::stoi(item));
     } else {
       std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
       return 1;
@@ -74,17 +78,21 @@ int main(int argc, char** argv) {
         scene.reconstruction.cameras.at(image.camera_id), image, scene.photos.at(image_id), image.name));
   }
 
-  std::printf("%-10s %-10s %-14s %10s %10s %12s %12s %12s %12s\n", "resolution", "vis", "grid",
-              "set-up s", "converge s", "memory MiB", "peak RSS MiB", "carved", "evaluated");
+  std::printf("%-10s %-10s %-7s %-14s %10s %10s %12s %12s %12s %12s\n", "resolution", "vis",
+              "threads", "grid", "set-up s", "converge s", "memory MiB", "peak RSS MiB", "carved",
+              "evaluated");
   std::ostringstream json;
   json << "[";
   bool first = true;
   for (size_t k = 0; k < resolutions.size(); ++k) {
    for (const raycarve::VisLookup lookup : lookups) {
+   for (const int threads : thread_counts) {
+    if (lookup == raycarve::VisLookup::kRayLists && threads != thread_counts.front()) continue;
     raycarve::CarveOptions options;
     options.resolution = resolutions[k];
     options.threshold = threshold;
     options.vis_lookup = lookup;
+    options.num_threads = lookup == raycarve::VisLookup::kRayLists ? 1 : threads;
     const std::string vis = raycarve::VisLookupToString(lookup);
     if (!raycarve::CheckCarveFits(views, scene.object_box, options, &reason)) {
       std::fprintf(stderr, "resolution %d: %s\n", resolutions[k], reason.c_str());
@@ -95,19 +103,21 @@ int main(int argc, char** argv) {
     char grid[32];
     std::snprintf(grid, sizeof(grid), "%dx%dx%d", s.dimensions.x(), s.dimensions.y(), s.dimensions.z());
     const double memory = s.peak_memory_bytes / (1024.0 * 1024.0);
-    std::printf("%-10d %-10s %-14s %10.2f %10.2f %12.1f %12.1f %12lld %12lld\n", resolutions[k],
-                vis.c_str(), grid,
+    std::printf("%-10d %-10s %-7d %-14s %10.2f %10.2f %12.1f %12.1f %12lld %12lld\n",
+                resolutions[k], vis.c_str(), options.num_threads, grid,
                 s.setup_seconds, s.carve_seconds, memory, PeakResidentMiB(),
                 static_cast<long long>(s.carved), static_cast<long long>(s.evaluated));
     std::fflush(stdout);
     json << (first ? "" : ",") << "\n  {\"resolution\": " << resolutions[k]
-         << ", \"vis_lookup\": \"" << vis << "\", \"grid\": \"" << grid
+         << ", \"vis_lookup\": \"" << vis << "\", \"threads\": " << options.num_threads
+         << ", \"grid\": \"" << grid
          << "\", \"views\": " << views.size() << ", \"width\": " << scene_options.width
          << ", \"height\": " << scene_options.height << ", \"setup_seconds\": " << s.setup_seconds
          << ", \"convergence_seconds\": " << s.carve_seconds << ", \"memory_mib\": " << memory
          << ", \"peak_rss_mib\": " << PeakResidentMiB() << ", \"carved\": " << s.carved
          << ", \"evaluated\": " << s.evaluated << "}";
     first = false;
+   }
    }
   }
   json << "\n]\n";

@@ -1,8 +1,8 @@
 #include "carve/carver.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <algorithm>
 #include <deque>
 #include <sstream>
 
@@ -10,7 +10,7 @@
 
 #include "carve/item_buffer_visibility.h"
 #include "carve/layered_depth_visibility.h"
-
+#include "carve/ray_image.h"
 
 namespace raycarve {
 namespace {
@@ -21,8 +21,8 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-constexpr double kBytesPerRay = 20.0;
-constexpr double kBytesPerListedRay = 24.0;
+constexpr double kBytesPerRay = 4.0;
+constexpr double kBytesPerListedRay = 8.0;
 // GVC: a 4-byte item per pixel (and one view's depth buffer, counted as 4 more bytes a pixel).
 constexpr double kBytesPerItemPixel = 8.0;
 // GVC-LDI: a 4-byte head per pixel and 12-byte entries; a ray crosses the surface a few times
@@ -119,7 +119,8 @@ bool CarveOrderFromString(const std::string& text, CarveOrder* order) {
 
 std::unique_ptr<Visibility> MakeVisibility(const std::vector<CalibratedView>& views,
                                            const Volume& volume,
-                                           const CarveOptions& options) {
+                                           const CarveOptions& options,
+                                           ViewWorkers* workers) {
   switch (options.method) {
     case CarveMethod::kGvc:
       return std::make_unique<ItemBufferVisibility>(views, volume);
@@ -129,7 +130,7 @@ std::unique_ptr<Visibility> MakeVisibility(const std::vector<CalibratedView>& vi
       break;
   }
   return std::make_unique<RayCastVisibility>(views, volume, options.vis_lookup,
-                                             options.order == CarveOrder::kVisiblePixels);
+                                             options.order == CarveOrder::kVisiblePixels, workers);
 }
 
 bool CarveOptions::IsValid(std::string* reason) const {
@@ -171,7 +172,8 @@ std::string CarveStatistics::Summary() const {
   text.precision(3);
   text << visibility << " carving of a " << dimensions.x() << "x" << dimensions.y() << "x"
        << dimensions.z() << " grid: " << carved << " voxels carved, " << evaluated
-       << " evaluated in " << carve_seconds << " s (set-up " << setup_seconds << " s), "
+       << " evaluated in " << carve_seconds << " s on " << threads
+       << (threads == 1 ? " thread" : " threads") << " (set-up " << setup_seconds << " s), "
        << final_surface << " surface voxels (" << visible_surface << " seen), peak memory "
        << peak_memory_bytes / (1024.0 * 1024.0) << " MiB";
   return text.str();
@@ -205,6 +207,14 @@ bool CheckCarveFits(const std::vector<CalibratedView>& views,
                      max_bytes - ray_bytes, reason)) {
     return false;
   }
+  if (options.method == CarveMethod::kRay &&
+      !RayImage::KeyBitsFit(VoxelGrid(box, options.resolution).dimensions())) {
+    const Eigen::Vector3i n = VoxelGrid(box, options.resolution).dimensions();
+    *reason = "rays keep a grid's voxel coordinates in 31 bits; " + std::to_string(n.x()) + "x" +
+              std::to_string(n.y()) + "x" + std::to_string(n.z()) +
+              " needs more: use a lower resolution";
+    return false;
+  }
   if (options.method != CarveMethod::kRay &&
       VoxelGrid(box, options.resolution).num_voxels() >= (int64_t{1} << 32) - 1) {
     *reason = CarveMethodToString(options.method) +
@@ -226,7 +236,10 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                                      const VisibilityFactory& factory)
     : views_(views),
       volume_(WithVisualHull(views, std::move(start), options, &visual_hull_)),
-      visibility_(factory ? factory(views, volume_) : MakeVisibility(views, volume_, options)),
+      workers_(static_cast<int>(views.size()),
+               options.method == CarveMethod::kRay ? options.num_threads : 1),
+      visibility_(factory ? factory(views, volume_)
+                          : MakeVisibility(views, volume_, options, &workers_)),
       ray_visibility_(dynamic_cast<RayCastVisibility*>(visibility_.get())),
       test_(options.consistency, options.threshold, options.min_views, options.adaptive_threshold),
       order_(options.order),
@@ -240,6 +253,9 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
     usable_pixels_ += usable.empty() ? static_cast<int64_t>(view.width) * view.height
                                      : cv::countNonZero(usable);
   }
+  view_parallel_ = ray_visibility_ != nullptr && ray_visibility_->ViewParallel() &&
+                   order_ == CarveOrder::kFifo && workers_.num_groups() > 1;
+  if (view_parallel_) groups_.resize(workers_.num_groups());
   for (int64_t voxel : volume_.SurfaceVoxels()) Enqueue(voxel);
   max_queue_ = queue_size();
 }
@@ -278,10 +294,85 @@ bool IncrementalCarver::Pop(int64_t* voxel) {
 }
 
 Consistency IncrementalCarver::Evaluate(int64_t voxel) {
-  vis_.clear();
-  visibility_->ComputeVis(voxel, &vis_);
-  GatherColours(views_, vis_, &stats_);
+  if (!view_parallel_) {
+    vis_.clear();
+    visibility_->ComputeVis(voxel, &vis_);
+    GatherColours(views_, vis_, &stats_);
+  } else if (prefetched_ != voxel) {
+    RunViewGroups(nullptr, voxel);
+  }
+  prefetched_ = -1;
   return test_.Evaluate(stats_);
+}
+
+void IncrementalCarver::RunViewGroups(const std::vector<PixelRef>* advance, int64_t vis_voxel) {
+  const int num_views = static_cast<int>(views_.size());
+  // `advance` is in view order: view v's pixels are [advance_begin_[v], advance_begin_[v + 1]).
+  if (advance != nullptr) {
+    advance_begin_.assign(num_views + 1, 0);
+    for (const PixelRef& ref : *advance) ++advance_begin_[ref.view + 1];
+    for (int view = 0; view < num_views; ++view) advance_begin_[view + 1] += advance_begin_[view];
+  }
+  const Eigen::Vector3i vis_coordinates =
+      vis_voxel >= 0 ? volume_.grid().Voxel(vis_voxel) : Eigen::Vector3i::Zero();
+  auto task = [&](int group) {
+    GroupBuffers& buffers = groups_[group];
+    buffers.changed.clear();
+    buffers.vis.clear();
+    buffers.stats.clear();
+    buffers.changed_end.clear();
+    buffers.vis_end.clear();
+    buffers.stats_end.clear();
+    for (int view = group; view < num_views; view += workers_.num_groups()) {
+      if (advance != nullptr) {
+        ray_visibility_->AdvanceRays(advance->data() + advance_begin_[view],
+                                     advance->data() + advance_begin_[view + 1], &buffers.changed);
+      }
+      buffers.changed_end.push_back(buffers.changed.size());
+      if (vis_voxel >= 0) {
+        const size_t first = buffers.vis.size();
+        ray_visibility_->ComputeVisInView(vis_coordinates, view, &buffers.vis);
+        if (buffers.vis.size() > first) {
+          ViewColourStats stats;
+          stats.view = view;
+          for (size_t i = first; i < buffers.vis.size(); ++i) {
+            const uint8_t* rgb = views_[view].image.data + 3 * static_cast<size_t>(buffers.vis[i].pixel);
+            stats.Add(Eigen::Vector3d(rgb[0], rgb[1], rgb[2]));
+          }
+          buffers.stats.push_back(stats);
+        }
+      }
+      buffers.vis_end.push_back(buffers.vis.size());
+      buffers.stats_end.push_back(buffers.stats.size());
+    }
+  };
+  workers_.Run(task);
+  // Merged view by view: exactly what one thread would have produced.
+  if (vis_voxel >= 0) {
+    vis_.clear();
+    stats_.clear();
+  }
+  const int num_groups = workers_.num_groups();
+  for (int view = 0; view < num_views; ++view) {
+    const GroupBuffers& buffers = groups_[view % num_groups];
+    const int k = view / num_groups;  // the view's place in its group
+    const auto append = [k](const auto& from, const std::vector<size_t>& ends, auto* to) {
+      const size_t begin = k == 0 ? 0 : ends[k - 1];
+      to->insert(to->end(), from.begin() + begin, from.begin() + ends[k]);
+    };
+    append(buffers.changed, buffers.changed_end, &changed_);
+    if (vis_voxel >= 0) {
+      append(buffers.vis, buffers.vis_end, &vis_);
+      append(buffers.stats, buffers.stats_end, &stats_);
+    }
+  }
+}
+
+int64_t IncrementalCarver::PeekNextSolid() const {
+  if (order_ != CarveOrder::kFifo || queue_.empty()) return -1;
+  const int64_t voxel = queue_.front();
+  const bool queued = (queued_[voxel >> 6] >> (voxel & 63)) & 1;
+  return queued && volume_.IsSolid(voxel) ? voxel : -1;
 }
 
 bool IncrementalCarver::Step() {
@@ -306,7 +397,14 @@ bool IncrementalCarver::Step() {
   exposed_.clear();
   changed_.clear();
   volume_.Carve(voxel, &exposed_);
-  visibility_->UpdateAfterCarve(voxel, vis_, exposed_, &changed_);
+  if (view_parallel_) {
+    // One task steps the rays and finds Vis of the voxel evaluated next (fifo: the front of
+    // the queue, which the voxels queued below go behind), saving a second hand-over.
+    prefetched_ = PeekNextSolid();
+    RunViewGroups(&vis_, prefetched_);
+  } else {
+    visibility_->UpdateAfterCarve(voxel, vis_, exposed_, &changed_);
+  }
   if (order_ != CarveOrder::kFifo) {
     // One entry per voxel, with its count after every ray has arrived.
     std::sort(changed_.begin(), changed_.end());
@@ -475,6 +573,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     statistics.levels.push_back(level_statistics);
     statistics.evaluated += carver->evaluated();
     statistics.passes = std::max(statistics.passes, carver->passes());
+    statistics.threads = carver->threads();
     statistics.peak_memory_bytes = std::max(statistics.peak_memory_bytes, carver->MemoryBytes());
   }
   statistics.carve_seconds = SecondsSince(start);

@@ -15,6 +15,7 @@
 #include "carve/consistency.h"
 #include "carve/level_of_detail.h"
 #include "carve/ray_cast_visibility.h"
+#include "carve/view_workers.h"
 #include "carve/visual_hull.h"
 #include "carve/volume.h"
 
@@ -83,6 +84,11 @@ struct CarveOptions {
   // to `resolution` (which must be divisible by 2^(L-1)).
   int lod_levels = 1;
   int lod_band = 1;
+  // Threads for ray casting with the footprint lookup and fifo order: each takes every n-th view
+  // (rays are per view) for Vis(V), colour gathering and stepping rays (see view_workers.h).
+  // The carving is identical for any count. < 1: one per hardware thread. Other methods, ray
+  // lists and the evidence order use one.
+  int num_threads = 1;
 
   bool IsValid(std::string* reason) const;
 };
@@ -109,6 +115,7 @@ struct CurveSample {
 struct CarveStatistics {
   std::string visibility;  // "ray (footprint)", "ray (ray_lists)", "gvc" or "gvc_ldi"
   int passes = 1;          // GVC: item-buffer renders (passes over the surface); others 1
+  int threads = 1;         // threads of the final level's carving
   int views_with_masks = 0;
   int64_t visual_hull_carved = 0;    // voxels removed by the silhouette pre-carve
   double visual_hull_seconds = 0.0;  // its time (part of set-up)
@@ -192,6 +199,8 @@ class IncrementalCarver {
   // The ray-cast visibility, or nullptr with another method.
   RayCastVisibility* ray_visibility() { return ray_visibility_; }
   int passes() const { return passes_; }
+  // Threads the carving runs on (1 unless view-parallel ray casting).
+  int threads() const { return view_parallel_ ? workers_.num_groups() : 1; }
   int64_t evaluated() const { return evaluated_; }
   int64_t carved() const { return carved_; }
   size_t queue_size() const { return queue_.size() + heap_.size(); }
@@ -207,6 +216,12 @@ class IncrementalCarver {
   bool Pop(int64_t* voxel);
   // Vis(V) into vis_ and its consistency.
   Consistency Evaluate(int64_t voxel);
+  // View-parallel ray casting: one task over the views' groups that first steps the rays of
+  // `advance` (when not null; the voxels they reach go to changed_), then finds Vis of
+  // `vis_voxel` and its colour statistics (when >= 0; into vis_ and stats_).
+  void RunViewGroups(const std::vector<PixelRef>* advance, int64_t vis_voxel);
+  // The voxel Pop will hand out next if it is known now and still solid (fifo only), else -1.
+  int64_t PeekNextSolid() const;
   // With vis_ holding Vis(V) and `colour` V's colour: the change of the reprojection error of
   // the pixels involved if V were carved (negative: carving explains them better).
   double ReprojectionChange(const Eigen::Vector3d& colour);
@@ -215,11 +230,28 @@ class IncrementalCarver {
     return Eigen::Vector3d(rgb[0], rgb[1], rgb[2]);
   }
 
+  // Per group of views, its own buffers (on cache lines of their own): what its views gave, one
+  // after another, with where each view's part ends.
+  struct alignas(64) GroupBuffers {
+    std::vector<PixelRef> vis;
+    std::vector<ViewColourStats> stats;
+    std::vector<int64_t> changed;
+    std::vector<size_t> vis_end;
+    std::vector<size_t> stats_end;
+    std::vector<size_t> changed_end;
+  };
+
   const std::vector<CalibratedView>& views_;
   VisualHullStatistics visual_hull_;  // declared before volume_: filled while volume_ is built
   Volume volume_;
+  ViewWorkers workers_;  // declared before visibility_, which uses it to set up rays
   std::unique_ptr<Visibility> visibility_;
   RayCastVisibility* ray_visibility_;  // visibility_ when it is ray casting, else nullptr
+  // Ray casting spread over workers_ (see CarveOptions::num_threads).
+  bool view_parallel_ = false;
+  std::vector<GroupBuffers> groups_;
+  std::vector<size_t> advance_begin_;  // per view: where its pixels start in the rays to step
+  int64_t prefetched_ = -1;  // the voxel whose Vis and statistics vis_ and stats_ already hold
   ConsistencyTest test_;
   CarveOrder order_;
   CarveDecision decision_;
@@ -241,14 +273,16 @@ class IncrementalCarver {
   std::vector<int64_t> changed_;
 };
 
+// The visibility of `method` over `volume` (both must outlive it); `workers`, when given, set
+// up ray casting's rays in parallel.
+std::unique_ptr<Visibility> MakeVisibility(const std::vector<CalibratedView>& views,
+                                           const Volume& volume,
+                                           const CarveOptions& options,
+                                           ViewWorkers* workers = nullptr);
+
 // Estimates the memory of carving `views` over `box` with `options` and returns false, with a
 // reason giving the sizes, when the options are invalid or the estimate exceeds
 // options.max_memory_gib.
-// The visibility of `method` over `volume` (both must outlive it).
-std::unique_ptr<Visibility> MakeVisibility(const std::vector<CalibratedView>& views,
-                                           const Volume& volume,
-                                           const CarveOptions& options);
-
 bool CheckCarveFits(const std::vector<CalibratedView>& views,
                     const Eigen::AlignedBox3d& box,
                     const CarveOptions& options,

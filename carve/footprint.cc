@@ -25,15 +25,16 @@ Footprint ComputeFootprint(const Eigen::Matrix<double, 3, 4>& P,
     if (c & 2) h += ey;
     if (c & 4) h += ez;
     if (!(h.z() > 0.0)) return Footprint();
-    const double x = h.x() / h.z(), y = h.y() / h.z();
+    const double inverse_depth = 1.0 / h.z();
+    const double x = h.x() * inverse_depth, y = h.y() * inverse_depth;
     x_min = std::min(x_min, x);
     x_max = std::max(x_max, x);
     y_min = std::min(y_min, y);
     y_max = std::max(y_max, y);
   }
-  // Pixel centres c + 0.5 within [x_min, x_max], with kSlackPx to spare: rays are stepped with
-  // float parameters, so a ray grazing an edge may be in a voxel whose exact projection misses
-  // its pixel centre by a hair; without slack such a ray would be missed and never stepped.
+  // Pixel centres c + 0.5 within [x_min, x_max], with kSlackPx to spare: rays are stepped in
+  // floating point, so a ray grazing an edge may be in a voxel whose exact projection misses its
+  // pixel centre by a hair; without slack such a ray would be missed and never stepped.
   Footprint footprint;
   footprint.col_min = std::max(0, static_cast<int>(std::ceil(x_min - 0.5 - kSlackPx)));
   footprint.col_max = std::min(width - 1, static_cast<int>(std::floor(x_max - 0.5 + kSlackPx)));

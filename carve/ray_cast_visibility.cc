@@ -26,27 +26,39 @@ bool VisLookupFromString(const std::string& text, VisLookup* lookup) {
 RayCastVisibility::RayCastVisibility(const std::vector<CalibratedView>& views,
                                      const Volume& volume,
                                      VisLookup lookup,
-                                     bool count_rays)
-    : views_(views), volume_(volume), lookup_(lookup) {
-  rays_.reserve(views.size());
+                                     bool count_rays,
+                                     ViewWorkers* workers)
+    : views_(views), volume_(volume), lookup_(lookup), rays_(views.size()) {
   int64_t total = 0;
   for (const CalibratedView& view : views) {
-    const Eigen::Matrix3d world_from_pixel =
-        view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse();
-    // Rays only where the view holds photo data on the object: background pixels never enter
-    // Vis(V) or consistency.
-    const cv::Mat usable = view.mask.empty() ? view.valid : (view.valid & view.mask);
-    rays_.emplace_back(volume.grid(), world_from_pixel, view.centre, view.width, view.height,
-                       usable);
-    rays_.back().Initialise(volume);
     view_offset_.push_back(static_cast<int32_t>(total));
     total += static_cast<int64_t>(view.width) * view.height;
   }
+  auto make_rays = [&](int view) {
+    const CalibratedView& v = views[view];
+    const Eigen::Matrix3d world_from_pixel =
+        v.cam_from_world.rotation.toRotationMatrix().transpose() * v.K.inverse();
+    // Rays only where the view holds photo data on the object: background pixels never enter
+    // Vis(V) or consistency.
+    const cv::Mat usable = v.mask.empty() ? v.valid : (v.valid & v.mask);
+    rays_[view] = std::make_unique<RayImage>(volume.grid(), world_from_pixel, v.centre, v.width,
+                                             v.height, usable);
+    rays_[view]->Initialise(volume);
+  };
+  if (workers != nullptr && workers->num_groups() > 1 &&
+      workers->num_views() == static_cast<int>(views.size())) {
+    auto task = [&](int group) {
+      for (int view : workers->ViewsOf(group)) make_rays(view);
+    };
+    workers->Run(task);
+  } else {
+    for (int view = 0; view < static_cast<int>(views.size()); ++view) make_rays(view);
+  }
   if (count_rays) {
     counts_.assign(volume.grid().num_voxels(), 0);
-    for (const RayImage& rays : rays_) {
-      for (int pixel = 0; pixel < rays.num_pixels(); ++pixel) {
-        const int64_t current = rays.CurrentVoxel(pixel);
+    for (const std::unique_ptr<RayImage>& rays : rays_) {
+      for (int pixel = 0; pixel < rays->num_pixels(); ++pixel) {
+        const int64_t current = rays->CurrentVoxel(pixel);
         if (current != RayImage::kNoVoxel && counts_[current] != UINT16_MAX) ++counts_[current];
       }
     }
@@ -57,8 +69,8 @@ RayCastVisibility::RayCastVisibility(const std::vector<CalibratedView>& views,
   next_.assign(total, -1);
   // Linked in reverse so that each list starts in row-major order (ComputeVis sorts anyway).
   for (int v = static_cast<int>(views.size()) - 1; v >= 0; --v) {
-    for (int pixel = rays_[v].num_pixels() - 1; pixel >= 0; --pixel) {
-      const int64_t current = rays_[v].CurrentVoxel(pixel);
+    for (int pixel = rays_[v]->num_pixels() - 1; pixel >= 0; --pixel) {
+      const int64_t current = rays_[v]->CurrentVoxel(pixel);
       if (current != RayImage::kNoVoxel) Link(view_offset_[v] + pixel, current);
     }
   }
@@ -78,14 +90,29 @@ void RayCastVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels)
     return;
   }
   const Eigen::Vector3i coordinates = volume_.grid().Voxel(voxel);
-  const uint64_t key = RayImage::Key(coordinates);
-  for (size_t v = 0; v < views_.size(); ++v) {
-    const CalibratedView& view = views_[v];
-    const Footprint footprint =
-        ComputeFootprint(view.P, view.width, view.height, volume_.grid(), coordinates);
-    const uint64_t* keys = rays_[v].keys();
-    AppendMatchingPixels(footprint, view.width, static_cast<uint32_t>(v),
-                         [&](int pixel) { return keys[pixel] == key; }, pixels);
+  for (int view = 0; view < static_cast<int>(views_.size()); ++view) {
+    ComputeVisInView(coordinates, view, pixels);
+  }
+}
+
+void RayCastVisibility::ComputeVisInView(const Eigen::Vector3i& voxel,
+                                         int view,
+                                         std::vector<PixelRef>* pixels) const {
+  const CalibratedView& v = views_[view];
+  const Footprint footprint = ComputeFootprint(v.P, v.width, v.height, volume_.grid(), voxel);
+  const uint32_t key = rays_[view]->Key(voxel);
+  const uint32_t* keys = rays_[view]->keys();
+  AppendMatchingPixels(footprint, v.width, static_cast<uint32_t>(view),
+                       [&](int pixel) { return keys[pixel] == key; }, pixels);
+}
+
+void RayCastVisibility::AdvanceRays(const PixelRef* begin,
+                                    const PixelRef* end,
+                                    std::vector<int64_t>* reached) {
+  CHECK(ViewParallel());
+  for (const PixelRef* ref = begin; ref != end; ++ref) {
+    const int64_t next = rays_[ref->view]->Advance(static_cast<int>(ref->pixel), volume_);
+    if (next != RayImage::kNoVoxel) reached->push_back(next);
   }
 }
 
@@ -97,7 +124,7 @@ void RayCastVisibility::UpdateAfterCarve(int64_t voxel,
   if (lookup_ == VisLookup::kRayLists) head_[voxel] = -1;
   if (!counts_.empty()) counts_[voxel] = 0;
   for (const PixelRef& ref : vis) {
-    const int64_t next = rays_[ref.view].Advance(static_cast<int>(ref.pixel), volume_);
+    const int64_t next = rays_[ref.view]->Advance(static_cast<int>(ref.pixel), volume_);
     if (next == RayImage::kNoVoxel) continue;
     changed->push_back(next);
     if (!counts_.empty() && counts_[next] != UINT16_MAX) ++counts_[next];
@@ -113,7 +140,7 @@ int64_t RayCastVisibility::CountVis(int64_t voxel) {
 size_t RayCastVisibility::MemoryBytes() const {
   size_t bytes = (head_.capacity() + next_.capacity()) * sizeof(int32_t) +
                  counts_.capacity() * sizeof(uint16_t);
-  for (const RayImage& rays : rays_) bytes += rays.MemoryBytes();
+  for (const std::unique_ptr<RayImage>& rays : rays_) bytes += rays->MemoryBytes();
   return bytes;
 }
 

@@ -1,10 +1,12 @@
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "calib/calibrated_view.h"
 #include "carve/ray_image.h"
+#include "carve/view_workers.h"
 #include "carve/visibility.h"
 #include "carve/volume.h"
 
@@ -24,15 +26,22 @@ bool VisLookupFromString(const std::string& text, VisLookup* lookup);
 // same pixels in the same order (view by view, row-major). Carving V steps only the rays of
 // Vis(V) to their next solid voxel, which is reported as changed. Pixels without photo data
 // (view.valid == 0) or on background (view.mask == 0 when there is a mask) get no ray.
+//
+// Each view's rays are independent of the others', so with the footprint lookup and no ray
+// counts (ViewParallel) the carver may find Vis(V) and step rays one view at a time on several
+// threads: ComputeVisInView and AdvanceRays for different views may run at once (the volume
+// unchanged meanwhile), and concatenated in view order they give exactly ComputeVis and what
+// UpdateAfterCarve reports.
 class RayCastVisibility : public Visibility {
  public:
   // `volume` must outlive this object; rays start at its first solid voxels. With `count_rays`,
   // a count per voxel of the rays ending in it is kept (2 bytes a voxel, saturating at 65535)
-  // so that CountVis costs nothing.
+  // so that CountVis costs nothing. With `workers`, the views' rays are set up in parallel.
   RayCastVisibility(const std::vector<CalibratedView>& views,
                     const Volume& volume,
                     VisLookup lookup = VisLookup::kFootprint,
-                    bool count_rays = false);
+                    bool count_rays = false,
+                    ViewWorkers* workers = nullptr);
 
   std::string Name() const override { return "ray"; }
   void ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels) override;
@@ -43,7 +52,14 @@ class RayCastVisibility : public Visibility {
   int64_t CountVis(int64_t voxel) override;
   size_t MemoryBytes() const override;
 
-  const RayImage& rays(int view) const { return rays_[view]; }
+  const RayImage& rays(int view) const { return *rays_[view]; }
+
+  bool ViewParallel() const { return lookup_ == VisLookup::kFootprint && counts_.empty(); }
+  // ComputeVis restricted to one view, for the voxel at grid coordinates `voxel`.
+  void ComputeVisInView(const Eigen::Vector3i& voxel, int view, std::vector<PixelRef>* pixels) const;
+  // Steps the rays of pixels [begin, end) (their voxel was carved) and appends the solid voxel
+  // each reaches, as UpdateAfterCarve reports them (footprint lookup, no counts: CHECKed).
+  void AdvanceRays(const PixelRef* begin, const PixelRef* end, std::vector<int64_t>* reached);
 
  private:
   // Ray lists: a ray's global id is view_offset_[view] + pixel.
@@ -55,7 +71,7 @@ class RayCastVisibility : public Visibility {
   const std::vector<CalibratedView>& views_;
   const Volume& volume_;
   VisLookup lookup_;
-  std::vector<RayImage> rays_;
+  std::vector<std::unique_ptr<RayImage>> rays_;  // per view
   std::vector<int32_t> view_offset_;
   std::vector<int32_t> head_;  // per voxel: a ray ending in it, or -1
   std::vector<int32_t> next_;  // per ray: the next ray ending in the same voxel, or -1

@@ -6,11 +6,34 @@
 #include <glog/logging.h>
 
 namespace raycarve {
+
+inline Eigen::Vector3d RayImage::GridDirection(int pixel) const {
+  // No integer division on this hot path: (pixel + 0.5) / width is at least 0.5 / width away from
+  // an integer, far beyond the rounding of the product.
+  const int row = static_cast<int>((pixel + 0.5) * inverse_width_);
+  const int col = pixel - row * width_;
+  return grid_from_pixel_ * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
+}
+
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
+// Bits needed for coordinates 0 .. n-1.
+int CoordinateBits(int n) {
+  int bits = 0;
+  while ((int64_t{1} << bits) < n) ++bits;
+  return bits;
+}
+
 }  // namespace
+
+bool RayImage::KeyBitsFit(const Eigen::Vector3i& dimensions) {
+  return (dimensions.array() >= 1).all() &&
+         CoordinateBits(dimensions.x()) + CoordinateBits(dimensions.y()) +
+                 CoordinateBits(dimensions.z()) <=
+             31;
+}
 
 RayImage::RayImage(const VoxelGrid& grid,
                    const Eigen::Matrix3d& world_from_pixel,
@@ -26,10 +49,14 @@ RayImage::RayImage(const VoxelGrid& grid,
       width_(width),
       height_(height),
       valid_(valid) {
-  CHECK((grid.dimensions().array() <= 32767).all()) << "grid too large for 16-bit coordinates";
+  const Eigen::Vector3i& n = grid.dimensions();
+  CHECK(KeyBitsFit(n)) << "grid " << n.transpose() << " too large for 31-bit ray keys";
   CHECK(valid.empty() || (valid.type() == CV_8UC1 && valid.cols == width && valid.rows == height));
+  shift_y_ = CoordinateBits(n.x());
+  shift_z_ = shift_y_ + CoordinateBits(n.y());
+  mask_x_ = (uint32_t{1} << shift_y_) - 1;
+  mask_y_ = (uint32_t{1} << (shift_z_ - shift_y_)) - 1;
   keys_.assign(static_cast<size_t>(width) * height, kInactive);
-  t_max_.resize(static_cast<size_t>(width) * height);
   for (int pixel = 0; pixel < num_pixels(); ++pixel) InitialiseRay(pixel);
 }
 
@@ -39,17 +66,10 @@ Eigen::Vector3d RayImage::Direction(int pixel) const {
   return world_from_pixel_ * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
 }
 
-Eigen::Vector3d RayImage::GridDirection(int pixel) const {
-  // No integer division on this hot path: (pixel + 0.5) / width is at least 0.5 / width away from
-  // an integer, far beyond the rounding of the product.
-  const int row = static_cast<int>((pixel + 0.5) * inverse_width_);
-  const int col = pixel - row * width_;
-  return grid_from_pixel_ * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
-}
+
 
 void RayImage::InitialiseRay(int pixel) {
   keys_[pixel] = kInactive;
-  float* t_max = t_max_[pixel].axis;
   if (!valid_.empty() && valid_.data[pixel] == 0) return;
   const Eigen::Vector3d d = GridDirection(pixel);
   const Eigen::Vector3d& o = centre_grid_;
@@ -73,13 +93,6 @@ void RayImage::InitialiseRay(int pixel) {
   Eigen::Vector3i voxel;
   for (int axis = 0; axis < 3; ++axis) {
     voxel[axis] = std::clamp(static_cast<int>(std::floor(entry[axis])), 0, n[axis] - 1);
-    if (d[axis] > 0.0) {
-      t_max[axis] = static_cast<float>((voxel[axis] + 1 - o[axis]) / d[axis]);
-    } else if (d[axis] < 0.0) {
-      t_max[axis] = static_cast<float>((voxel[axis] - o[axis]) / d[axis]);
-    } else {
-      t_max[axis] = std::numeric_limits<float>::infinity();
-    }
   }
   keys_[pixel] = Key(voxel);
 }
@@ -91,47 +104,78 @@ void RayImage::Initialise(const Volume& volume) {
   }
 }
 
-int64_t RayImage::Step(int pixel, const Volume& volume, int voxel[3], float t_max[3],
-                       bool skip_current) const {
+int64_t RayImage::Step(int pixel, const Volume& volume, int voxel[3], bool skip_current) const {
+  // The hottest loop of ray-cast carving: per axis scalars rather than arrays indexed by the
+  // chosen axis, so that the state stays in registers.
   const Eigen::Vector3i& n = grid_.dimensions();
-  int64_t index = voxel[0] + static_cast<int64_t>(n.x()) * (voxel[1] + static_cast<int64_t>(n.y()) * voxel[2]);
-  if (!skip_current && volume.IsSolid(index)) return index;
+  const int64_t stride_y = n.x(), stride_z = static_cast<int64_t>(n.x()) * n.y();
+  int x = voxel[0], y = voxel[1], z = voxel[2];
+  int64_t index = x + stride_y * y + stride_z * z;
+  const uint64_t* solid = volume.solid_bits().data();
+  const auto is_solid = [solid](int64_t i) { return ((solid[i >> 6] >> (i & 63)) & 1) != 0; };
+  if (!skip_current && is_solid(index)) return index;
   const Eigen::Vector3d d = GridDirection(pixel);
-  int step[3];
-  float t_delta[3];
-  const int64_t stride[3] = {1, n.x(), static_cast<int64_t>(n.x()) * n.y()};
-  for (int axis = 0; axis < 3; ++axis) {
-    step[axis] = d[axis] > 0.0 ? 1 : -1;
-    t_delta[axis] = 1.0f / std::abs(static_cast<float>(d[axis]));  // inf along an axis plane
-  }
+  // Amanatides-Woo state of the current voxel, per axis: the ray parameter where the ray leaves
+  // it through that axis's far face (infinite along an axis plane: that axis never steps), the
+  // parameter length of one voxel, the step, its index stride and the coordinate that means
+  // the ray has left the grid.
+  const auto axis_state = [&](int axis, int coordinate, int64_t stride, double* t_max,
+                              double* t_delta, int* step, int64_t* index_step, int* end) {
+    const double inverse = 1.0 / d[axis];
+    const bool up = d[axis] > 0.0;
+    *t_max = d[axis] == 0.0 ? kInfinity : (coordinate + (up ? 1 : 0) - centre_grid_[axis]) * inverse;
+    *t_delta = std::abs(inverse);
+    *step = up ? 1 : -1;
+    *index_step = up ? stride : -stride;
+    *end = up ? n[axis] : -1;
+  };
+  double tx, ty, tz, dx, dy, dz;
+  int step_x, step_y, step_z, end_x, end_y, end_z;
+  int64_t index_x, index_y, index_z;
+  axis_state(0, x, 1, &tx, &dx, &step_x, &index_x, &end_x);
+  axis_state(1, y, stride_y, &ty, &dy, &step_y, &index_y, &end_y);
+  axis_state(2, z, stride_z, &tz, &dz, &step_z, &index_z, &end_z);
   while (true) {
-    const int axis = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2)
-                                         : (t_max[1] < t_max[2] ? 1 : 2);
-    voxel[axis] += step[axis];
-    if (voxel[axis] < 0 || voxel[axis] >= n[axis]) return kNoVoxel;
-    t_max[axis] += t_delta[axis];
-    index += step[axis] * stride[axis];
-    if (volume.IsSolid(index)) return index;
+    if (tx < ty && tx < tz) {
+      x += step_x;
+      if (x == end_x) return kNoVoxel;
+      tx += dx;
+      index += index_x;
+    } else if (!(tx < ty) && ty < tz) {
+      y += step_y;
+      if (y == end_y) return kNoVoxel;
+      ty += dy;
+      index += index_y;
+    } else {
+      z += step_z;
+      if (z == end_z) return kNoVoxel;
+      tz += dz;
+      index += index_z;
+    }
+    if (is_solid(index)) break;
   }
+  voxel[0] = x;
+  voxel[1] = y;
+  voxel[2] = z;
+  return index;
 }
 
 int64_t RayImage::Advance(int pixel, const Volume& volume) {
-  const uint64_t key = keys_[pixel];
+  const uint32_t key = keys_[pixel];
   if (key == kInactive) return kNoVoxel;
-  int voxel[3] = {static_cast<int>(key & 0xffff), static_cast<int>((key >> 16) & 0xffff),
-                  static_cast<int>((key >> 32) & 0xffff)};
-  const int64_t index = Step(pixel, volume, voxel, t_max_[pixel].axis, /*skip_current=*/false);
+  const Eigen::Vector3i start = Unpack(key);
+  int voxel[3] = {start.x(), start.y(), start.z()};
+  const int64_t index = Step(pixel, volume, voxel, /*skip_current=*/false);
   keys_[pixel] = index == kNoVoxel ? kInactive : Key(Eigen::Vector3i(voxel[0], voxel[1], voxel[2]));
   return index;
 }
 
 int64_t RayImage::PeekBeyondCurrent(int pixel, const Volume& volume) const {
-  const uint64_t key = keys_[pixel];
+  const uint32_t key = keys_[pixel];
   if (key == kInactive) return kNoVoxel;
-  int voxel[3] = {static_cast<int>(key & 0xffff), static_cast<int>((key >> 16) & 0xffff),
-                  static_cast<int>((key >> 32) & 0xffff)};
-  float t_max[3] = {t_max_[pixel].axis[0], t_max_[pixel].axis[1], t_max_[pixel].axis[2]};
-  return Step(pixel, volume, voxel, t_max, /*skip_current=*/true);
+  const Eigen::Vector3i start = Unpack(key);
+  int voxel[3] = {start.x(), start.y(), start.z()};
+  return Step(pixel, volume, voxel, /*skip_current=*/true);
 }
 
 }  // namespace raycarve

@@ -21,12 +21,18 @@ namespace raycarve {
 // and Advance keep it so) or kNoVoxel when the ray missed the box, has left it, or the pixel is
 // masked out.
 //
-// Memory: 20 bytes per pixel (the direction is recomputed from the pixel when a ray is stepped).
-// Coordinates are kept as 16-bit fields of a 64-bit key per pixel, tMax in a separate array.
-// Voxel coordinates are stored in 16 bits: grids up to 32767 voxels along an axis.
+// Memory: 4 bytes per pixel, the current voxel's coordinates packed into one 32-bit key. Nothing
+// else is stored: the direction follows from the pixel, and the traversal state (the ray
+// parameter of the next boundary per axis) from the direction and the current voxel, so both are
+// recomputed when a ray is stepped. Recomputing is also exact where accumulating tMax in floats
+// drifts. The key packs each axis in as many bits as its dimension needs; the three together
+// must fit in 31 bits (KeyBitsFit), e.g. 1024 x 1024 x 1024 or 4096 x 4096 x 128.
 class RayImage {
  public:
   static constexpr int64_t kNoVoxel = -1;
+
+  // Whether a grid's voxel coordinates fit a ray's 31-bit key.
+  static bool KeyBitsFit(const Eigen::Vector3i& dimensions);
 
   // `world_from_pixel` maps homogeneous COLMAP pixel coordinates (x, y, 1) to a world-space
   // direction (R^T K^-1); `centre` is the camera centre in world coordinates.
@@ -45,19 +51,18 @@ class RayImage {
   void Initialise(const Volume& volume);
 
   int64_t CurrentVoxel(int pixel) const {
-    const uint64_t key = keys_[pixel];
+    const uint32_t key = keys_[pixel];
     return key == kInactive ? kNoVoxel : grid_.Index(Unpack(key));
   }
 
   // A voxel's key: what keys() holds for a ray whose current voxel it is. Comparing keys is how
   // a footprint is scanned without decoding every ray.
-  static uint64_t Key(const Eigen::Vector3i& voxel) {
-    return static_cast<uint64_t>(static_cast<uint16_t>(voxel.x())) |
-           static_cast<uint64_t>(static_cast<uint16_t>(voxel.y())) << 16 |
-           static_cast<uint64_t>(static_cast<uint16_t>(voxel.z())) << 32;
+  uint32_t Key(const Eigen::Vector3i& voxel) const {
+    return static_cast<uint32_t>(voxel.x()) | static_cast<uint32_t>(voxel.y()) << shift_y_ |
+           static_cast<uint32_t>(voxel.z()) << shift_z_;
   }
   // Per pixel, row-major: the current voxel's key, or a value no voxel has when the ray is gone.
-  const uint64_t* keys() const { return keys_.data(); }
+  const uint32_t* keys() const { return keys_.data(); }
 
   // Steps the ray at `pixel` until its current voxel is solid in `volume` or it leaves the box
   // (then kNoVoxel). Returns the new current voxel. A ray already at a solid voxel stays.
@@ -71,25 +76,20 @@ class RayImage {
   // The ray parameter convention: world point = centre + t * Direction(pixel).
   Eigen::Vector3d Direction(int pixel) const;
 
-  size_t MemoryBytes() const {
-    return keys_.capacity() * sizeof(uint64_t) + t_max_.capacity() * sizeof(TMax);
-  }
+  size_t MemoryBytes() const { return keys_.capacity() * sizeof(uint32_t); }
 
  private:
-  static constexpr uint64_t kInactive = ~uint64_t{0};
-  // Ray parameter of the next voxel boundary crossing, per axis.
-  struct TMax {
-    float axis[3];
-  };
-  static Eigen::Vector3i Unpack(uint64_t key) {
-    return Eigen::Vector3i(static_cast<int>(key & 0xffff), static_cast<int>((key >> 16) & 0xffff),
-                           static_cast<int>((key >> 32) & 0xffff));
+  static constexpr uint32_t kInactive = ~uint32_t{0};
+  Eigen::Vector3i Unpack(uint32_t key) const {
+    return Eigen::Vector3i(static_cast<int>(key & mask_x_),
+                           static_cast<int>((key >> shift_y_) & mask_y_),
+                           static_cast<int>(key >> shift_z_));
   }
 
   void InitialiseRay(int pixel);
-  // Steps from voxel/t_max (updated in place) until a solid voxel (returned, its index) or the
-  // box's edge (kNoVoxel). With `skip_current`, the starting voxel counts as empty.
-  int64_t Step(int pixel, const Volume& volume, int voxel[3], float t_max[3], bool skip_current) const;
+  // Steps from `voxel` (updated in place) until a solid voxel (returned, its index) or the box's
+  // edge (kNoVoxel). With `skip_current`, the starting voxel counts as empty.
+  int64_t Step(int pixel, const Volume& volume, int voxel[3], bool skip_current) const;
   // The direction in grid units (voxel size 1) for `pixel`.
   Eigen::Vector3d GridDirection(int pixel) const;
 
@@ -101,9 +101,11 @@ class RayImage {
   int width_;
   int height_;
   cv::Mat valid_;
-  // Structure of arrays: the keys are what footprint scans read, 8 bytes a pixel.
-  std::vector<uint64_t> keys_;
-  std::vector<TMax> t_max_;
+  int shift_y_;  // key = x | y << shift_y_ | z << shift_z_
+  int shift_z_;
+  uint32_t mask_x_;
+  uint32_t mask_y_;
+  std::vector<uint32_t> keys_;
 };
 
 }  // namespace raycarve

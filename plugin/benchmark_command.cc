@@ -56,6 +56,9 @@ int RunBenchmark(int argc, char** argv) {
       "memory, voxels carved and evaluated), compares the final volumes with each other (voxel "
       "IoU, voxels that differ), and writes <output>/benchmark/: benchmark.json, table.md, "
       "figure6.csv and figure6.png (voxels carved against time), cloud_<method>.ply.");
+  // One thread by default: the paper's comparison is of the methods, and only ray casting runs
+  // on several.
+  request.options.num_threads = 1;
   AddCarveFlags(&parser, &request, &text);
   parser.AddDefault("methods", &methods_text, "comma-separated: ray, gvc_ldi, gvc");
   parser.AddDefault("reference", &reference,

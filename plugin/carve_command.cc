@@ -149,6 +149,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("lod_levels").Value(request.options.lod_levels)
       .Key("lod_band").Value(request.options.lod_band)
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
+      .Key("num_threads").Value(ResolveNumThreads(request.options.num_threads))
       .Key("max_memory_gib").Value(request.options.max_memory_gib)
       .Key("mask_path").Value(request.view_options.mask_path)
       .Key("background").Value(request.background)
@@ -194,6 +195,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("carved").Value(s.carved)
       .Key("evaluated").Value(s.evaluated)
       .Key("passes").Value(s.passes)
+      .Key("threads").Value(s.threads)
       .Key("reprojection_error_before").Value(s.reprojection_error_before)
       .Key("reprojection_error_after").Value(s.reprojection_error_after)
       .Key("final_solid").Value(s.final_solid)
@@ -290,6 +292,9 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->AddDefault("colour_calibration", &request->colour_calibration,
                      "estimate a gain and offset per photo and channel from the sparse points' "
                      "colours (Ceres, robust) and correct the photos before carving");
+  parser->AddDefault("num_threads", &request->options.num_threads,
+                     "threads for ray casting, each taking every n-th view (-1: one per core); "
+                     "the carving is identical for any count");
   parser->AddDefault("max_memory_gib", &request->options.max_memory_gib,
                      "refuse grids whose carving structures would need more (GiB)");
   parser->AddDefault("skip_missing_images", &request->view_options.skip_missing_images,

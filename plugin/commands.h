@@ -81,6 +81,7 @@ LoadedProject LoadProject(const std::string& command,
 
 // carve: everything `raycarve carve` takes, and what it produced.
 struct CarveRequest {
+  CarveRequest() { options.num_threads = -1; }  // the command line uses every core by default
   std::string workspace_path;
   std::string input_path;
   std::string image_path;

@@ -101,6 +101,35 @@ TEST(CarveVolume, FootprintScansAndRayListsCarveIdentically) {
   }
 }
 
+TEST(CarveVolume, AnyNumberOfThreadsCarvesExactlyAsOneDoes) {
+  const SyntheticScene scene = Scene(6, 160, 120);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  for (const CarveDecision decision : {CarveDecision::kThreshold, CarveDecision::kReprojection}) {
+    CarveOptions options = Options(48, 30.0);
+    options.decision = decision;
+    options.num_threads = 1;
+    const CarveResult one = CarveVolume(views, scene.object_box, options);
+    EXPECT_GT(one.statistics.carved, 1000);
+    // 2 threads: views dealt 3 and 3; 4: dealt 2, 2, 1, 1 (more threads than this machine's
+    // cores is allowed, only slower).
+    for (const int threads : {2, 4}) {
+      options.num_threads = threads;
+      const CarveResult many = CarveVolume(views, scene.object_box, options);
+      EXPECT_EQ(many.statistics.carved, one.statistics.carved) << threads;
+      EXPECT_EQ(many.statistics.evaluated, one.statistics.evaluated) << threads;
+      for (int64_t i = 0; i < one.volume.grid().num_voxels(); ++i) {
+        ASSERT_EQ(many.volume.IsSolid(i), one.volume.IsSolid(i)) << threads << " threads, " << i;
+      }
+      ASSERT_EQ(many.surface.size(), one.surface.size());
+      for (size_t i = 0; i < one.surface.size(); ++i) {
+        EXPECT_EQ(many.surface[i].colour, one.surface[i].colour);
+        EXPECT_EQ(many.surface[i].num_pixels, one.surface[i].num_pixels);
+      }
+      EXPECT_EQ(many.statistics.reprojection_error_after, one.statistics.reprojection_error_after);
+    }
+  }
+}
+
 // Share of the surface voxels judged by two or more views that lie within 2 voxels of the truth.
 double JudgedSurfaceNearTruth(const CarveResult& result) {
   int judged = 0, near = 0;

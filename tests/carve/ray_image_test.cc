@@ -62,18 +62,35 @@ std::vector<int64_t> TraversedVoxels(const VoxelGrid& grid,
 const VoxelGrid kGrid(Eigen::AlignedBox3d(Eigen::Vector3d(-1, -0.5, 0), Eigen::Vector3d(1, 0.5, 1)), 8);
 
 TEST(RayImage, TraversalVisitsExactlyTheVoxelsARandomRayCrosses) {
-  std::mt19937_64 random(42);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  int rays_hitting = 0;
-  for (int trial = 0; trial < 300; ++trial) {
-    const Eigen::Vector3d origin(3 * uniform(random), 3 * uniform(random), 3 * uniform(random));
-    const Eigen::Vector3d target(uniform(random), 0.5 * uniform(random), 0.5 + 0.5 * uniform(random));
-    const Eigen::Vector3d direction = target - origin;
-    const std::vector<int64_t> expected = BruteForceVoxels(kGrid, origin, direction);
-    EXPECT_EQ(TraversedVoxels(kGrid, origin, direction), expected) << "trial " << trial;
-    rays_hitting += !expected.empty();
+  // kGrid (8x4x4) and one whose dimensions are not powers of two, so that the packed keys have
+  // unused values.
+  const VoxelGrid odd_grid(
+      Eigen::AlignedBox3d(Eigen::Vector3d(-1, -0.5, 0), Eigen::Vector3d(1, 0.2, 1.05)), 11);
+  ASSERT_EQ(odd_grid.dimensions(), Eigen::Vector3i(11, 4, 6));
+  for (const VoxelGrid& grid : {kGrid, odd_grid}) {
+    std::mt19937_64 random(42);
+    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+    int rays_hitting = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+      const Eigen::Vector3d origin(3 * uniform(random), 3 * uniform(random), 3 * uniform(random));
+      const Eigen::Vector3d target(uniform(random), -0.15 + 0.35 * uniform(random),
+                                   0.5 + 0.5 * uniform(random));
+      const Eigen::Vector3d direction = target - origin;
+      const std::vector<int64_t> expected = BruteForceVoxels(grid, origin, direction);
+      EXPECT_EQ(TraversedVoxels(grid, origin, direction), expected) << "trial " << trial;
+      rays_hitting += !expected.empty();
+    }
+    EXPECT_GT(rays_hitting, 250);
   }
-  EXPECT_GT(rays_hitting, 250);
+}
+
+TEST(RayImage, KeysHoldGridsWhoseCoordinatesNeedAtMost31Bits) {
+  EXPECT_TRUE(RayImage::KeyBitsFit(Eigen::Vector3i(1, 1, 1)));
+  EXPECT_TRUE(RayImage::KeyBitsFit(Eigen::Vector3i(1024, 1024, 1024)));   // 30 bits
+  EXPECT_TRUE(RayImage::KeyBitsFit(Eigen::Vector3i(2048, 1024, 1000)));   // 31
+  EXPECT_FALSE(RayImage::KeyBitsFit(Eigen::Vector3i(2048, 2048, 1024)));  // 32
+  EXPECT_FALSE(RayImage::KeyBitsFit(Eigen::Vector3i(4096, 4096, 129)));   // 32
+  EXPECT_FALSE(RayImage::KeyBitsFit(Eigen::Vector3i(0, 4, 4)));
 }
 
 TEST(RayImage, RaysAlongGridPlanesEdgesAndCornersStayOnAConnectedPathOfTouchedVoxels) {
@@ -139,7 +156,7 @@ TEST(RayImage, RaysMissingTheBoxOrMaskedOutHaveNoVoxel) {
   RayImage open_rays(kGrid, down, Eigen::Vector3d(0, 0, 2), 1, 1);
   open_rays.Initialise(volume);
   EXPECT_EQ(kGrid.Voxel(open_rays.CurrentVoxel(0)).z(), 3);  // the top layer
-  EXPECT_EQ(open_rays.MemoryBytes(), 20u);
+  EXPECT_EQ(open_rays.MemoryBytes(), 4u);  // one packed key a pixel
 }
 
 TEST(RayImage, StepsToTheNextSolidVoxelAfterCarving) {

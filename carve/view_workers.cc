@@ -1,0 +1,137 @@
+#include "carve/view_workers.h"
+
+#include <algorithm>
+#include <chrono>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
+namespace raycarve {
+namespace {
+
+// Waiting for the other side: first spinning (a few microseconds: the serial work between two
+// tasks of a carve), then yielding the core (when there are more threads than cores, the thread
+// waited for may need it), then sleeping (an idle pool costs nothing).
+constexpr int kSpins = 256;
+constexpr int kYields = 64;
+// Runs per judgement of the workers, and runs on the calling thread alone before trying again.
+constexpr int kWindowRuns = 256;
+constexpr int kInlineRuns = 8192;
+
+int64_t NowNanoseconds() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// One round of waiting; returns false when it is time to sleep.
+inline bool KeepWaiting(int round) {
+  if (round < kSpins) {
+#if defined(__x86_64__) || defined(__i386__)
+    _mm_pause();
+#endif
+    return true;
+  }
+  if (round < kSpins + kYields) {
+    std::this_thread::yield();
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+int ResolveNumThreads(int num_threads) {
+  if (num_threads >= 1) return num_threads;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+ViewWorkers::ViewWorkers(int num_views, int num_threads)
+    : num_views_(num_views),
+      num_groups_(std::max(1, std::min(ResolveNumThreads(num_threads), num_views))) {
+  for (int group = 1; group < num_groups_; ++group) {
+    threads_.emplace_back([this, group] { WorkerLoop(group); });
+  }
+}
+
+std::vector<int> ViewWorkers::ViewsOf(int group) const {
+  std::vector<int> views;
+  for (int view = group; view < num_views_; view += num_groups_) views.push_back(view);
+  return views;
+}
+
+ViewWorkers::~ViewWorkers() {
+  stop_.store(true);
+  generation_.fetch_add(1);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    workers_wake_.notify_all();
+  }
+  for (std::thread& thread : threads_) thread.join();
+}
+
+void ViewWorkers::RunErased(void (*call)(void*, int), void* task) {
+  if (inline_runs_left_ > 0) {
+    --inline_runs_left_;
+    for (int group = 0; group < num_groups_; ++group) call(task, group);
+    return;
+  }
+  const int64_t start = NowNanoseconds();
+  call_ = call;
+  task_ = task;
+  pending_.store(num_groups_ - 1, std::memory_order_relaxed);
+  generation_.fetch_add(1);  // sequentially consistent: publishes the task, then reads below
+  if (sleeping_workers_.load() > 0) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    workers_wake_.notify_all();
+  }
+  call(task, 0);
+  const int64_t own_done = NowNanoseconds();
+  for (int round = 0; pending_.load(std::memory_order_acquire) != 0; ++round) {
+    if (KeepWaiting(round)) continue;
+    std::unique_lock<std::mutex> lock(mutex_);
+    caller_sleeping_.store(true);
+    caller_wake_.wait(lock, [this] { return pending_.load() == 0; });
+    caller_sleeping_.store(false);
+    break;
+  }
+  Account(own_done - start, NowNanoseconds() - own_done);
+}
+
+void ViewWorkers::Account(int64_t own_nanoseconds, int64_t wait_nanoseconds) {
+  window_own_ += own_nanoseconds;
+  window_wait_ += wait_nanoseconds;
+  if (++window_runs_ < kWindowRuns) return;
+  // On the calling thread alone a run would cost about num_groups x its own share; on the
+  // workers it cost own + wait. Only a clear loss counts (twice that), not a worker's hiccup.
+  if (window_wait_ > 2 * (num_groups_ - 1) * window_own_) inline_runs_left_ = kInlineRuns;
+  window_runs_ = 0;
+  window_own_ = 0;
+  window_wait_ = 0;
+}
+
+void ViewWorkers::WorkerLoop(int group) {
+  uint64_t seen = 0;
+  while (true) {
+    uint64_t generation;
+    for (int round = 0; (generation = generation_.load(std::memory_order_acquire)) == seen;
+         ++round) {
+      if (KeepWaiting(round)) continue;
+      std::unique_lock<std::mutex> lock(mutex_);
+      sleeping_workers_.fetch_add(1);
+      workers_wake_.wait(lock, [this, seen] { return generation_.load() != seen; });
+      sleeping_workers_.fetch_sub(1);
+      round = 0;
+    }
+    seen = generation;
+    if (stop_.load()) return;
+    call_(task_, group);
+    if (pending_.fetch_sub(1) == 1 && caller_sleeping_.load()) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      caller_wake_.notify_one();
+    }
+  }
+}
+
+}  // namespace raycarve

@@ -1,7 +1,8 @@
 // Carving benchmark: the generated scene (samples/synthetic_scene) at N views of WxH, carved at
 // each requested resolution; prints convergence time, memory, voxels carved and evaluated as a
 // table and as JSON. A benchmark, not a test: figures depend on the machine.
-//   scripts/run_benchmark.sh [--views 14 --width 800 --height 600 --resolutions 128,256]
+//   scripts/run_benchmark.sh [--views 14 --width 800 --height 600 --resolutions 128,256
+//                             --threads 1,2 --vis_lookup footprint --incremental_statistics 1]
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
   std::vector<raycarve::VisLookup> lookups = {raycarve::VisLookup::kFootprint,
                                               raycarve::VisLookup::kRayLists};
   double threshold = 30.0;
+  bool incremental_statistics = false;
   // One thread (the paper's setting) and every hardware thread; ray lists always use one.
   std::vector<int> thread_counts = {1};
   if (raycarve::ResolveNumThreads(-1) > 1) thread_counts.push_back(raycarve::ResolveNumThreads(-1));
@@ -45,6 +47,7 @@ int main(int argc, char** argv) {
     else if (flag == "--width") scene_options.width = std::stoi(value);
     else if (flag == "--height") scene_options.height = std::stoi(value);
     else if (flag == "--threshold") threshold = std::stod(value);
+    else if (flag == "--incremental_statistics") incremental_statistics = std::stoi(value) != 0;
     else if (flag == "--vis_lookup") {
       raycarve::VisLookup lookup;
       if (value != "both" && !raycarve::VisLookupFromString(value, &lookup)) {
@@ -92,6 +95,7 @@ int main(int argc, char** argv) {
     options.resolution = resolutions[k];
     options.threshold = threshold;
     options.vis_lookup = lookup;
+    options.incremental_statistics = incremental_statistics;
     options.num_threads = lookup == raycarve::VisLookup::kRayLists ? 1 : threads;
     const std::string vis = raycarve::VisLookupToString(lookup);
     if (!raycarve::CheckCarveFits(views, scene.object_box, options, &reason)) {

@@ -154,6 +154,10 @@ bool CarveOptions::IsValid(std::string* reason) const {
     *reason = "the reprojection decision needs ray casting (--method ray)";
     return false;
   }
+  if (incremental_statistics && method != CarveMethod::kRay) {
+    *reason = "incremental statistics need ray casting (--method ray)";
+    return false;
+  }
   std::vector<int> resolutions;
   if (!LevelResolutions(resolution, lod_levels, &resolutions, reason)) return false;
   if (lod_band < 0 || lod_band > 8) {
@@ -256,6 +260,20 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
   view_parallel_ = ray_visibility_ != nullptr && ray_visibility_->ViewParallel() &&
                    order_ == CarveOrder::kFifo && workers_.num_groups() > 1;
   if (view_parallel_) groups_.resize(workers_.num_groups());
+  if (options.incremental_statistics) {
+    CHECK(ray_visibility_ != nullptr) << "incremental statistics need ray casting";
+    sums_ = std::make_unique<VoxelColourSums>(volume_.grid().num_voxels(),
+                                              static_cast<int>(views.size()));
+    for (int view = 0; view < static_cast<int>(views.size()); ++view) {
+      const RayImage& rays = ray_visibility_->rays(view);
+      for (int pixel = 0; pixel < rays.num_pixels(); ++pixel) {
+        const int64_t voxel = rays.CurrentVoxel(pixel);
+        if (voxel != RayImage::kNoVoxel) {
+          sums_->Add(voxel, view, views[view].image.data + 3 * static_cast<size_t>(pixel));
+        }
+      }
+    }
+  }
   for (int64_t voxel : volume_.SurfaceVoxels()) Enqueue(voxel);
   max_queue_ = queue_size();
 }
@@ -293,19 +311,46 @@ bool IncrementalCarver::Pop(int64_t* voxel) {
   }
 }
 
-Consistency IncrementalCarver::Evaluate(int64_t voxel) {
-  if (!view_parallel_) {
-    vis_.clear();
-    visibility_->ComputeVis(voxel, &vis_);
-    GatherColours(views_, vis_, &stats_);
-  } else if (prefetched_ != voxel) {
-    RunViewGroups(nullptr, voxel);
+Consistency IncrementalCarver::Evaluate(int64_t voxel, bool need_vis) {
+  if (sums_ != nullptr) {
+    vis_ready_ = false;
+    if (need_vis) FindVis(voxel, /*gather=*/false);
+    sums_->Stats(voxel, &stats_);
+  } else if (view_parallel_ && prefetched_ == voxel) {
+    vis_ready_ = true;  // found with the last carving's task
+  } else {
+    FindVis(voxel, /*gather=*/true);
   }
   prefetched_ = -1;
   return test_.Evaluate(stats_);
 }
 
-void IncrementalCarver::RunViewGroups(const std::vector<PixelRef>* advance, int64_t vis_voxel) {
+void IncrementalCarver::FindVis(int64_t voxel, bool gather) {
+  if (view_parallel_) {
+    RunViewGroups(nullptr, voxel, gather);
+  } else {
+    vis_.clear();
+    visibility_->ComputeVis(voxel, &vis_);
+    if (gather) GatherColours(views_, vis_, &stats_);
+  }
+  vis_ready_ = true;
+}
+
+void IncrementalCarver::AddArrivals() {
+  for (const PixelRef& ref : vis_) {
+    const int64_t reached = ray_visibility_->rays(static_cast<int>(ref.view)).CurrentVoxel(
+        static_cast<int>(ref.pixel));
+    if (reached == RayImage::kNoVoxel) continue;
+    sums_->Add(reached, static_cast<int>(ref.view),
+               views_[ref.view].image.data + 3 * static_cast<size_t>(ref.pixel));
+  }
+}
+
+void IncrementalCarver::RunViewGroups(const std::vector<PixelRef>* advance,
+                                      int64_t vis_voxel,
+                                      bool gather,
+                                      bool advance_found) {
+  CHECK(!advance_found || (advance == nullptr && vis_voxel >= 0));
   const int num_views = static_cast<int>(views_.size());
   // `advance` is in view order: view v's pixels are [advance_begin_[v], advance_begin_[v + 1]).
   if (advance != nullptr) {
@@ -324,24 +369,30 @@ void IncrementalCarver::RunViewGroups(const std::vector<PixelRef>* advance, int6
     buffers.vis_end.clear();
     buffers.stats_end.clear();
     for (int view = group; view < num_views; view += workers_.num_groups()) {
+      // Stepping the rays before finding Vis: the Vis found is that after this carving.
       if (advance != nullptr) {
         ray_visibility_->AdvanceRays(advance->data() + advance_begin_[view],
                                      advance->data() + advance_begin_[view + 1], &buffers.changed);
       }
-      buffers.changed_end.push_back(buffers.changed.size());
       if (vis_voxel >= 0) {
         const size_t first = buffers.vis.size();
         ray_visibility_->ComputeVisInView(vis_coordinates, view, &buffers.vis);
-        if (buffers.vis.size() > first) {
+        if (advance_found) {
+          ray_visibility_->AdvanceRays(buffers.vis.data() + first,
+                                       buffers.vis.data() + buffers.vis.size(), &buffers.changed);
+        }
+        if (gather && buffers.vis.size() > first) {
           ViewColourStats stats;
           stats.view = view;
           for (size_t i = first; i < buffers.vis.size(); ++i) {
-            const uint8_t* rgb = views_[view].image.data + 3 * static_cast<size_t>(buffers.vis[i].pixel);
+            const uint8_t* rgb =
+                views_[view].image.data + 3 * static_cast<size_t>(buffers.vis[i].pixel);
             stats.Add(Eigen::Vector3d(rgb[0], rgb[1], rgb[2]));
           }
           buffers.stats.push_back(stats);
         }
       }
+      buffers.changed_end.push_back(buffers.changed.size());
       buffers.vis_end.push_back(buffers.vis.size());
       buffers.stats_end.push_back(buffers.stats.size());
     }
@@ -350,7 +401,7 @@ void IncrementalCarver::RunViewGroups(const std::vector<PixelRef>* advance, int6
   // Merged view by view: exactly what one thread would have produced.
   if (vis_voxel >= 0) {
     vis_.clear();
-    stats_.clear();
+    if (gather) stats_.clear();
   }
   const int num_groups = workers_.num_groups();
   for (int view = 0; view < num_views; ++view) {
@@ -363,7 +414,7 @@ void IncrementalCarver::RunViewGroups(const std::vector<PixelRef>* advance, int6
     append(buffers.changed, buffers.changed_end, &changed_);
     if (vis_voxel >= 0) {
       append(buffers.vis, buffers.vis_end, &vis_);
-      append(buffers.stats, buffers.stats_end, &stats_);
+      if (gather) append(buffers.stats, buffers.stats_end, &stats_);
     }
   }
 }
@@ -386,7 +437,9 @@ bool IncrementalCarver::Step() {
   }
   if (!volume_.IsSolid(voxel)) return true;
   ++evaluated_;
-  const Consistency consistency = Evaluate(voxel);
+  // Vis(V) is needed to judge V only by the reprojection decision, or without incremental
+  // statistics (which gather from it).
+  const Consistency consistency = Evaluate(voxel, decision_ == CarveDecision::kReprojection);
   // The threshold carves what is inconsistent; the reprojection decision also carves consistent
   // voxels whose pixels the voxels behind them explain better (floaters consistent by chance).
   if (consistency.consistent &&
@@ -397,14 +450,22 @@ bool IncrementalCarver::Step() {
   exposed_.clear();
   changed_.clear();
   volume_.Carve(voxel, &exposed_);
-  if (view_parallel_) {
+  if (sums_ != nullptr) sums_->Release(voxel);
+  if (view_parallel_ && sums_ != nullptr && !vis_ready_) {
+    // One task finds Vis(V) and steps its rays.
+    RunViewGroups(nullptr, voxel, /*gather=*/false, /*advance_found=*/true);
+  } else if (view_parallel_ && sums_ != nullptr) {
+    RunViewGroups(&vis_, -1);
+  } else if (view_parallel_) {
     // One task steps the rays and finds Vis of the voxel evaluated next (fifo: the front of
     // the queue, which the voxels queued below go behind), saving a second hand-over.
     prefetched_ = PeekNextSolid();
     RunViewGroups(&vis_, prefetched_);
   } else {
+    if (!vis_ready_) FindVis(voxel, /*gather=*/false);
     visibility_->UpdateAfterCarve(voxel, vis_, exposed_, &changed_);
   }
+  if (sums_ != nullptr) AddArrivals();
   if (order_ != CarveOrder::kFifo) {
     // One entry per voxel, with its count after every ray has arrived.
     std::sort(changed_.begin(), changed_.end());
@@ -485,7 +546,7 @@ double IncrementalCarver::MeanReprojectionError() {
 size_t IncrementalCarver::MemoryBytes() const {
   const size_t entry = order_ == CarveOrder::kFifo ? sizeof(int64_t) : 2 * sizeof(int64_t);
   return volume_.MemoryBytes() + visibility_->MemoryBytes() + queued_.size() * sizeof(uint64_t) +
-         max_queue_ * entry;
+         max_queue_ * entry + (sums_ != nullptr ? sums_->MemoryBytes() : 0);
 }
 
 CarveResult CarveVolume(const std::vector<CalibratedView>& views,

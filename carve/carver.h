@@ -16,6 +16,7 @@
 #include "carve/level_of_detail.h"
 #include "carve/ray_cast_visibility.h"
 #include "carve/view_workers.h"
+#include "carve/voxel_colour_sums.h"
 #include "carve/visual_hull.h"
 #include "carve/volume.h"
 
@@ -89,6 +90,10 @@ struct CarveOptions {
   // The carving is identical for any count. < 1: one per hardware thread. Other methods, ray
   // lists and the evidence order use one.
   int num_threads = 1;
+  // Ray casting: keep colour statistics per voxel and view incrementally (voxel_colour_sums.h):
+  // evaluating a voxel reads its sums, and Vis(V) is found only for voxels carved (or judged by
+  // the reprojection decision). Same carving, 56 bytes per view and voxel holding rays.
+  bool incremental_statistics = false;
 
   bool IsValid(std::string* reason) const;
 };
@@ -214,12 +219,22 @@ class IncrementalCarver {
   void Enqueue(int64_t voxel);
   // The next voxel to evaluate, or false when the CVSVL is empty.
   bool Pop(int64_t* voxel);
-  // Vis(V) into vis_ and its consistency.
-  Consistency Evaluate(int64_t voxel);
+  // V's consistency, with Vis(V) in vis_ (with incremental statistics, only when `need_vis`;
+  // vis_ready_ says whether vis_ holds it).
+  Consistency Evaluate(int64_t voxel, bool need_vis = true);
+  // Vis(V) into vis_ (and, with `gather`, its statistics into stats_).
+  void FindVis(int64_t voxel, bool gather);
+  // With incremental statistics: the colours of vis_'s pixels go to the voxels their rays reach.
+  void AddArrivals();
   // View-parallel ray casting: one task over the views' groups that first steps the rays of
   // `advance` (when not null; the voxels they reach go to changed_), then finds Vis of
   // `vis_voxel` and its colour statistics (when >= 0; into vis_ and stats_).
-  void RunViewGroups(const std::vector<PixelRef>* advance, int64_t vis_voxel);
+  // With `advance_found` (and no `advance`), the rays of the Vis found are stepped instead, in
+  // the same task; without `gather`, no statistics are gathered.
+  void RunViewGroups(const std::vector<PixelRef>* advance,
+                     int64_t vis_voxel,
+                     bool gather = true,
+                     bool advance_found = false);
   // The voxel Pop will hand out next if it is known now and still solid (fifo only), else -1.
   int64_t PeekNextSolid() const;
   // With vis_ holding Vis(V) and `colour` V's colour: the change of the reprojection error of
@@ -252,6 +267,8 @@ class IncrementalCarver {
   std::vector<GroupBuffers> groups_;
   std::vector<size_t> advance_begin_;  // per view: where its pixels start in the rays to step
   int64_t prefetched_ = -1;  // the voxel whose Vis and statistics vis_ and stats_ already hold
+  std::unique_ptr<VoxelColourSums> sums_;  // with incremental statistics
+  bool vis_ready_ = false;
   ConsistencyTest test_;
   CarveOrder order_;
   CarveDecision decision_;

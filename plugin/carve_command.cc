@@ -150,6 +150,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("lod_band").Value(request.options.lod_band)
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
       .Key("num_threads").Value(ResolveNumThreads(request.options.num_threads))
+      .Key("incremental_statistics").Value(request.options.incremental_statistics)
       .Key("max_memory_gib").Value(request.options.max_memory_gib)
       .Key("mask_path").Value(request.view_options.mask_path)
       .Key("background").Value(request.background)
@@ -295,6 +296,9 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->AddDefault("num_threads", &request->options.num_threads,
                      "threads for ray casting, each taking every n-th view (-1: one per core); "
                      "the carving is identical for any count");
+  parser->AddDefault("incremental_statistics", &request->options.incremental_statistics,
+                     "ray casting: keep per-voxel colour sums as rays arrive instead of gathering "
+                     "Vis(V)'s pixels at every evaluation (same carving)");
   parser->AddDefault("max_memory_gib", &request->options.max_memory_gib,
                      "refuse grids whose carving structures would need more (GiB)");
   parser->AddDefault("skip_missing_images", &request->view_options.skip_missing_images,

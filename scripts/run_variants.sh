@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The seed paper's section 4 measured (not a test): on a generated scene, carve with each CVSVL
-# order and each number of levels of detail, and score every result against the scene's truth.
+# order, decision and number of levels of detail, and with incremental colour statistics (one
+# thread each, so that times compare), and score every result against the scene's truth.
 # Prints a Markdown table. Usage: scripts/run_variants.sh [VIEWS WIDTH HEIGHT RESOLUTION THRESHOLD]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,7 +17,7 @@ echo "|---|---:|---:|---:|---:|---:|---:|---:|"
 run() {
   local name=$1; shift
   build/plugin/raycarve carve --workspace_path "$out/scene" --output_path "$out/$name" \
-    --resolution "$resolution" --threshold "$threshold" "$@" > "$out/$name.log" 2>&1
+    --resolution "$resolution" --threshold "$threshold" --num_threads 1 "$@" > "$out/$name.log" 2>&1
   local report="$out/$name/report.json" voxel
   voxel=$(json_number "$report" voxel_size)
   build/plugin/raycarve compare --reference "$out/scene/truth.ply" --input "$out/$name/cloud.ply" \
@@ -31,6 +32,7 @@ run() {
 run fifo
 run visible_pixels --order visible_pixels
 run reprojection --decision reprojection
+run incremental_statistics --incremental_statistics 1
 for levels in 2 3 4; do
   for band in 1 2; do run "lod${levels}_band${band}" --lod_levels "$levels" --lod_band "$band"; done
 done

@@ -130,6 +130,51 @@ TEST(CarveVolume, AnyNumberOfThreadsCarvesExactlyAsOneDoes) {
   }
 }
 
+TEST(CarveVolume, IncrementalStatisticsCarveExactlyAsGatheringDoes) {
+  const SyntheticScene scene = Scene(6, 160, 120);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  struct Variant {
+    CarveDecision decision;
+    CarveOrder order;
+    int lod_levels;
+    int threads;
+  };
+  for (const Variant& variant : {Variant{CarveDecision::kThreshold, CarveOrder::kFifo, 1, 1},
+                                 Variant{CarveDecision::kThreshold, CarveOrder::kFifo, 1, 2},
+                                 Variant{CarveDecision::kReprojection, CarveOrder::kFifo, 1, 2},
+                                 Variant{CarveDecision::kThreshold, CarveOrder::kVisiblePixels, 1, 1},
+                                 Variant{CarveDecision::kThreshold, CarveOrder::kFifo, 2, 1}}) {
+    CarveOptions options = Options(48, 30.0);
+    options.decision = variant.decision;
+    options.order = variant.order;
+    options.lod_levels = variant.lod_levels;
+    options.num_threads = variant.threads;
+    const CarveResult gathered = CarveVolume(views, scene.object_box, options);
+    options.incremental_statistics = true;
+    const CarveResult incremental = CarveVolume(views, scene.object_box, options);
+    const std::string name = CarveDecisionToString(variant.decision) + " " +
+                             CarveOrderToString(variant.order) + " lod " +
+                             std::to_string(variant.lod_levels) + " threads " +
+                             std::to_string(variant.threads);
+    EXPECT_GT(gathered.statistics.carved, 1000) << name;
+    EXPECT_EQ(incremental.statistics.carved, gathered.statistics.carved) << name;
+    EXPECT_EQ(incremental.statistics.evaluated, gathered.statistics.evaluated) << name;
+    for (int64_t i = 0; i < gathered.volume.grid().num_voxels(); ++i) {
+      ASSERT_EQ(incremental.volume.IsSolid(i), gathered.volume.IsSolid(i)) << name << ", " << i;
+    }
+    ASSERT_EQ(incremental.surface.size(), gathered.surface.size()) << name;
+    for (size_t i = 0; i < gathered.surface.size(); ++i) {
+      EXPECT_EQ(incremental.surface[i].colour, gathered.surface[i].colour) << name;
+    }
+  }
+  CarveOptions gvc = Options(48, 30.0);
+  gvc.method = CarveMethod::kGvc;
+  gvc.incremental_statistics = true;
+  std::string reason;
+  EXPECT_FALSE(gvc.IsValid(&reason));
+  EXPECT_NE(reason.find("ray casting"), std::string::npos) << reason;
+}
+
 // Share of the surface voxels judged by two or more views that lie within 2 voxels of the truth.
 double JudgedSurfaceNearTruth(const CarveResult& result) {
   int judged = 0, near = 0;

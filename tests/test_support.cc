@@ -7,12 +7,40 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <vector>
 
 #include <sys/wait.h>
 #include <unistd.h>
 
 namespace raycarve {
 namespace testing {
+
+namespace {
+
+// The folders MakeTemporaryDirectory made, removed when the test program exits (kept when
+// RAYCARVE_KEEP_TEST_FILES is set, to look at a failure's files).
+class TemporaryDirectories {
+ public:
+  ~TemporaryDirectories() {
+    const char* keep = std::getenv("RAYCARVE_KEEP_TEST_FILES");
+    if (keep != nullptr && *keep != '\0') return;
+    for (const std::filesystem::path& path : paths_) {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  }
+  void Add(const std::filesystem::path& path) { paths_.push_back(path); }
+
+ private:
+  std::vector<std::filesystem::path> paths_;
+};
+
+TemporaryDirectories& MadeDirectories() {
+  static TemporaryDirectories directories;
+  return directories;
+}
+
+}  // namespace
 
 std::string MakeTemporaryDirectory(const std::string& name) {
   std::random_device device;
@@ -21,6 +49,7 @@ std::string MakeTemporaryDirectory(const std::string& name) {
       ("raycarve_test_" + name + "_" + std::to_string(getpid()) + "_" + std::to_string(device()));
   std::filesystem::remove_all(path);
   std::filesystem::create_directories(path);
+  MadeDirectories().Add(path);
   return path.string();
 }
 

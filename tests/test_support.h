@@ -8,7 +8,8 @@
 namespace raycarve {
 namespace testing {
 
-// A fresh, empty folder for one test under the system's temporary folder.
+// A fresh, empty folder for one test under the system's temporary folder; removed when the test
+// program exits unless RAYCARVE_KEEP_TEST_FILES is set.
 std::string MakeTemporaryDirectory(const std::string& name);
 
 // The shared data folder ($RAYCARVE_DATA_DIR, else <source>/../shared/data), or "" when absent.

@@ -10,8 +10,7 @@ scripts/setup.sh raycarve >&2
 out=out/variants_${views}x${width}x${height}
 [ -d "$out/scene" ] || build/plugin/raycarve synth --output_path "$out/scene" --views "$views" \
   --width "$width" --height "$height" >&2
-# A JSON number from a report: json_number FILE KEY
-json_number() { grep -o "\"$2\": [-0-9.e+]*" "$1" | head -1 | sed 's/.*: //'; }
+source scripts/variants.sh
 echo "| variant | convergence s | evaluated | carved | final surface | completeness | accuracy (90%) | F-score |"
 echo "|---|---:|---:|---:|---:|---:|---:|---:|"
 run() {
@@ -29,12 +28,6 @@ run() {
     "$(json_number "$out/$name/compare.json" accuracy)" \
     "$(awk -v v="$(json_number "$out/$name/compare.json" f_score)" 'BEGIN { print 100 * v }')"
 }
-run fifo
-run visible_pixels --order visible_pixels
-run reprojection --decision reprojection
-run incremental_statistics --incremental_statistics 1
-for levels in 2 3 4; do
-  for band in 1 2; do run "lod${levels}_band${band}" --lod_levels "$levels" --lod_band "$band"; done
-done
+run_all_variants
 echo
 echo "Completeness and F-score at 2 voxels against $out/scene/truth.ply; reports in $out/."

@@ -14,7 +14,7 @@ data=${RAYCARVE_DATA_DIR:-../shared/data}/middlebury/$set
 scripts/setup.sh raycarve >&2
 out=out/variants_${set}_$resolution
 mkdir -p "$out"
-json_number() { grep -o "\"$2\": [-0-9.e+]*" "$1" | head -1 | sed 's/.*: //'; }
+source scripts/variants.sh
 echo "| variant | convergence s | evaluated | carved | final surface | sparse points within 2 voxels | held-out silhouette IoU | held-out PSNR |"
 echo "|---|---:|---:|---:|---:|---:|---:|---:|"
 run() {
@@ -31,12 +31,6 @@ run() {
     "$(awk -v v="$(json_number "$report" within_2_voxels)" 'BEGIN { print 100 * v }')" \
     "$(json_number "$holdout" mean_silhouette_iou)" "$(json_number "$holdout" mean_psnr_db)"
 }
-run fifo
-run visible_pixels --order visible_pixels
-run reprojection --decision reprojection
-run incremental_statistics --incremental_statistics 1
-for levels in 2 3 4; do
-  for band in 1 2; do run "lod${levels}_band${band}" --lod_levels "$levels" --lod_band "$band"; done
-done
+run_all_variants
 echo
 echo "$set (its calibration), $resolution voxels, threshold $threshold; reports in $out/."

@@ -1,0 +1,15 @@
+# The seed paper's section 4 variants, shared by run_variants.sh and run_variants_photos.sh
+# (sourced, not run): json_number FILE KEY reads a number from a report, and run_all_variants
+# calls the sourcing script's `run NAME [carve flags...]` once per variant.
+json_number() { grep -o "\"$2\": [-0-9.e+]*" "$1" | head -1 | sed 's/.*: //'; }
+
+run_all_variants() {
+  run fifo
+  run visible_pixels --order visible_pixels
+  run reprojection --decision reprojection
+  run incremental_statistics --incremental_statistics 1
+  local levels band
+  for levels in 2 3 4; do
+    for band in 1 2; do run "lod${levels}_band${band}" --lod_levels "$levels" --lod_band "$band"; done
+  done
+}

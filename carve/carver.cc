@@ -188,9 +188,7 @@ bool CheckCarveFits(const std::vector<CalibratedView>& views,
                     const CarveOptions& options,
                     std::string* reason) {
   if (!options.IsValid(reason)) return false;
-  // Levels of detail carve their coarse levels with ray lists.
-  const bool lists = options.method == CarveMethod::kRay &&
-                     (options.vis_lookup == VisLookup::kRayLists || options.lod_levels > 1);
+  const bool lists = options.method == CarveMethod::kRay && options.vis_lookup == VisLookup::kRayLists;
   double bytes_per_pixel = lists ? kBytesPerListedRay : kBytesPerRay;
   if (options.method == CarveMethod::kGvc) bytes_per_pixel = kBytesPerItemPixel;
   if (options.method == CarveMethod::kGvcLdi) bytes_per_pixel = kBytesPerLayeredPixel;
@@ -572,9 +570,6 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     CarveOptions level_options = options;
     level_options.resolution = resolutions[level];
     level_options.lod_levels = 1;
-    // Coarse voxels cover many pixels, so scanning their footprints costs far more than their
-    // Vis: coarse levels find Vis(V) through ray lists.
-    if (level + 1 < num_levels) level_options.vis_lookup = VisLookup::kRayLists;
     if (level == 0) {
       carver = std::make_unique<IncrementalCarver>(views, box, level_options);
     } else {

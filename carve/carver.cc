@@ -61,7 +61,7 @@ Volume WithVisualHull(const std::vector<CalibratedView>& views,
                       Volume volume,
                       const CarveOptions& options,
                       VisualHullStatistics* statistics) {
-  if (options.visual_hull) *statistics = CarveVisualHull(views, &volume);
+  if (options.visual_hull) *statistics = CarveVisualHull(views, &volume, options.num_threads);
   return volume;
 }
 

@@ -1,10 +1,13 @@
 #include "carve/visual_hull.h"
 
+#include <algorithm>
 #include <chrono>
+#include <thread>
 
 #include <opencv2/imgproc.hpp>
 
 #include "carve/footprint.h"
+#include "carve/view_workers.h"
 
 namespace raycarve {
 namespace {
@@ -15,25 +18,25 @@ int RectSum(const cv::Mat& integral, const Footprint& f) {
          integral.at<int>(f.row_max + 1, f.col_min) + integral.at<int>(f.row_min, f.col_min);
 }
 
-// Whether the voxel's projection lies inside the image: its footprint computed without clipping
-// equals the clipped one.
+// Whether the voxel's projection lies inside the image (not touching its first row or column),
+// with its footprint.
 bool FullyInside(const Eigen::Matrix<double, 3, 4>& P,
                  int width,
                  int height,
                  const VoxelGrid& grid,
                  const Eigen::Vector3i& voxel,
                  Footprint* footprint) {
-  *footprint = ComputeFootprint(P, width, height, grid, voxel);
-  if (footprint->empty()) return false;
-  const Footprint unclipped = ComputeFootprint(P, 1 << 20, 1 << 20, grid, voxel);
-  return unclipped.col_min == footprint->col_min && unclipped.row_min == footprint->row_min &&
-         unclipped.col_max == footprint->col_max && unclipped.row_max == footprint->row_max &&
-         footprint->col_min > 0 && footprint->row_min > 0;
+  // Computed as if the image were unbounded: inside, clipping would change nothing.
+  *footprint = ComputeFootprint(P, 1 << 20, 1 << 20, grid, voxel);
+  return !footprint->empty() && footprint->col_min > 0 && footprint->row_min > 0 &&
+         footprint->col_max < width && footprint->row_max < height;
 }
 
 }  // namespace
 
-VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views, Volume* volume) {
+VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
+                                     Volume* volume,
+                                     int num_threads) {
   const auto start = std::chrono::steady_clock::now();
   VisualHullStatistics statistics;
   struct MaskedView {
@@ -57,19 +60,34 @@ VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views, V
   statistics.views_with_masks = static_cast<int>(masked.size());
   if (masked.empty()) return statistics;
   const VoxelGrid& grid = volume->grid();
-  for (int64_t index = 0; index < grid.num_voxels(); ++index) {
-    if (!volume->IsSolid(index)) continue;
-    const Eigen::Vector3i voxel = grid.Voxel(index);
-    for (const MaskedView& m : masked) {
-      Footprint footprint;
-      if (!FullyInside(m.view->P, m.view->width, m.view->height, grid, voxel, &footprint)) continue;
-      if (RectSum(m.valid_integral, footprint) == 0) continue;  // no photo data there
-      if (RectSum(m.object_integral, footprint) == 0) {
-        volume->Carve(index, nullptr);
-        ++statistics.carved;
-        break;
+  // Judged in parallel (the decisions read nothing the carving changes), carved in order.
+  std::vector<uint8_t> outside(grid.num_voxels(), 0);
+  const int threads = std::max(1, std::min<int>(ResolveNumThreads(num_threads), 64));
+  auto judge = [&](int thread) {
+    for (int64_t index = thread; index < grid.num_voxels(); index += threads) {
+      if (!volume->IsSolid(index)) continue;
+      const Eigen::Vector3i voxel = grid.Voxel(index);
+      for (const MaskedView& m : masked) {
+        Footprint footprint;
+        if (!FullyInside(m.view->P, m.view->width, m.view->height, grid, voxel, &footprint)) {
+          continue;
+        }
+        if (RectSum(m.valid_integral, footprint) == 0) continue;  // no photo data there
+        if (RectSum(m.object_integral, footprint) == 0) {
+          outside[index] = 1;
+          break;
+        }
       }
     }
+  };
+  std::vector<std::thread> workers;
+  for (int thread = 1; thread < threads; ++thread) workers.emplace_back(judge, thread);
+  judge(0);
+  for (std::thread& worker : workers) worker.join();
+  for (int64_t index = 0; index < grid.num_voxels(); ++index) {
+    if (!outside[index]) continue;
+    volume->Carve(index, nullptr);
+    ++statistics.carved;
   }
   statistics.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -34,6 +34,12 @@ TEST(VisualHull, KeepsEveryVoxelOfTheTrueSurfaceAndRemovesMostEmptySpace) {
   for (int64_t i = 0; i < volume.grid().num_voxels(); ++i) {
     ASSERT_EQ(volume.IsSurface(i), volume.IsExposed(i)) << i;
   }
+  // Judged on 3 threads: the same voxels.
+  Volume threaded(VoxelGrid(box, 48));
+  EXPECT_EQ(CarveVisualHull(views, &threaded, 3).carved, statistics.carved);
+  for (int64_t i = 0; i < volume.grid().num_voxels(); ++i) {
+    ASSERT_EQ(threaded.IsSolid(i), volume.IsSolid(i)) << i;
+  }
 }
 
 TEST(VisualHull, ViewsWithoutMasksChangeNothing) {

@@ -32,17 +32,18 @@ constexpr double kBytesPerLayeredPixel = 4.0 + 4 * 12.0;
 constexpr double kBytesPerVoxel = 3.0 / 8.0 + 1.0;
 constexpr double kBytesPerListedVoxel = kBytesPerVoxel + 4.0;
 
-// Groups `vis` (view by view) into per-view colour statistics.
+// Appends to `stats` the colour statistics of pixels [begin, end), grouped view by view (a new
+// entry wherever the view changes).
 void GatherColours(const std::vector<CalibratedView>& views,
-                   const std::vector<PixelRef>& vis,
+                   const PixelRef* begin,
+                   const PixelRef* end,
                    std::vector<ViewColourStats>* stats) {
-  stats->clear();
-  for (const PixelRef& ref : vis) {
-    if (stats->empty() || stats->back().view != static_cast<int>(ref.view)) {
+  for (const PixelRef* ref = begin; ref != end; ++ref) {
+    if (ref == begin || ref->view != (ref - 1)->view) {
       stats->emplace_back();
-      stats->back().view = static_cast<int>(ref.view);
+      stats->back().view = static_cast<int>(ref->view);
     }
-    const uint8_t* rgb = views[ref.view].image.data + 3 * static_cast<size_t>(ref.pixel);
+    const uint8_t* rgb = views[ref->view].image.data + 3 * static_cast<size_t>(ref->pixel);
     stats->back().Add(Eigen::Vector3d(rgb[0], rgb[1], rgb[2]));
   }
 }
@@ -329,7 +330,10 @@ void IncrementalCarver::FindVis(int64_t voxel, bool gather) {
   } else {
     vis_.clear();
     visibility_->ComputeVis(voxel, &vis_);
-    if (gather) GatherColours(views_, vis_, &stats_);
+    if (gather) {
+      stats_.clear();
+      GatherColours(views_, vis_.data(), vis_.data() + vis_.size(), &stats_);
+    }
   }
   vis_ready_ = true;
 }
@@ -379,15 +383,9 @@ void IncrementalCarver::RunViewGroups(const std::vector<PixelRef>* advance,
           ray_visibility_->AdvanceRays(buffers.vis.data() + first,
                                        buffers.vis.data() + buffers.vis.size(), &buffers.changed);
         }
-        if (gather && buffers.vis.size() > first) {
-          ViewColourStats stats;
-          stats.view = view;
-          for (size_t i = first; i < buffers.vis.size(); ++i) {
-            const uint8_t* rgb =
-                views_[view].image.data + 3 * static_cast<size_t>(buffers.vis[i].pixel);
-            stats.Add(Eigen::Vector3d(rgb[0], rgb[1], rgb[2]));
-          }
-          buffers.stats.push_back(stats);
+        if (gather) {
+          GatherColours(views_, buffers.vis.data() + first,
+                        buffers.vis.data() + buffers.vis.size(), &buffers.stats);
         }
       }
       buffers.changed_end.push_back(buffers.changed.size());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
 #include <utility>
 
 #include <gtest/gtest.h>
@@ -81,6 +82,23 @@ TEST(CarveVolume, AThresholdSoTightThatNothingIsConsistentCarvesEverythingSeenTw
   }
 }
 
+// Two carvings are the same: counts, every voxel, and every surface voxel's colour and pixels.
+void ExpectSameCarving(const CarveResult& a, const CarveResult& b, const std::string& context) {
+  EXPECT_EQ(a.statistics.carved, b.statistics.carved) << context;
+  EXPECT_EQ(a.statistics.evaluated, b.statistics.evaluated) << context;
+  ASSERT_EQ(a.volume.grid().num_voxels(), b.volume.grid().num_voxels()) << context;
+  int64_t differing = 0;
+  for (int64_t i = 0; i < a.volume.grid().num_voxels(); ++i) {
+    differing += a.volume.IsSolid(i) != b.volume.IsSolid(i);
+  }
+  EXPECT_EQ(differing, 0) << context;
+  ASSERT_EQ(a.surface.size(), b.surface.size()) << context;
+  for (size_t i = 0; i < a.surface.size(); ++i) {
+    EXPECT_EQ(a.surface[i].colour, b.surface[i].colour) << context;
+    EXPECT_EQ(a.surface[i].num_pixels, b.surface[i].num_pixels) << context;
+  }
+}
+
 TEST(CarveVolume, FootprintScansAndRayListsCarveIdentically) {
   const SyntheticScene scene = Scene(6, 160, 120);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
@@ -89,16 +107,7 @@ TEST(CarveVolume, FootprintScansAndRayListsCarveIdentically) {
   options.vis_lookup = VisLookup::kRayLists;
   const CarveResult lists = CarveVolume(views, scene.object_box, options);
   EXPECT_GT(footprint.statistics.carved, 1000);
-  EXPECT_EQ(footprint.statistics.carved, lists.statistics.carved);
-  EXPECT_EQ(footprint.statistics.evaluated, lists.statistics.evaluated);
-  for (int64_t i = 0; i < footprint.volume.grid().num_voxels(); ++i) {
-    ASSERT_EQ(footprint.volume.IsSolid(i), lists.volume.IsSolid(i)) << i;
-  }
-  ASSERT_EQ(footprint.surface.size(), lists.surface.size());
-  for (size_t i = 0; i < footprint.surface.size(); ++i) {
-    EXPECT_EQ(footprint.surface[i].colour, lists.surface[i].colour);
-    EXPECT_EQ(footprint.surface[i].num_pixels, lists.surface[i].num_pixels);
-  }
+  ExpectSameCarving(lists, footprint, "ray lists against footprints");
 }
 
 TEST(CarveVolume, AnyNumberOfThreadsCarvesExactlyAsOneDoes) {
@@ -115,16 +124,7 @@ TEST(CarveVolume, AnyNumberOfThreadsCarvesExactlyAsOneDoes) {
     for (const int threads : {2, 4}) {
       options.num_threads = threads;
       const CarveResult many = CarveVolume(views, scene.object_box, options);
-      EXPECT_EQ(many.statistics.carved, one.statistics.carved) << threads;
-      EXPECT_EQ(many.statistics.evaluated, one.statistics.evaluated) << threads;
-      for (int64_t i = 0; i < one.volume.grid().num_voxels(); ++i) {
-        ASSERT_EQ(many.volume.IsSolid(i), one.volume.IsSolid(i)) << threads << " threads, " << i;
-      }
-      ASSERT_EQ(many.surface.size(), one.surface.size());
-      for (size_t i = 0; i < one.surface.size(); ++i) {
-        EXPECT_EQ(many.surface[i].colour, one.surface[i].colour);
-        EXPECT_EQ(many.surface[i].num_pixels, one.surface[i].num_pixels);
-      }
+      ExpectSameCarving(many, one, std::to_string(threads) + " threads");
       EXPECT_EQ(many.statistics.reprojection_error_after, one.statistics.reprojection_error_after);
     }
   }
@@ -157,15 +157,7 @@ TEST(CarveVolume, IncrementalStatisticsCarveExactlyAsGatheringDoes) {
                              std::to_string(variant.lod_levels) + " threads " +
                              std::to_string(variant.threads);
     EXPECT_GT(gathered.statistics.carved, 1000) << name;
-    EXPECT_EQ(incremental.statistics.carved, gathered.statistics.carved) << name;
-    EXPECT_EQ(incremental.statistics.evaluated, gathered.statistics.evaluated) << name;
-    for (int64_t i = 0; i < gathered.volume.grid().num_voxels(); ++i) {
-      ASSERT_EQ(incremental.volume.IsSolid(i), gathered.volume.IsSolid(i)) << name << ", " << i;
-    }
-    ASSERT_EQ(incremental.surface.size(), gathered.surface.size()) << name;
-    for (size_t i = 0; i < gathered.surface.size(); ++i) {
-      EXPECT_EQ(incremental.surface[i].colour, gathered.surface[i].colour) << name;
-    }
+    ExpectSameCarving(incremental, gathered, name);
   }
   CarveOptions gvc = Options(48, 30.0);
   gvc.method = CarveMethod::kGvc;

@@ -70,4 +70,39 @@ CalibratedView MakeCalibratedView(const Camera& camera,
   return view;
 }
 
+CalibratedView ReduceView(const CalibratedView& view, int factor) {
+  CHECK(factor >= 1 && factor <= std::min(view.width, view.height)) << "factor " << factor;
+  if (factor == 1) return view;
+  CalibratedView reduced = view;
+  reduced.width = view.width / factor;
+  reduced.height = view.height / factor;
+  const cv::Rect kept(0, 0, reduced.width * factor, reduced.height * factor);
+  const cv::Size size(reduced.width, reduced.height);
+  // INTER_AREA with an integer factor averages exactly the factor x factor blocks.
+  cv::resize(view.image(kept), reduced.image, size, 0, 0, cv::INTER_AREA);
+  // Valid where the whole block is; on the object where any of it is.
+  const auto reduce_mask = [&](const cv::Mat& mask, bool need_all) {
+    cv::Mat reduced_mask(size, CV_8UC1);
+    for (int row = 0; row < size.height; ++row) {
+      for (int col = 0; col < size.width; ++col) {
+        int set = 0;
+        for (int y = row * factor; y < (row + 1) * factor; ++y) {
+          const uint8_t* line = mask.ptr<uint8_t>(y);
+          for (int x = col * factor; x < (col + 1) * factor; ++x) set += line[x] != 0;
+        }
+        reduced_mask.at<uint8_t>(row, col) =
+            (need_all ? set == factor * factor : set > 0) ? 255 : 0;
+      }
+    }
+    return reduced_mask;
+  };
+  reduced.valid = reduce_mask(view.valid, /*need_all=*/true);
+  if (!view.mask.empty()) reduced.mask = reduce_mask(view.mask, /*need_all=*/false);
+  Eigen::Matrix3d scale = Eigen::Matrix3d::Identity();
+  scale(0, 0) = scale(1, 1) = 1.0 / factor;
+  reduced.K = scale * view.K;
+  reduced.P = scale * view.P;
+  return reduced;
+}
+
 }  // namespace raycarve

@@ -44,4 +44,13 @@ CalibratedView MakeCalibratedView(const Camera& camera,
                                   const cv::Mat& mask = cv::Mat(),
                                   const std::string& mask_source = "");
 
+// The view seen through an image `factor` times smaller along each axis, for carving coarse
+// voxels: each output pixel is the mean of a factor x factor block of input pixels (the last
+// width % factor columns and height % factor rows are dropped), so that COLMAP pixel coordinates
+// scale by 1 / factor exactly (K and P follow). A pixel is valid only where its whole block is,
+// and on the object (mask) where any of its block is: background pixels may be blended into a
+// silhouette's colours, but no object pixel is lost to a visual hull. factor 1 returns a copy
+// sharing the pixels. CHECKs 1 <= factor <= min(width, height).
+CalibratedView ReduceView(const CalibratedView& view, int factor);
+
 }  // namespace raycarve

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <sstream>
 
 #include <glog/logging.h>
@@ -64,6 +65,16 @@ Volume WithVisualHull(const std::vector<CalibratedView>& views,
                       VisualHullStatistics* statistics) {
   if (options.visual_hull) *statistics = CarveVisualHull(views, &volume, options.num_threads);
   return volume;
+}
+
+// How many times a level's photos are reduced: the level's voxel scale, halved while any photo's
+// shorter side would fall below CarveOptions::kMinReducedSide.
+int ImageFactor(const std::vector<CalibratedView>& views, int level_resolution, int resolution) {
+  int factor = resolution / level_resolution;
+  int shortest = std::numeric_limits<int>::max();
+  for (const CalibratedView& view : views) shortest = std::min({shortest, view.width, view.height});
+  while (factor > 1 && shortest / factor < CarveOptions::kMinReducedSide) factor /= 2;
+  return factor;
 }
 
 }  // namespace
@@ -563,25 +574,41 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   double next_sample = 0.0;
   int64_t hull_carved = 0;  // the first level's visual hull, in final voxels
   std::unique_ptr<IncrementalCarver> carver;
+  std::vector<CalibratedView> reduced_views;  // the photos of a coarse level, when reduced
   for (int level = 0; level < num_levels; ++level) {
     const Clock::time_point level_start = Clock::now();
     CarveOptions level_options = options;
     level_options.resolution = resolutions[level];
     level_options.lod_levels = 1;
-    if (level == 0) {
-      carver = std::make_unique<IncrementalCarver>(views, box, level_options);
-    } else {
-      Volume start_volume =
-          RefineVolume(carver->volume(), VoxelGrid(box, resolutions[level]), options.lod_band);
+    const int factor = options.lod_reduce_images ? ImageFactor(views, resolutions[level],
+                                                               options.resolution)
+                                                 : 1;
+    std::unique_ptr<Volume> start_volume;
+    if (level > 0) {
+      start_volume = std::make_unique<Volume>(
+          RefineVolume(carver->volume(), VoxelGrid(box, resolutions[level]), options.lod_band));
       carver.reset();  // the coarse level's rays and queue go before the fine level's come
-      carver = std::make_unique<IncrementalCarver>(views, std::move(start_volume), level_options);
+    }
+    reduced_views.clear();
+    if (factor > 1) {
+      reduced_views.resize(views.size());
+      for (size_t v = 0; v < views.size(); ++v) reduced_views[v] = ReduceView(views[v], factor);
+    }
+    const std::vector<CalibratedView>& level_views = factor > 1 ? reduced_views : views;
+    if (level == 0) {
+      carver = std::make_unique<IncrementalCarver>(level_views, box, level_options);
+    } else {
+      carver = std::make_unique<IncrementalCarver>(level_views, std::move(*start_volume),
+                                                   level_options);
     }
     // A voxel of this level holds `scale` final voxels (up to the grid's edge).
     const int64_t scale = int64_t{1} << (3 * (num_levels - 1 - level));
     LevelStatistics level_statistics;
     level_statistics.resolution = resolutions[level];
+    level_statistics.image_factor = factor;
     level_statistics.dimensions = carver->volume().grid().dimensions();
     level_statistics.start_solid = carver->volume().num_solid();
+    level_statistics.setup_seconds = SecondsSince(level_start);
     if (level == 0) {
       statistics.visibility = carver->visibility().Name();
       if (options.method == CarveMethod::kRay) {

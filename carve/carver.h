@@ -50,6 +50,9 @@ bool CarveDecisionFromString(const std::string& text, CarveDecision* decision);
 
 // Incremental voxel colouring with ray-cast visibility (Batchelor, Mukundan, Green).
 struct CarveOptions {
+  // The smallest shorter side of a photo reduced for a coarse level of detail.
+  static constexpr int kMinReducedSide = 48;
+
   CarveMethod method = CarveMethod::kRay;
   // Voxels along the longest axis of the box; voxels are cubes.
   int resolution = 128;
@@ -85,6 +88,11 @@ struct CarveOptions {
   // to `resolution` (which must be divisible by 2^(L-1)).
   int lod_levels = 1;
   int lod_band = 1;
+  // With levels of detail: a level whose voxels are f = 2^k times the final ones carves the
+  // photos reduced f times (block means; ReduceView), so that a voxel covers about as many
+  // pixels at every level (fewer while any photo's shorter side would drop below
+  // kMinReducedSide pixels). Off: every level carves the full photos.
+  bool lod_reduce_images = true;
   // Threads for ray casting with the footprint lookup and fifo order: each takes every n-th view
   // (rays are per view) for Vis(V), colour gathering and stepping rays (see view_workers.h).
   // The carving is identical for any count. < 1: one per hardware thread. Other methods, ray

@@ -16,12 +16,14 @@ namespace raycarve {
 // One level's figures.
 struct LevelStatistics {
   int resolution = 0;
+  int image_factor = 1;  // the photos were reduced this many times (CarveOptions::lod_reduce_images)
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   int64_t start_solid = 0;  // solid voxels when the level began (after refinement and hull)
   int64_t carved = 0;
   int64_t evaluated = 0;
   int64_t final_solid = 0;
-  double seconds = 0.0;  // set-up (rays) and carving
+  double seconds = 0.0;        // set-up (rays) and carving
+  double setup_seconds = 0.0;  // of which set-up: refinement, visual hull, rays, queue
 };
 
 // The resolutions of `levels` levels ending at `resolution`, coarsest first, each half the next.

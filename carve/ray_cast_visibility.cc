@@ -34,6 +34,12 @@ RayCastVisibility::RayCastVisibility(const std::vector<CalibratedView>& views,
     view_offset_.push_back(static_cast<int32_t>(total));
     total += static_cast<int64_t>(view.width) * view.height;
   }
+  // Where carving (a visual hull, a coarser level of detail) has emptied space, rays cross it a
+  // block at a time.
+  std::unique_ptr<BlockOccupancy> blocks;
+  if (volume.num_solid() < volume.grid().num_voxels()) {
+    blocks = std::make_unique<BlockOccupancy>(volume);
+  }
   auto make_rays = [&](int view) {
     const CalibratedView& v = views[view];
     const Eigen::Matrix3d world_from_pixel =
@@ -43,7 +49,7 @@ RayCastVisibility::RayCastVisibility(const std::vector<CalibratedView>& views,
     const cv::Mat usable = v.mask.empty() ? v.valid : (v.valid & v.mask);
     rays_[view] = std::make_unique<RayImage>(volume.grid(), world_from_pixel, v.centre, v.width,
                                              v.height, usable);
-    rays_[view]->Initialise(volume);
+    rays_[view]->Initialise(volume, blocks.get());
   };
   if (workers != nullptr && workers->num_groups() > 1 &&
       workers->num_views() == static_cast<int>(views.size())) {

@@ -1,5 +1,6 @@
 #include "carve/ray_image.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -18,6 +19,7 @@ inline Eigen::Vector3d RayImage::GridDirection(int pixel) const {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr int kZero[3] = {0, 0, 0};
 
 // Bits needed for coordinates 0 .. n-1.
 int CoordinateBits(int n) {
@@ -56,8 +58,8 @@ RayImage::RayImage(const VoxelGrid& grid,
   shift_z_ = shift_y_ + CoordinateBits(n.y());
   mask_x_ = (uint32_t{1} << shift_y_) - 1;
   mask_y_ = (uint32_t{1} << (shift_z_ - shift_y_)) - 1;
+  n_ = {n.x(), n.y(), n.z()};
   keys_.assign(static_cast<size_t>(width) * height, kInactive);
-  for (int pixel = 0; pixel < num_pixels(); ++pixel) InitialiseRay(pixel);
 }
 
 Eigen::Vector3d RayImage::Direction(int pixel) const {
@@ -97,14 +99,29 @@ void RayImage::InitialiseRay(int pixel) {
   keys_[pixel] = Key(voxel);
 }
 
-void RayImage::Initialise(const Volume& volume) {
+void RayImage::Initialise(const Volume& volume, const BlockOccupancy* blocks) {
+  CHECK(volume.grid().dimensions() == grid_.dimensions());
+  CHECK(blocks == nullptr ||
+        (blocks->dimensions().array() ==
+         (grid_.dimensions().array() + (BlockOccupancy::kSize - 1)) / BlockOccupancy::kSize)
+            .all());
   for (int pixel = 0; pixel < num_pixels(); ++pixel) {
     InitialiseRay(pixel);
-    Advance(pixel, volume);
+    if (keys_[pixel] == kInactive) continue;
+    if (blocks != nullptr) {
+      keys_[pixel] = FirstSolid(pixel, volume, *blocks);
+    } else {
+      Advance(pixel, volume);
+    }
   }
 }
 
-int64_t RayImage::Step(int pixel, const Volume& volume, int voxel[3], bool skip_current) const {
+int64_t RayImage::Step(int pixel,
+                       const Volume& volume,
+                       int voxel[3],
+                       bool skip_current,
+                       const int lo[3],
+                       const int hi[3]) const {
   // The hottest loop of ray-cast carving: per axis scalars rather than arrays indexed by the
   // chosen axis, so that the state stays in registers.
   const Eigen::Vector3i& n = grid_.dimensions();
@@ -118,7 +135,7 @@ int64_t RayImage::Step(int pixel, const Volume& volume, int voxel[3], bool skip_
   // Amanatides-Woo state of the current voxel, per axis: the ray parameter where the ray leaves
   // it through that axis's far face (infinite along an axis plane: that axis never steps), the
   // parameter length of one voxel, the step, its index stride and the coordinate that means
-  // the ray has left the grid.
+  // the ray has left the region.
   const auto axis_state = [&](int axis, int coordinate, int64_t stride, double* t_max,
                               double* t_delta, int* step, int64_t* index_step, int* end) {
     const double inverse = 1.0 / d[axis];
@@ -127,7 +144,7 @@ int64_t RayImage::Step(int pixel, const Volume& volume, int voxel[3], bool skip_
     *t_delta = std::abs(inverse);
     *step = up ? 1 : -1;
     *index_step = up ? stride : -stride;
-    *end = up ? n[axis] : -1;
+    *end = up ? hi[axis] : lo[axis] - 1;
   };
   double tx, ty, tz, dx, dy, dz;
   int step_x, step_y, step_z, end_x, end_y, end_z;
@@ -138,26 +155,134 @@ int64_t RayImage::Step(int pixel, const Volume& volume, int voxel[3], bool skip_
   while (true) {
     if (tx < ty && tx < tz) {
       x += step_x;
-      if (x == end_x) return kNoVoxel;
+      if (x == end_x) break;
       tx += dx;
       index += index_x;
     } else if (!(tx < ty) && ty < tz) {
       y += step_y;
-      if (y == end_y) return kNoVoxel;
+      if (y == end_y) break;
       ty += dy;
       index += index_y;
     } else {
       z += step_z;
-      if (z == end_z) return kNoVoxel;
+      if (z == end_z) break;
       tz += dz;
       index += index_z;
     }
-    if (is_solid(index)) break;
+    if (is_solid(index)) {
+      voxel[0] = x;
+      voxel[1] = y;
+      voxel[2] = z;
+      return index;
+    }
   }
   voxel[0] = x;
   voxel[1] = y;
   voxel[2] = z;
-  return index;
+  return kNoVoxel;
+}
+
+
+bool RayImage::SkipEmptyBlocks(int pixel, const BlockOccupancy& blocks, int voxel[3]) const {
+  constexpr int kShift = BlockOccupancy::kShift;
+  constexpr int kSize = BlockOccupancy::kSize;
+  const Eigen::Vector3i& n = grid_.dimensions();
+  int bx = voxel[0] >> kShift, by = voxel[1] >> kShift, bz = voxel[2] >> kShift;
+  const Eigen::Vector3i& nb = blocks.dimensions();
+  const int64_t block_stride_y = nb.x(), block_stride_z = static_cast<int64_t>(nb.x()) * nb.y();
+  int64_t block = bx + block_stride_y * by + block_stride_z * bz;
+  if (blocks.IsOccupied(block)) return true;
+  const Eigen::Vector3d d = GridDirection(pixel);
+  // Step's traversal on a grid of voxels kSize wide, per axis in scalars. The ray leaves the
+  // grid at t_exit: the last block along an axis may be partial (the grid ends at n, not at a
+  // block edge), so leaving the blocks is not enough.
+  double t_exit = kInfinity;
+  const auto axis_state = [&](int axis, int coordinate, int64_t stride, double* t_max,
+                              double* t_delta, int* step, int64_t* index_step) {
+    const bool up = d[axis] > 0.0;
+    if (d[axis] != 0.0) {
+      t_exit = std::min(t_exit, ((up ? n[axis] : 0) - centre_grid_[axis]) / d[axis]);
+    }
+    *t_max = d[axis] == 0.0 ? kInfinity
+                            : ((coordinate + (up ? 1 : 0)) * kSize - centre_grid_[axis]) / d[axis];
+    *t_delta = kSize / std::abs(d[axis]);
+    *step = up ? 1 : -1;
+    *index_step = up ? stride : -stride;
+  };
+  double tx, ty, tz, dx, dy, dz;
+  int step_x, step_y, step_z;
+  int64_t index_x, index_y, index_z;
+  axis_state(0, bx, 1, &tx, &dx, &step_x, &index_x);
+  axis_state(1, by, block_stride_y, &ty, &dy, &step_y, &index_y);
+  axis_state(2, bz, block_stride_z, &tz, &dz, &step_z, &index_z);
+  // Leaving the blocks (or the grid, at t_exit) ends the search.
+  const int end_x = step_x > 0 ? nb.x() : -1, end_y = step_y > 0 ? nb.y() : -1,
+            end_z = step_z > 0 ? nb.z() : -1;
+  // The axis and parameter of the last step: where the ray enters the block it stops in.
+  int axis;
+  double t;
+  do {
+    if (tx < ty && tx < tz) {
+      axis = 0;
+      t = tx;
+      bx += step_x;
+      if (bx == end_x) return false;
+      tx += dx;
+      block += index_x;
+    } else if (!(tx < ty) && ty < tz) {
+      axis = 1;
+      t = ty;
+      by += step_y;
+      if (by == end_y) return false;
+      ty += dy;
+      block += index_y;
+    } else {
+      axis = 2;
+      t = tz;
+      bz += step_z;
+      if (bz == end_z) return false;
+      tz += dz;
+      block += index_z;
+    }
+    if (t >= t_exit) return false;
+  } while (!blocks.IsOccupied(block));
+  // The voxel where the ray enters the block: on the entered face along `axis`, and where the ray
+  // is at that moment along the others (kept inside the block against rounding).
+  const int entered[3] = {bx, by, bz};
+  for (int other = 0; other < 3; ++other) {
+    const int first = entered[other] * kSize;
+    const int last = std::min(first + kSize, n[other]) - 1;
+    if (other == axis) {
+      voxel[other] = d[other] > 0.0 ? first : last;
+    } else {
+      const int at = static_cast<int>(std::floor(centre_grid_[other] + t * d[other]));
+      voxel[other] = std::clamp(at, first, last);
+    }
+  }
+  return true;
+}
+
+uint32_t RayImage::FirstSolid(int pixel, const Volume& volume, const BlockOccupancy& blocks) const {
+  constexpr int kShift = BlockOccupancy::kShift;
+  constexpr int kSize = BlockOccupancy::kSize;
+  const Eigen::Vector3i& n = grid_.dimensions();
+  const Eigen::Vector3i start = Unpack(keys_[pixel]);
+  int voxel[3] = {start.x(), start.y(), start.z()};
+  // Each round moves to a later block along the ray, so the loop ends.
+  while (true) {
+    if (!SkipEmptyBlocks(pixel, blocks, voxel)) return kInactive;
+    int lo[3], hi[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      lo[axis] = (voxel[axis] >> kShift) << kShift;
+      hi[axis] = std::min(lo[axis] + kSize, n[axis]);
+    }
+    if (Step(pixel, volume, voxel, /*skip_current=*/false, lo, hi) != kNoVoxel) {
+      return Key(Eigen::Vector3i(voxel[0], voxel[1], voxel[2]));
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      if (voxel[axis] < 0 || voxel[axis] >= n[axis]) return kInactive;  // left the grid
+    }
+  }
 }
 
 int64_t RayImage::Advance(int pixel, const Volume& volume) {
@@ -165,7 +290,7 @@ int64_t RayImage::Advance(int pixel, const Volume& volume) {
   if (key == kInactive) return kNoVoxel;
   const Eigen::Vector3i start = Unpack(key);
   int voxel[3] = {start.x(), start.y(), start.z()};
-  const int64_t index = Step(pixel, volume, voxel, /*skip_current=*/false);
+  const int64_t index = Step(pixel, volume, voxel, /*skip_current=*/false, kZero, n_.data());
   keys_[pixel] = index == kNoVoxel ? kInactive : Key(Eigen::Vector3i(voxel[0], voxel[1], voxel[2]));
   return index;
 }
@@ -175,7 +300,7 @@ int64_t RayImage::PeekBeyondCurrent(int pixel, const Volume& volume) const {
   if (key == kInactive) return kNoVoxel;
   const Eigen::Vector3i start = Unpack(key);
   int voxel[3] = {start.x(), start.y(), start.z()};
-  return Step(pixel, volume, voxel, /*skip_current=*/true);
+  return Step(pixel, volume, voxel, /*skip_current=*/true, kZero, n_.data());
 }
 
 }  // namespace raycarve

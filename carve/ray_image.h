@@ -1,11 +1,13 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "carve/block_occupancy.h"
 #include "carve/volume.h"
 #include "carve/voxel_grid.h"
 
@@ -47,8 +49,11 @@ class RayImage {
   int height() const { return height_; }
   int num_pixels() const { return width_ * height_; }
 
-  // Moves every ray to the first solid voxel of `volume` along it.
-  void Initialise(const Volume& volume);
+  // Moves every ray to the first solid voxel of `volume` along it (until then every ray is
+  // gone). With `blocks` (made from `volume`), empty blocks are crossed a block at a time: the
+  // same voxels (up to rays through exact block edges, which may start in either voxel they
+  // touch), at a fraction of the steps where much of the volume is empty.
+  void Initialise(const Volume& volume, const BlockOccupancy* blocks = nullptr);
 
   int64_t CurrentVoxel(int pixel) const {
     const uint32_t key = keys_[pixel];
@@ -87,9 +92,20 @@ class RayImage {
   }
 
   void InitialiseRay(int pixel);
-  // Steps from `voxel` (updated in place) until a solid voxel (returned, its index) or the box's
-  // edge (kNoVoxel). With `skip_current`, the starting voxel counts as empty.
-  int64_t Step(int pixel, const Volume& volume, int voxel[3], bool skip_current) const;
+  // Steps from `voxel` (updated in place) until a solid voxel (returned, its index) or the edge
+  // of the region [lo, hi) of voxel coordinates (kNoVoxel; `voxel` is then the first voxel
+  // outside it). With `skip_current`, the starting voxel counts as empty.
+  int64_t Step(int pixel,
+               const Volume& volume,
+               int voxel[3],
+               bool skip_current,
+               const int lo[3],
+               const int hi[3]) const;
+  // From `voxel`, crosses empty blocks until the ray enters an occupied one (true; `voxel` is
+  // then where it enters) or leaves the grid (false).
+  bool SkipEmptyBlocks(int pixel, const BlockOccupancy& blocks, int voxel[3]) const;
+  // The key of the first solid voxel from the ray's current (entry) voxel, or kInactive.
+  uint32_t FirstSolid(int pixel, const Volume& volume, const BlockOccupancy& blocks) const;
   // The direction in grid units (voxel size 1) for `pixel`.
   Eigen::Vector3d GridDirection(int pixel) const;
 
@@ -98,6 +114,7 @@ class RayImage {
   Eigen::Matrix3d grid_from_pixel_;  // world_from_pixel_ in voxel units, for stepping
   double inverse_width_;             // row = floor((pixel + 0.5) * inverse_width_), exactly
   Eigen::Vector3d centre_grid_;  // camera centre in grid coordinates
+  std::array<int, 3> n_;  // grid dimensions
   int width_;
   int height_;
   cv::Mat valid_;

@@ -148,6 +148,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("decision").Value(CarveDecisionToString(request.options.decision))
       .Key("lod_levels").Value(request.options.lod_levels)
       .Key("lod_band").Value(request.options.lod_band)
+      .Key("lod_reduce_images").Value(request.options.lod_reduce_images)
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
       .Key("num_threads").Value(ResolveNumThreads(request.options.num_threads))
       .Key("incremental_statistics").Value(request.options.incremental_statistics)
@@ -212,11 +213,13 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
         .Key("grid").Value(std::vector<double>{static_cast<double>(level.dimensions.x()),
                                                 static_cast<double>(level.dimensions.y()),
                                                 static_cast<double>(level.dimensions.z())})
+        .Key("image_factor").Value(level.image_factor)
         .Key("start_solid").Value(level.start_solid)
         .Key("carved").Value(level.carved)
         .Key("evaluated").Value(level.evaluated)
         .Key("final_solid").Value(level.final_solid)
         .Key("seconds").Value(level.seconds)
+        .Key("setup_seconds").Value(level.setup_seconds)
         .EndObject();
   }
   json.EndArray();
@@ -290,6 +293,9 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "resolution must be divisible by 2^(L-1)); 1: no levels");
   parser->AddDefault("lod_band", &request->options.lod_band,
                      "voxels put back around what survived a coarse level before refining");
+  parser->AddDefault("lod_reduce_images", &request->options.lod_reduce_images,
+                     "coarse levels carve photos reduced by the level's voxel scale (block "
+                     "means): a voxel covers about as many pixels at every level");
   parser->AddDefault("colour_calibration", &request->colour_calibration,
                      "estimate a gain and offset per photo and channel from the sparse points' "
                      "colours (Ceres, robust) and correct the photos before carving");

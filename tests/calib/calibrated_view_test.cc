@@ -153,6 +153,56 @@ TEST(CalibratedView, PhotoOfTheWrongSizeIsAnErrorNamingIt) {
   }
 }
 
+TEST(CalibratedView, AReducedViewAveragesBlocksAndProjectsToScaledPixels) {
+  const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kPinhole));
+  const Reconstruction& reconstruction = scene.reconstruction;
+  const Image& image = reconstruction.images.begin()->second;
+  CalibratedView view = MakeCalibratedView(reconstruction.cameras.at(image.camera_id), image,
+                                           scene.photos.at(image.image_id), image.name);
+  // An object mask with one isolated object pixel, and one invalid pixel.
+  view.mask = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
+  view.mask.at<uint8_t>(50, 70) = 255;
+  view.valid.at<uint8_t>(10, 21) = 0;
+  for (int factor : {2, 3, 7}) {  // 7 does not divide 160 or 120
+    SCOPED_TRACE(factor);
+    const CalibratedView reduced = ReduceView(view, factor);
+    ASSERT_EQ(reduced.width, 160 / factor);
+    ASSERT_EQ(reduced.height, 120 / factor);
+    ASSERT_EQ(reduced.image.cols, reduced.width);
+    ASSERT_EQ(reduced.image.rows, reduced.height);
+    // Each pixel is its block's mean (rounded).
+    for (int row = 0; row < reduced.height; row += 3) {
+      for (int col = 0; col < reduced.width; col += 5) {
+        for (int channel = 0; channel < 3; ++channel) {
+          double sum = 0.0;
+          for (int y = 0; y < factor; ++y) {
+            for (int x = 0; x < factor; ++x) {
+              sum += view.image.at<cv::Vec3b>(row * factor + y, col * factor + x)[channel];
+            }
+          }
+          EXPECT_NEAR(reduced.image.at<cv::Vec3b>(row, col)[channel], sum / (factor * factor), 0.51)
+              << row << " " << col;
+        }
+      }
+    }
+    // A world point lands at the full view's pixel coordinates divided by the factor (COLMAP
+    // convention: the image's corner at 0), and inside the block that held it.
+    for (const Point2D& point2D : image.points2D) {
+      const Eigen::Vector3d xyz = reconstruction.points3D.at(point2D.point3D_id).xyz;
+      EXPECT_LT((reduced.Project(xyz) - view.Project(xyz) / factor).norm(), 1e-9);
+    }
+    EXPECT_TRUE(reduced.centre.isApprox(view.centre));
+    // The mask keeps the lone object pixel's block; the invalid pixel spoils its block only.
+    EXPECT_EQ(cv::countNonZero(reduced.mask), 1);
+    EXPECT_EQ(reduced.mask.at<uint8_t>(50 / factor, 70 / factor), 255);
+    EXPECT_EQ(reduced.valid.at<uint8_t>(10 / factor, 21 / factor), 0);
+    EXPECT_EQ(cv::countNonZero(reduced.valid), reduced.width * reduced.height - 1);
+  }
+  const CalibratedView same = ReduceView(view, 1);
+  EXPECT_EQ(same.width, view.width);
+  EXPECT_EQ(same.image.data, view.image.data);
+}
+
 TEST(ViewReader, MissingPhotosAreErrorsOrSkippedAndCounted) {
   const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kSimpleRadial));
   const std::string root = testing::MakeTemporaryDirectory("view_reader");

@@ -140,6 +140,60 @@ TEST(RayImage, RaysAlongGridPlanesEdgesAndCornersStayOnAConnectedPathOfTouchedVo
   }
 }
 
+// A volume of a few random solid balls on a grid whose dimensions are not multiples of the
+// block size, so that most blocks are empty and the edge blocks are partial.
+Volume RandomBalls(const VoxelGrid& grid, int balls, std::mt19937_64* random) {
+  const Eigen::Vector3i& n = grid.dimensions();
+  std::vector<uint64_t> solid((grid.num_voxels() + 63) / 64, 0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int ball = 0; ball < balls; ++ball) {
+    const Eigen::Vector3d centre(n.x() * unit(*random), n.y() * unit(*random), n.z() * unit(*random));
+    const double radius = 1.5 + 3.5 * unit(*random);
+    for (int64_t index = 0; index < grid.num_voxels(); ++index) {
+      const Eigen::Vector3d at = grid.Voxel(index).cast<double>().array() + 0.5;
+      if ((at - centre).norm() <= radius) solid[index >> 6] |= uint64_t{1} << (index & 63);
+    }
+  }
+  return Volume(grid, std::move(solid));
+}
+
+TEST(RayImage, CrossingEmptyBlocksReachesTheSameFirstSolidVoxelsAsSteppingEveryVoxel) {
+  const VoxelGrid grid(
+      Eigen::AlignedBox3d(Eigen::Vector3d(-1, -0.7, -0.5), Eigen::Vector3d(1, 0.7, 0.6)), 23);
+  ASSERT_EQ(grid.dimensions(), Eigen::Vector3i(23, 17, 13));
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  int64_t hits = 0, rays_compared = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const Volume volume = RandomBalls(grid, trial % 5 == 0 ? 0 : 2 + trial % 7, &random);
+    const BlockOccupancy blocks(volume);
+    // A 40x30 camera somewhere around the box, looking at a random point inside it.
+    Eigen::Vector3d centre(uniform(random), uniform(random), uniform(random));
+    centre = 3.0 * centre.normalized();
+    const Eigen::Vector3d target(0.8 * uniform(random), 0.5 * uniform(random), 0.4 * uniform(random));
+    const Eigen::Vector3d forward = (target - centre).normalized();
+    const Eigen::Vector3d right = forward.cross(Eigen::Vector3d(0.3, 0.1, 1)).normalized();
+    const Eigen::Vector3d down = forward.cross(right);
+    Eigen::Matrix3d world_from_pixel;  // pixel (u, v, 1) -> forward + (u - 20) r + (v - 15) d
+    world_from_pixel.col(0) = right / 25.0;
+    world_from_pixel.col(1) = down / 25.0;
+    world_from_pixel.col(2) = forward - 20.0 * right / 25.0 - 15.0 * down / 25.0;
+    RayImage every_voxel(grid, world_from_pixel, centre, 40, 30);
+    RayImage by_blocks(grid, world_from_pixel, centre, 40, 30);
+    every_voxel.Initialise(volume);
+    by_blocks.Initialise(volume, &blocks);
+    for (int pixel = 0; pixel < 40 * 30; ++pixel) {
+      ASSERT_EQ(by_blocks.CurrentVoxel(pixel), every_voxel.CurrentVoxel(pixel))
+          << "trial " << trial << " pixel " << pixel;
+      hits += every_voxel.CurrentVoxel(pixel) != RayImage::kNoVoxel;
+      ++rays_compared;
+    }
+  }
+  // The comparison covers both rays that hit and rays that cross the whole grid.
+  EXPECT_GT(hits, rays_compared / 20);
+  EXPECT_LT(hits, rays_compared / 2);
+}
+
 TEST(RayImage, RaysMissingTheBoxOrMaskedOutHaveNoVoxel) {
   Volume volume(kGrid);
   Eigen::Matrix3d away = Eigen::Matrix3d::Zero();

@@ -1,8 +1,13 @@
 // Carving benchmark: the generated scene (samples/synthetic_scene) at N views of WxH, carved at
 // each requested resolution; prints convergence time, memory, voxels carved and evaluated as a
 // table and as JSON. A benchmark, not a test: figures depend on the machine.
+// With each result, its quality against the scene's exact surface: the share of the seen
+// surface voxels whose centre lies within 2 voxels of it (precision), and the share of a sample of
+// the true surface seen by 2 views with a seen surface voxel centre within 2 voxels
+// (completeness).
 //   scripts/run_benchmark.sh [--views 14 --width 800 --height 600 --resolutions 128,256
-//                             --threads 1,2 --vis_lookup footprint --incremental_statistics 1]
+//                             --threads 1,2 --vis_lookup footprint --incremental_statistics 1
+//                             --lod_levels 1,3]
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -25,6 +30,44 @@ double PeakResidentMiB() {
   return -1.0;
 }
 
+struct Quality {
+  double precision = 0.0;
+  double completeness = 0.0;
+};
+
+Quality MeasureQuality(const raycarve::CarveResult& result,
+                       const std::vector<Eigen::Vector3d>& truth) {
+  const raycarve::VoxelGrid& grid = result.volume.grid();
+  const double within = 2.0 * grid.voxel_size();
+  std::vector<uint8_t> seen(grid.num_voxels(), 0);
+  int64_t num_seen = 0, near = 0;
+  for (const raycarve::ColouredVoxel& voxel : result.surface) {
+    if (voxel.num_pixels == 0) continue;
+    seen[voxel.index] = 1;
+    ++num_seen;
+    near += raycarve::TrueSurfaceDistance(grid.Centre(grid.Voxel(voxel.index))) <= within;
+  }
+  int64_t covered = 0;
+  for (const Eigen::Vector3d& point : truth) {
+    const Eigen::Vector3i at = grid.VoxelOf(point);
+    bool found = false;
+    for (int dz = -2; dz <= 2 && !found; ++dz) {
+      for (int dy = -2; dy <= 2 && !found; ++dy) {
+        for (int dx = -2; dx <= 2 && !found; ++dx) {
+          const Eigen::Vector3i voxel = at + Eigen::Vector3i(dx, dy, dz);
+          found = grid.Contains(voxel) && seen[grid.Index(voxel)] &&
+                  (grid.Centre(voxel) - point).norm() <= within;
+        }
+      }
+    }
+    covered += found;
+  }
+  Quality quality;
+  quality.precision = num_seen == 0 ? 0.0 : static_cast<double>(near) / num_seen;
+  quality.completeness = truth.empty() ? 0.0 : static_cast<double>(covered) / truth.size();
+  return quality;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -40,6 +83,7 @@ int main(int argc, char** argv) {
   bool incremental_statistics = false;
   // One thread (the paper's setting) and every hardware thread; ray lists always use one.
   std::vector<int> thread_counts = {1};
+  std::vector<int> level_counts = {1};
   if (raycarve::ResolveNumThreads(-1) > 1) thread_counts.push_back(raycarve::ResolveNumThreads(-1));
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
@@ -56,8 +100,9 @@ int main(int argc, char** argv) {
       }
       if (value != "both") lookups = {lookup};
     }
-    else if (flag == "--resolutions" || flag == "--threads") {
-      std::vector<int>& numbers = flag == "--threads" ? thread_counts : resolutions;
+    else if (flag == "--resolutions" || flag == "--threads" || flag == "--lod_levels") {
+      std::vector<int>& numbers =
+          flag == "--threads" ? thread_counts : (flag == "--lod_levels" ? level_counts : resolutions);
       numbers.clear();
       std::stringstream list(value);
       std::string item;
@@ -81,13 +126,15 @@ int main(int argc, char** argv) {
         scene.reconstruction.cameras.at(image.camera_id), image, scene.photos.at(image_id), image.name));
   }
 
-  std::printf("%-10s %-10s %-7s %-14s %10s %10s %12s %12s %12s %12s\n", "resolution", "vis",
-              "threads", "grid", "set-up s", "converge s", "memory MiB", "peak RSS MiB", "carved",
-              "evaluated");
+  const std::vector<Eigen::Vector3d> truth = raycarve::SampleTrueSurface(scene, 20000, 5, 2);
+  std::printf("%-10s %-10s %-7s %-6s %-14s %10s %10s %12s %12s %12s %12s %9s %12s\n", "resolution",
+              "vis", "threads", "levels", "grid", "set-up s", "converge s", "memory MiB",
+              "peak RSS MiB", "carved", "evaluated", "precision", "completeness");
   std::ostringstream json;
   json << "[";
   bool first = true;
   for (size_t k = 0; k < resolutions.size(); ++k) {
+   for (const int levels : level_counts) {
    for (const raycarve::VisLookup lookup : lookups) {
    for (const int threads : thread_counts) {
     if (lookup == raycarve::VisLookup::kRayLists && threads != thread_counts.front()) continue;
@@ -97,6 +144,7 @@ int main(int argc, char** argv) {
     options.vis_lookup = lookup;
     options.incremental_statistics = incremental_statistics;
     options.num_threads = lookup == raycarve::VisLookup::kRayLists ? 1 : threads;
+    options.lod_levels = levels;
     const std::string vis = raycarve::VisLookupToString(lookup);
     if (!raycarve::CheckCarveFits(views, scene.object_box, options, &reason)) {
       std::fprintf(stderr, "resolution %d: %s\n", resolutions[k], reason.c_str());
@@ -107,20 +155,25 @@ int main(int argc, char** argv) {
     char grid[32];
     std::snprintf(grid, sizeof(grid), "%dx%dx%d", s.dimensions.x(), s.dimensions.y(), s.dimensions.z());
     const double memory = s.peak_memory_bytes / (1024.0 * 1024.0);
-    std::printf("%-10d %-10s %-7d %-14s %10.2f %10.2f %12.1f %12.1f %12lld %12lld\n",
-                resolutions[k], vis.c_str(), options.num_threads, grid,
+    const Quality quality = MeasureQuality(result, truth);
+    std::printf("%-10d %-10s %-7d %-6d %-14s %10.2f %10.2f %12.1f %12.1f %12lld %12lld %8.1f%% %11.1f%%\n",
+                resolutions[k], vis.c_str(), options.num_threads, levels, grid,
                 s.setup_seconds, s.carve_seconds, memory, PeakResidentMiB(),
-                static_cast<long long>(s.carved), static_cast<long long>(s.evaluated));
+                static_cast<long long>(s.carved), static_cast<long long>(s.evaluated),
+                100.0 * quality.precision, 100.0 * quality.completeness);
     std::fflush(stdout);
     json << (first ? "" : ",") << "\n  {\"resolution\": " << resolutions[k]
          << ", \"vis_lookup\": \"" << vis << "\", \"threads\": " << options.num_threads
+         << ", \"lod_levels\": " << levels
          << ", \"grid\": \"" << grid
          << "\", \"views\": " << views.size() << ", \"width\": " << scene_options.width
          << ", \"height\": " << scene_options.height << ", \"setup_seconds\": " << s.setup_seconds
          << ", \"convergence_seconds\": " << s.carve_seconds << ", \"memory_mib\": " << memory
          << ", \"peak_rss_mib\": " << PeakResidentMiB() << ", \"carved\": " << s.carved
-         << ", \"evaluated\": " << s.evaluated << "}";
+         << ", \"evaluated\": " << s.evaluated << ", \"precision\": " << quality.precision
+         << ", \"completeness\": " << quality.completeness << "}";
     first = false;
+   }
    }
    }
   }

@@ -39,6 +39,12 @@ int RunSynth(int argc, char** argv) {
                     "behind the scene: a patchwork sky, or a uniform dark backdrop (a studio set-up "
                     "that needs masks)",
                     {"patchwork", "uniform"});
+  std::string texture = "plain";
+  parser.AddDefault("texture", &texture,
+                    "the surfaces' texture: plain checks and stripes, or with a non-repeating "
+                    "noise added (detailed) so that COLMAP's structure-from-motion can match the "
+                    "photos",
+                    {"plain", "detailed"});
   std::vector<std::string> models;
   for (CameraModelId model : SupportedCameraModels()) models.push_back(CameraModelName(model));
   parser.AddDefault("camera_model", &camera_model,
@@ -46,6 +52,7 @@ int RunSynth(int argc, char** argv) {
   if (!parser.Parse(argc, argv)) return 0;
   options.camera_model = CameraModelIdFromName(camera_model, "--camera_model");
   options.uniform_backdrop = backdrop == "uniform";
+  options.detail_texture = texture == "detailed";
   SceneKindFromString(scene_kind, &options.scene);
   std::string reason;
   if (!options.IsValid(&reason)) throw InputError("raycarve synth: " + reason);

@@ -143,8 +143,36 @@ Eigen::Vector3d SkyColour(const Eigen::Vector3d& direction) {
   return Eigen::Vector3d(40 + (hash & 0x7f), 40 + ((hash >> 8) & 0x7f), 60 + ((hash >> 16) & 0x7f));
 }
 
-// Texture colour (RGB, 0-255) of a surface point, with a fixed directional shading.
-Eigen::Vector3d SurfaceColour(const Hit& hit) {
+// Value noise in [0, 1] at a point: random values on a lattice of spacing `scale` (hashed from
+// the lattice coordinates and `channel`), interpolated smoothly. Not periodic.
+double ValueNoise(const Eigen::Vector3d& point, double scale, uint32_t channel) {
+  const Eigen::Vector3d p = point / scale;
+  const Eigen::Vector3d base = p.array().floor();
+  const Eigen::Vector3d f = p - base;
+  const Eigen::Vector3d w = f.array().square() * (3.0 - 2.0 * f.array());  // smoothstep
+  const auto lattice = [&](int dx, int dy, int dz) {
+    uint32_t hash = static_cast<uint32_t>(static_cast<int64_t>(base.x()) + dx) * 73856093u ^
+                    static_cast<uint32_t>(static_cast<int64_t>(base.y()) + dy) * 19349663u ^
+                    static_cast<uint32_t>(static_cast<int64_t>(base.z()) + dz) * 83492791u ^
+                    channel * 2654435761u;
+    hash = (hash ^ (hash >> 13)) * 0x5bd1e995u;
+    hash ^= hash >> 15;
+    return (hash & 0xffff) / 65535.0;
+  };
+  double value = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
+    value += lattice(dx, dy, dz) * (dx ? w.x() : 1.0 - w.x()) * (dy ? w.y() : 1.0 - w.y()) *
+             (dz ? w.z() : 1.0 - w.z());
+  }
+  return value;
+}
+
+// Texture colour (RGB, 0-255) of a surface point, with a fixed directional shading. With
+// `detail`, a non-repeating multi-scale noise modulates each channel: blobs of a few to a few
+// tens of pixels that feature detectors find and match unambiguously, where the checks and
+// stripes alone repeat.
+Eigen::Vector3d SurfaceColour(const Hit& hit, bool detail = false) {
   Eigen::Vector3d albedo = Eigen::Vector3d::Zero();
   switch (hit.surface) {
     case Surface::kGround: {
@@ -183,6 +211,14 @@ Eigen::Vector3d SurfaceColour(const Hit& hit) {
     case Surface::kNone:
       LOG(FATAL) << "no surface: use SkyColour";
   }
+  if (detail) {
+    for (int k = 0; k < 3; ++k) {
+      const double noise = 0.5 * ValueNoise(hit.point, 0.012, k) +
+                           0.3 * ValueNoise(hit.point, 0.03, k + 3) +
+                           0.2 * ValueNoise(hit.point, 0.08, k + 6);
+      albedo[k] *= 0.35 + 1.1 * noise;
+    }
+  }
   const Eigen::Vector3d light = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
   const double shade = 0.55 + 0.45 * std::max(0.0, hit.normal.dot(light));
   return (albedo * shade).cwiseMin(255.0);
@@ -208,6 +244,7 @@ cv::Mat Render(const SceneGeometry& geometry,
                const Rigid3d& cam_from_world,
                int supersampling,
                bool uniform_backdrop,
+               bool detail,
                cv::Mat* mask) {
   const Rigid3d world_from_cam = cam_from_world.Inverse();
   cv::Mat photo(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC3);
@@ -226,7 +263,7 @@ cv::Mat Render(const SceneGeometry& geometry,
               (world_from_cam.rotation * normalized.homogeneous()).normalized();
           const Hit hit = Trace(geometry, world_from_cam.translation, direction);
           hits += hit.surface != Surface::kNone;
-          sum += hit.surface != Surface::kNone ? SurfaceColour(hit)
+          sum += hit.surface != Surface::kNone ? SurfaceColour(hit, detail)
                  : uniform_backdrop            ? kBackdropColour
                                                : SkyColour(direction);
         }
@@ -501,7 +538,7 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
     cv::Mat mask;
     scene.photos.emplace(image.image_id,
                          Render(geometry, camera, image.cam_from_world, options.supersampling,
-                                options.uniform_backdrop, &mask));
+                                options.uniform_backdrop, options.detail_texture, &mask));
     scene.masks.emplace(image.image_id, mask);
     reconstruction.images.emplace(image.image_id, std::move(image));
   }
@@ -521,7 +558,7 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
       }
     }
     if (observations.size() < 2) continue;
-    const Eigen::Vector3d colour = SurfaceColour(surface);
+    const Eigen::Vector3d colour = SurfaceColour(surface, options.detail_texture);
     for (int k = 0; k < 3; ++k) point3D.color[k] = static_cast<uint8_t>(std::lround(colour[k]));
     point3D.error = options.pixel_noise;
     const point3D_t point3D_id = next_point3D_id++;

@@ -49,6 +49,9 @@ struct SyntheticSceneOptions {
   // Behind the scene: a patchwork sky (empty space is photo-inconsistent) or a uniform backdrop
   // (kBackdropColour, as a studio backdrop: empty space is consistent unless masks are used).
   bool uniform_backdrop = false;
+  // A non-repeating noise texture over every surface, on top of the checks and stripes, so that
+  // structure-from-motion (SIFT matching) can tell places apart; off, the photos are plain.
+  bool detail_texture = false;
 
   bool IsValid(std::string* reason) const;
 };

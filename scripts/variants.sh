@@ -11,5 +11,7 @@ run_all_variants() {
   local levels band
   for levels in 2 3 4; do
     for band in 1 2; do run "lod${levels}_band${band}" --lod_levels "$levels" --lod_band "$band"; done
+    # The same levels carving the full photos at every level (before photos were reduced).
+    run "lod${levels}_band1_full_photos" --lod_levels "$levels" --lod_band 1 --lod_reduce_images 0
   done
 }

@@ -79,7 +79,8 @@ int main(int argc, char** argv) {
   std::vector<int> resolutions = {128, 256};
   std::vector<raycarve::VisLookup> lookups = {raycarve::VisLookup::kFootprint,
                                               raycarve::VisLookup::kRayLists};
-  double threshold = 30.0;
+  // 40: at 30 these 800x600 photos are carved into (completeness 35.9% at 128 voxels, measured).
+  double threshold = 40.0;
   bool incremental_statistics = false;
   // One thread (the paper's setting) and every hardware thread; ray lists always use one.
   std::vector<int> thread_counts = {1};

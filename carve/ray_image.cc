@@ -58,7 +58,6 @@ RayImage::RayImage(const VoxelGrid& grid,
   shift_z_ = shift_y_ + CoordinateBits(n.y());
   mask_x_ = (uint32_t{1} << shift_y_) - 1;
   mask_y_ = (uint32_t{1} << (shift_z_ - shift_y_)) - 1;
-  n_ = {n.x(), n.y(), n.z()};
   keys_.assign(static_cast<size_t>(width) * height, kInactive);
 }
 
@@ -182,7 +181,6 @@ int64_t RayImage::Step(int pixel,
   return kNoVoxel;
 }
 
-
 bool RayImage::SkipEmptyBlocks(int pixel, const BlockOccupancy& blocks, int voxel[3]) const {
   constexpr int kShift = BlockOccupancy::kShift;
   constexpr int kSize = BlockOccupancy::kSize;
@@ -290,7 +288,9 @@ int64_t RayImage::Advance(int pixel, const Volume& volume) {
   if (key == kInactive) return kNoVoxel;
   const Eigen::Vector3i start = Unpack(key);
   int voxel[3] = {start.x(), start.y(), start.z()};
-  const int64_t index = Step(pixel, volume, voxel, /*skip_current=*/false, kZero, n_.data());
+  const Eigen::Vector3i& n = grid_.dimensions();
+  const int end[3] = {n.x(), n.y(), n.z()};
+  const int64_t index = Step(pixel, volume, voxel, /*skip_current=*/false, kZero, end);
   keys_[pixel] = index == kNoVoxel ? kInactive : Key(Eigen::Vector3i(voxel[0], voxel[1], voxel[2]));
   return index;
 }
@@ -300,7 +300,9 @@ int64_t RayImage::PeekBeyondCurrent(int pixel, const Volume& volume) const {
   if (key == kInactive) return kNoVoxel;
   const Eigen::Vector3i start = Unpack(key);
   int voxel[3] = {start.x(), start.y(), start.z()};
-  return Step(pixel, volume, voxel, /*skip_current=*/true, kZero, n_.data());
+  const Eigen::Vector3i& n = grid_.dimensions();
+  const int end[3] = {n.x(), n.y(), n.z()};
+  return Step(pixel, volume, voxel, /*skip_current=*/true, kZero, end);
 }
 
 }  // namespace raycarve

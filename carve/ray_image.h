@@ -1,6 +1,5 @@
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -114,7 +113,6 @@ class RayImage {
   Eigen::Matrix3d grid_from_pixel_;  // world_from_pixel_ in voxel units, for stepping
   double inverse_width_;             // row = floor((pixel + 0.5) * inverse_width_), exactly
   Eigen::Vector3d centre_grid_;  // camera centre in grid coordinates
-  std::array<int, 3> n_;  // grid dimensions
   int width_;
   int height_;
   cv::Mat valid_;

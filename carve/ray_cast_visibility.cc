@@ -104,6 +104,8 @@ void RayCastVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels)
 void RayCastVisibility::ComputeVisInView(const Eigen::Vector3i& voxel,
                                          int view,
                                          std::vector<PixelRef>* pixels) const {
+  // No ray of this view ends in the voxel: nothing to scan.
+  if (!rays_[view]->MayEndIn(volume_.grid().Index(voxel))) return;
   const CalibratedView& v = views_[view];
   const Footprint footprint = ComputeFootprint(v.P, v.width, v.height, volume_.grid(), voxel);
   const uint32_t key = rays_[view]->Key(voxel);

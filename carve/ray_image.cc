@@ -59,6 +59,8 @@ RayImage::RayImage(const VoxelGrid& grid,
   mask_x_ = (uint32_t{1} << shift_y_) - 1;
   mask_y_ = (uint32_t{1} << (shift_z_ - shift_y_)) - 1;
   keys_.assign(static_cast<size_t>(width) * height, kInactive);
+  const int64_t voxels = grid.num_voxels();
+  if (voxels <= 32 * static_cast<int64_t>(width) * height) arrived_.assign((voxels + 63) / 64, 0);
 }
 
 Eigen::Vector3d RayImage::Direction(int pixel) const {
@@ -109,6 +111,7 @@ void RayImage::Initialise(const Volume& volume, const BlockOccupancy* blocks) {
     if (keys_[pixel] == kInactive) continue;
     if (blocks != nullptr) {
       keys_[pixel] = FirstSolid(pixel, volume, *blocks);
+      if (keys_[pixel] != kInactive) MarkArrival(grid_.Index(Unpack(keys_[pixel])));
     } else {
       Advance(pixel, volume);
     }
@@ -291,7 +294,12 @@ int64_t RayImage::Advance(int pixel, const Volume& volume) {
   const Eigen::Vector3i& n = grid_.dimensions();
   const int end[3] = {n.x(), n.y(), n.z()};
   const int64_t index = Step(pixel, volume, voxel, /*skip_current=*/false, kZero, end);
-  keys_[pixel] = index == kNoVoxel ? kInactive : Key(Eigen::Vector3i(voxel[0], voxel[1], voxel[2]));
+  if (index == kNoVoxel) {
+    keys_[pixel] = kInactive;
+  } else {
+    keys_[pixel] = Key(Eigen::Vector3i(voxel[0], voxel[1], voxel[2]));
+    MarkArrival(index);
+  }
   return index;
 }
 

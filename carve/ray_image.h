@@ -73,6 +73,18 @@ class RayImage {
   // Cost: one step per voxel passed (Amanatides-Woo).
   int64_t Advance(int pixel, const Volume& volume);
 
+  // Whether some ray of this image has ended in `voxel` since Initialise. For a solid voxel this
+  // is exactly whether some ray ends in it now: a ray leaves a voxel only once it is carved, so a
+  // bit set on arrival never needs clearing while the voxel is solid. Where this image keeps no
+  // arrival bits (see HasArrivalBits) every voxel answers true. Footprint scans use it to skip
+  // the views that cannot see a voxel.
+  bool MayEndIn(int64_t voxel) const {
+    return arrived_.empty() || ((arrived_[voxel >> 6] >> (voxel & 63)) & 1) != 0;
+  }
+  // Arrival bits are kept when they take no more memory than the rays (one bit a voxel against
+  // 4 bytes a pixel: grids of at most 32 voxels a pixel).
+  bool HasArrivalBits() const { return !arrived_.empty(); }
+
   // The voxel the ray at `pixel` would reach if its current voxel were carved: the first solid
   // voxel of `volume` beyond it, or kNoVoxel. Changes nothing.
   int64_t PeekBeyondCurrent(int pixel, const Volume& volume) const;
@@ -80,7 +92,9 @@ class RayImage {
   // The ray parameter convention: world point = centre + t * Direction(pixel).
   Eigen::Vector3d Direction(int pixel) const;
 
-  size_t MemoryBytes() const { return keys_.capacity() * sizeof(uint32_t); }
+  size_t MemoryBytes() const {
+    return keys_.capacity() * sizeof(uint32_t) + arrived_.capacity() * sizeof(uint64_t);
+  }
 
  private:
   static constexpr uint32_t kInactive = ~uint32_t{0};
@@ -91,6 +105,9 @@ class RayImage {
   }
 
   void InitialiseRay(int pixel);
+  void MarkArrival(int64_t voxel) {
+    if (!arrived_.empty()) arrived_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
+  }
   // Steps from `voxel` (updated in place) until a solid voxel (returned, its index) or the edge
   // of the region [lo, hi) of voxel coordinates (kNoVoxel; `voxel` is then the first voxel
   // outside it). With `skip_current`, the starting voxel counts as empty.
@@ -121,6 +138,7 @@ class RayImage {
   uint32_t mask_x_;
   uint32_t mask_y_;
   std::vector<uint32_t> keys_;
+  std::vector<uint64_t> arrived_;  // per voxel, set when a ray ends there (MayEndIn)
 };
 
 }  // namespace raycarve

@@ -194,6 +194,48 @@ TEST(RayImage, CrossingEmptyBlocksReachesTheSameFirstSolidVoxelsAsSteppingEveryV
   EXPECT_LT(hits, rays_compared / 2);
 }
 
+TEST(RayImage, ArrivalBitsSayExactlyWhichSolidVoxelsSomeRayEndsIn) {
+  const VoxelGrid grid(
+      Eigen::AlignedBox3d(Eigen::Vector3d(-1, -0.7, -0.5), Eigen::Vector3d(1, 0.7, 0.6)), 23);
+  std::mt19937_64 random(11);
+  for (int trial = 0; trial < 6; ++trial) {
+    Volume volume = trial % 2 == 0 ? Volume(grid) : RandomBalls(grid, 4, &random);
+    const BlockOccupancy blocks(volume);
+    Eigen::Matrix3d world_from_pixel;  // a 40x30 camera looking down the -x axis at the box
+    world_from_pixel.col(0) = Eigen::Vector3d(0, 1, 0) / 25.0;
+    world_from_pixel.col(1) = Eigen::Vector3d(0, 0, -1) / 25.0;
+    world_from_pixel.col(2) = Eigen::Vector3d(-1, 0.05 * trial, 0.1) -
+                              20.0 * world_from_pixel.col(0) - 15.0 * world_from_pixel.col(1);
+    RayImage rays(grid, world_from_pixel, Eigen::Vector3d(3, 0.1, 0.2), 40, 30);
+    ASSERT_TRUE(rays.HasArrivalBits());  // 5,083 voxels, 1,200 pixels
+    rays.Initialise(volume, trial < 3 ? nullptr : &blocks);
+    // Carve the voxel of a random ray, step every ray that ended there, and compare the bits of
+    // every solid voxel with the rays.
+    for (int carving = 0; carving < 300; ++carving) {
+      if (carving % 50 == 0) {
+        std::vector<bool> ends(grid.num_voxels(), false);
+        for (int pixel = 0; pixel < 40 * 30; ++pixel) {
+          if (rays.CurrentVoxel(pixel) != RayImage::kNoVoxel) ends[rays.CurrentVoxel(pixel)] = true;
+        }
+        int64_t ended = 0;
+        for (int64_t voxel = 0; voxel < grid.num_voxels(); ++voxel) {
+          if (!volume.IsSolid(voxel)) continue;
+          ASSERT_EQ(rays.MayEndIn(voxel), ends[voxel]) << "trial " << trial << " voxel " << voxel;
+          ended += ends[voxel];
+        }
+        EXPECT_GT(ended, 0);
+      }
+      const int pixel = static_cast<int>(random() % (40 * 30));
+      const int64_t voxel = rays.CurrentVoxel(pixel);
+      if (voxel == RayImage::kNoVoxel) continue;
+      volume.Carve(voxel, nullptr);
+      for (int other = 0; other < 40 * 30; ++other) {
+        if (rays.CurrentVoxel(other) == voxel) rays.Advance(other, volume);
+      }
+    }
+  }
+}
+
 TEST(RayImage, RaysMissingTheBoxOrMaskedOutHaveNoVoxel) {
   Volume volume(kGrid);
   Eigen::Matrix3d away = Eigen::Matrix3d::Zero();

@@ -13,10 +13,11 @@ Footprint ComputeFootprint(const Eigen::Matrix<double, 3, 4>& P,
                            int width,
                            int height,
                            const VoxelGrid& grid,
-                           const Eigen::Vector3i& voxel) {
+                           const Eigen::Vector3i& voxel,
+                           int span) {
   // P * corner is affine in the corner, so project the first corner and add the columns.
   const Eigen::Vector3d base = P * grid.Corner(voxel, 0).homogeneous();
-  const double s = grid.voxel_size();
+  const double s = grid.voxel_size() * span;
   const Eigen::Vector3d ex = s * P.col(0), ey = s * P.col(1), ez = s * P.col(2);
   double x_min = INFINITY, x_max = -INFINITY, y_min = INFINITY, y_max = -INFINITY;
   for (int c = 0; c < 8; ++c) {

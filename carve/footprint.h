@@ -21,11 +21,14 @@ struct Footprint {
 };
 
 // `P` maps world points to homogeneous COLMAP pixels. A voxel with a corner at or behind the
-// camera's plane gets an empty footprint (the view is not used for it).
+// camera's plane gets an empty footprint (the view is not used for it). With `span` > 1, the
+// footprint of the cube of span x span x span voxels whose first voxel is `voxel` (it holds the
+// footprint of each of them); the cube may reach beyond the grid.
 Footprint ComputeFootprint(const Eigen::Matrix<double, 3, 4>& P,
                            int width,
                            int height,
                            const VoxelGrid& grid,
-                           const Eigen::Vector3i& voxel);
+                           const Eigen::Vector3i& voxel,
+                           int span = 1);
 
 }  // namespace raycarve

@@ -7,7 +7,8 @@
 // (completeness).
 //   scripts/run_benchmark.sh [--views 14 --width 800 --height 600 --resolutions 128,256
 //                             --threads 1,2 --vis_lookup footprint --incremental_statistics 1
-//                             --lod_levels 1,3]
+//                             --lod_levels 1,0,3]   (0: automatic, the command line's default;
+//                             the levels column shows how many it chose)
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -84,7 +85,8 @@ int main(int argc, char** argv) {
   bool incremental_statistics = false;
   // One thread (the paper's setting) and every hardware thread; ray lists always use one.
   std::vector<int> thread_counts = {1};
-  std::vector<int> level_counts = {1};
+  // One level (the paper's ray casting) and the command line's automatic levels of detail.
+  std::vector<int> level_counts = {1, raycarve::kAutomaticLevels};
   if (raycarve::ResolveNumThreads(-1) > 1) thread_counts.push_back(raycarve::ResolveNumThreads(-1));
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
@@ -158,14 +160,15 @@ int main(int argc, char** argv) {
     const double memory = s.peak_memory_bytes / (1024.0 * 1024.0);
     const Quality quality = MeasureQuality(result, truth);
     std::printf("%-10d %-10s %-7d %-6d %-14s %10.2f %10.2f %12.1f %12.1f %12lld %12lld %8.1f%% %11.1f%%\n",
-                resolutions[k], vis.c_str(), options.num_threads, levels, grid,
+                resolutions[k], vis.c_str(), options.num_threads, static_cast<int>(s.levels.size()), grid,
                 s.setup_seconds, s.carve_seconds, memory, PeakResidentMiB(),
                 static_cast<long long>(s.carved), static_cast<long long>(s.evaluated),
                 100.0 * quality.precision, 100.0 * quality.completeness);
     std::fflush(stdout);
     json << (first ? "" : ",") << "\n  {\"resolution\": " << resolutions[k]
          << ", \"vis_lookup\": \"" << vis << "\", \"threads\": " << options.num_threads
-         << ", \"lod_levels\": " << levels
+         << ", \"lod_levels\": " << s.levels.size()
+         << ", \"lod_automatic\": " << (levels == raycarve::kAutomaticLevels ? "true" : "false")
          << ", \"grid\": \"" << grid
          << "\", \"views\": " << views.size() << ", \"width\": " << scene_options.width
          << ", \"height\": " << scene_options.height << ", \"setup_seconds\": " << s.setup_seconds

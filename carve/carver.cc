@@ -172,6 +172,10 @@ bool CarveOptions::IsValid(std::string* reason) const {
   }
   std::vector<int> resolutions;
   if (!LevelResolutions(resolution, lod_levels, &resolutions, reason)) return false;
+  if (!(lod_threshold_scale >= 1.0 && lod_threshold_scale <= 10.0)) {
+    *reason = "lod_threshold_scale must be in [1, 10], got " + std::to_string(lod_threshold_scale);
+    return false;
+  }
   if (lod_band < 0 || lod_band > 8) {
     *reason = "lod_band must be in [0, 8], got " + std::to_string(lod_band);
     return false;
@@ -580,6 +584,8 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     CarveOptions level_options = options;
     level_options.resolution = resolutions[level];
     level_options.lod_levels = 1;
+    level_options.threshold =
+        options.threshold * std::pow(options.lod_threshold_scale, num_levels - 1 - level);
     const int factor = options.lod_reduce_images ? ImageFactor(views, resolutions[level],
                                                                options.resolution)
                                                  : 1;
@@ -606,6 +612,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     LevelStatistics level_statistics;
     level_statistics.resolution = resolutions[level];
     level_statistics.image_factor = factor;
+    level_statistics.threshold = level_options.threshold;
     level_statistics.dimensions = carver->volume().grid().dimensions();
     level_statistics.start_solid = carver->volume().num_solid();
     level_statistics.setup_seconds = SecondsSince(level_start);

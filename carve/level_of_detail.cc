@@ -30,11 +30,22 @@ void Dilate(const Eigen::Vector3i& n, std::vector<uint8_t>* mask) {
 
 }  // namespace
 
+int AutomaticLevels(int resolution) {
+  int levels = 1;
+  for (int coarsest = resolution; levels < 8 && coarsest % 2 == 0 &&
+                                  coarsest / 2 >= kMinAutomaticResolution;
+       coarsest /= 2) {
+    ++levels;
+  }
+  return levels;
+}
+
 bool LevelResolutions(int resolution, int levels, std::vector<int>* resolutions,
                       std::string* reason) {
   resolutions->clear();
+  if (levels == kAutomaticLevels) levels = AutomaticLevels(resolution);
   if (levels < 1 || levels > 8) {
-    *reason = "lod_levels must be in [1, 8], got " + std::to_string(levels);
+    *reason = "lod_levels must be in [1, 8] (0: automatic), got " + std::to_string(levels);
     return false;
   }
   const int divisor = 1 << (levels - 1);

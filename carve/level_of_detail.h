@@ -17,6 +17,7 @@ namespace raycarve {
 struct LevelStatistics {
   int resolution = 0;
   int image_factor = 1;  // the photos were reduced this many times (CarveOptions::lod_reduce_images)
+  double threshold = 0.0;  // the consistency threshold of this level (CarveOptions::lod_threshold_scale)
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   int64_t start_solid = 0;  // solid voxels when the level began (after refinement and hull)
   int64_t carved = 0;
@@ -26,9 +27,17 @@ struct LevelStatistics {
   double setup_seconds = 0.0;  // of which set-up: refinement, visual hull, rays, queue
 };
 
-// The resolutions of `levels` levels ending at `resolution`, coarsest first, each half the next.
-// False, with a reason, when `resolution` is not divisible by 2^(levels - 1), when the coarsest
-// level would have fewer than 4 voxels along the longest axis, or when levels < 1.
+// `levels` = kAutomaticLevels: as many levels as keep the coarsest at kMinAutomaticResolution
+// voxels or more along the longest axis (resolution halved while it is even and its half is at
+// least that): 128 -> 64, 128; 256 -> 64, 128, 256; 96 or less -> one level.
+constexpr int kAutomaticLevels = 0;
+constexpr int kMinAutomaticResolution = 64;
+int AutomaticLevels(int resolution);
+
+// The resolutions of `levels` levels ending at `resolution`, coarsest first, each half the next
+// (kAutomaticLevels: AutomaticLevels(resolution) of them). False, with a reason, when
+// `resolution` is not divisible by 2^(levels - 1), when the coarsest level would have fewer than
+// 4 voxels along the longest axis, or when levels < 0 or > 8.
 bool LevelResolutions(int resolution, int levels, std::vector<int>* resolutions,
                       std::string* reason);
 

@@ -146,9 +146,13 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("min_views").Value(request.options.min_views)
       .Key("order").Value(CarveOrderToString(request.options.order))
       .Key("decision").Value(CarveDecisionToString(request.options.decision))
-      .Key("lod_levels").Value(request.options.lod_levels)
+      .Key("lod_levels").Value(request.options.lod_levels == kAutomaticLevels
+                                   ? AutomaticLevels(request.options.resolution)
+                                   : request.options.lod_levels)
+      .Key("lod_levels_automatic").Value(request.options.lod_levels == kAutomaticLevels)
       .Key("lod_band").Value(request.options.lod_band)
       .Key("lod_reduce_images").Value(request.options.lod_reduce_images)
+      .Key("lod_threshold_scale").Value(request.options.lod_threshold_scale)
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
       .Key("num_threads").Value(ResolveNumThreads(request.options.num_threads))
       .Key("incremental_statistics").Value(request.options.incremental_statistics)
@@ -214,6 +218,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
                                                 static_cast<double>(level.dimensions.y()),
                                                 static_cast<double>(level.dimensions.z())})
         .Key("image_factor").Value(level.image_factor)
+        .Key("threshold").Value(level.threshold)
         .Key("start_solid").Value(level.start_solid)
         .Key("carved").Value(level.carved)
         .Key("evaluated").Value(level.evaluated)
@@ -290,12 +295,17 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      {"threshold", "reprojection"});
   parser->AddDefault("lod_levels", &request->options.lod_levels,
                      "levels of detail: carve at resolution / 2^(L-1) first, then refine (the "
-                     "resolution must be divisible by 2^(L-1)); 1: no levels");
+                     "resolution must be divisible by 2^(L-1)); 1: no levels; 0: as many as "
+                     "keep the coarsest level at 64 voxels or more (128: 2, 256: 3)");
   parser->AddDefault("lod_band", &request->options.lod_band,
                      "voxels put back around what survived a coarse level before refining");
   parser->AddDefault("lod_reduce_images", &request->options.lod_reduce_images,
                      "coarse levels carve photos reduced by the level's voxel scale (block "
                      "means): a voxel covers about as many pixels at every level");
+  parser->AddDefault("lod_threshold_scale", &request->options.lod_threshold_scale,
+                     "a level whose voxels are 2^k times the final ones judges with threshold x "
+                     "this^k (coarse voxels straddle more texture; only the final level uses "
+                     "--threshold as given)");
   parser->AddDefault("colour_calibration", &request->colour_calibration,
                      "estimate a gain and offset per photo and channel from the sparse points' "
                      "colours (Ceres, robust) and correct the photos before carving");

@@ -81,7 +81,11 @@ LoadedProject LoadProject(const std::string& command,
 
 // carve: everything `raycarve carve` takes, and what it produced.
 struct CarveRequest {
-  CarveRequest() { options.num_threads = -1; }  // the command line uses every core by default
+  // The command line uses every core and automatic levels of detail by default.
+  CarveRequest() {
+    options.num_threads = -1;
+    options.lod_levels = kAutomaticLevels;
+  }
   std::string workspace_path;
   std::string input_path;
   std::string image_path;

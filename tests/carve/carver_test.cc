@@ -285,6 +285,10 @@ TEST(CarveVolume, LevelsOfDetailAndEvidenceOrderReachPhotoConsistentVolumesOfThe
   EXPECT_EQ(lod.statistics.levels[0].image_factor, 2);
   EXPECT_EQ(lod.statistics.levels[1].image_factor, 2);
   EXPECT_EQ(lod.statistics.levels[2].image_factor, 1);
+  // Thresholds 30 x 1.2^2, 30 x 1.2, 30.
+  EXPECT_DOUBLE_EQ(lod.statistics.levels[0].threshold, 30.0 * 1.2 * 1.2);
+  EXPECT_DOUBLE_EQ(lod.statistics.levels[1].threshold, 36.0);
+  EXPECT_DOUBLE_EQ(lod.statistics.levels[2].threshold, 30.0);
   EXPECT_EQ(lod.volume.grid().dimensions(), single.volume.grid().dimensions());
   EXPECT_EQ(lod.statistics.carved, lod.statistics.num_voxels - lod.volume.num_solid());
   int64_t evaluated = 0;
@@ -294,9 +298,10 @@ TEST(CarveVolume, LevelsOfDetailAndEvidenceOrderReachPhotoConsistentVolumesOfThe
     evaluated += level.evaluated;
   }
   EXPECT_EQ(evaluated, lod.statistics.evaluated);
-  // Each finer level starts from more voxels than the coarser one left, in its finer units:
-  // the band put some back.
-  EXPECT_GT(lod.statistics.levels[1].start_solid, 8 * lod.statistics.levels[0].final_solid);
+  // Each finer level starts from at least what the coarser one left (RefineVolume's own test
+  // checks which voxels: the children of what survived and of the band around it).
+  EXPECT_GE(lod.statistics.levels[1].start_solid, lod.statistics.levels[0].final_solid);
+  EXPECT_GE(lod.statistics.levels[2].start_solid, lod.statistics.levels[1].final_solid);
   // The curve is in final voxels and ends at the total carved less the visual hull (none here).
   EXPECT_EQ(lod.statistics.curve.back().carved, lod.statistics.carved);
   EXPECT_EQ(single.statistics.levels.size(), 1u);
@@ -311,8 +316,8 @@ TEST(CarveVolume, LevelsOfDetailAndEvidenceOrderReachPhotoConsistentVolumesOfThe
   options.order = CarveOrder::kVisiblePixels;
   const CarveResult ordered = CarveVolume(views, scene.object_box, options);
   // Judged surface voxels within 2 voxels of the truth, measured: single level 0.720, levels of
-  // detail 0.676 (0.687 with full photos at every level), evidence order 0.578; a small scene,
-  // the bound is loose.
+  // detail 0.703 (0.684 with full photos at every level; 0.676 and 0.687 when every level used
+  // the final threshold), evidence order 0.578; a small scene, the bound is loose.
   std::printf("judged surface near the truth: single %.3f, levels of detail %.3f (full photos "
               "%.3f), evidence order %.3f\n", JudgedSurfaceNearTruth(single),
               JudgedSurfaceNearTruth(lod), JudgedSurfaceNearTruth(full_photos),

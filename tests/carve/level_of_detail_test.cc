@@ -18,7 +18,27 @@ TEST(LevelOfDetail, ResolutionsHalveDownToTheCoarsestAndRefuseWhatCannotHalve) {
   EXPECT_NE(reason.find("divisible by 8"), std::string::npos) << reason;
   EXPECT_FALSE(LevelResolutions(16, 4, &resolutions, &reason));
   EXPECT_NE(reason.find("coarsest level would have 2"), std::string::npos) << reason;
-  EXPECT_FALSE(LevelResolutions(128, 0, &resolutions, &reason));
+  EXPECT_FALSE(LevelResolutions(128, 9, &resolutions, &reason));
+}
+
+TEST(LevelOfDetail, AutomaticLevelsKeepTheCoarsestAtSixtyFourVoxelsOrMore) {
+  EXPECT_EQ(AutomaticLevels(64), 1);
+  EXPECT_EQ(AutomaticLevels(96), 1);   // 48 would be too coarse
+  EXPECT_EQ(AutomaticLevels(127), 1);  // odd: cannot halve
+  EXPECT_EQ(AutomaticLevels(128), 2);
+  EXPECT_EQ(AutomaticLevels(200), 2);  // 100; 50 would be too coarse
+  EXPECT_EQ(AutomaticLevels(256), 3);
+  EXPECT_EQ(AutomaticLevels(1024), 5);
+  EXPECT_EQ(AutomaticLevels(1 << 12), 7);
+  EXPECT_EQ(AutomaticLevels(1 << 14), 8);  // at most 8 levels
+  std::vector<int> resolutions;
+  std::string reason;
+  ASSERT_TRUE(LevelResolutions(256, kAutomaticLevels, &resolutions, &reason)) << reason;
+  EXPECT_EQ(resolutions, (std::vector<int>{64, 128, 256}));
+  ASSERT_TRUE(LevelResolutions(24, kAutomaticLevels, &resolutions, &reason)) << reason;
+  EXPECT_EQ(resolutions, (std::vector<int>{24}));
+  EXPECT_FALSE(LevelResolutions(128, -1, &resolutions, &reason));
+  EXPECT_NE(reason.find("0: automatic"), std::string::npos) << reason;
 }
 
 TEST(LevelOfDetail, RefinementKeepsExactlyTheChildrenOfVoxelsNearWhatSurvived) {

@@ -11,6 +11,7 @@
 #include "export/carve_export.h"
 #include "export/holdout_score.h"
 #include "export/point_renderer.h"
+#include "export/volume_renderer.h"
 #include "plugin/commands.h"
 #include "plugin/json_writer.h"
 
@@ -20,14 +21,19 @@ int RunHoldout(int argc, char** argv) {
   CarveRequest request;
   CarveFlagText text;
   int every = 4;
+  std::string render = "volume";
   OptionParser parser(
       "holdout",
-      "Held-out evaluation: carves the project without every k-th view, renders the carved cloud "
+      "Held-out evaluation: carves the project without every k-th view, renders the carved model "
       "into the left-out views, and reports PSNR (over the rendered and the true silhouette where "
       "there is a mask, else over the whole photo) and silhouette IoU; writes photo | render | "
       "error images to <output>/holdout/ and holdout.json.");
   AddCarveFlags(&parser, &request, &text);
   parser.AddDefault("every", &every, "leave out views 1, 1 + k, 1 + 2k, ... (k >= 2)");
+  parser.AddDefault("render", &render,
+                    "how the model is drawn: the carved volume (a ray per pixel to the first "
+                    "solid voxel, in its colour) or the cloud's points as square splats",
+                    {"volume", "splats"});
   if (!parser.Parse(argc, argv)) return 0;
   ApplyCarveFlags(text, &request);
   if (every < 2) throw InputError("raycarve holdout: --every must be at least 2");
@@ -65,13 +71,22 @@ int RunHoldout(int argc, char** argv) {
       .Key("every").Value(every)
       .Key("training_views").Value(static_cast<uint64_t>(training.size()))
       .Key("cloud_points").Value(static_cast<uint64_t>(points.size()))
+      .Key("render").Value(render)
       .Key("carve").Value(result.statistics.Summary());
   json.Key("views").BeginArray();
   double psnr_sum = 0.0, iou_sum = 0.0;
   int iou_count = 0;
   std::printf("%-24s %10s %12s %10s\n", "held-out view", "PSNR dB", "scored px", "sil. IoU");
   for (const CalibratedView& view : held_out) {
-    const exporter::Rendering rendering = exporter::RenderPoints(points, view, point_size);
+    int uncoloured = 0;
+    exporter::Rendering rendering;
+    if (render == "volume") {
+      exporter::VolumeRendering drawn = exporter::RenderVolume(result.volume, result.surface, view);
+      uncoloured = drawn.uncoloured_pixels;
+      rendering = std::move(drawn);
+    } else {
+      rendering = exporter::RenderPoints(points, view, point_size);
+    }
     const exporter::HoldoutScore score = exporter::ScoreRendering(rendering, view);
     psnr_sum += score.psnr;
     if (score.silhouette_iou >= 0.0) {
@@ -85,6 +100,7 @@ int RunHoldout(int argc, char** argv) {
         .Key("psnr_db").Value(score.psnr)
         .Key("scored_pixels").Value(score.scored_pixels)
         .Key("silhouette_iou").Value(score.silhouette_iou)
+        .Key("uncoloured_pixels").Value(uncoloured)
         .EndObject();
     cv::Mat bgr;
     cv::cvtColor(exporter::SideBySide(rendering, view), bgr, cv::COLOR_RGB2BGR);

@@ -43,7 +43,8 @@ TEST(RealPhotos, TempleCarvesOntoItsSparsePointsAndRendersItsHeldOutSilhouettes)
             0)
       << log;
   const std::string holdout = testing::ReadFileBytes(root + "/holdout/holdout/holdout.json");
-  // Measured: silhouette IoU 0.688, PSNR 13.37 dB over the 4 held-out views.
+  // Measured (the carved volume drawn ray by ray): silhouette IoU 0.691, PSNR 13.66 dB over the 4
+  // held-out views (0.688 and 13.37 dB with the cloud splatted).
   EXPECT_GT(JsonNumber(holdout, "mean_silhouette_iou"), 0.62);
   EXPECT_GT(JsonNumber(holdout, "mean_psnr_db"), 12.0);
   std::filesystem::remove_all(root);

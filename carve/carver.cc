@@ -176,6 +176,10 @@ bool CarveOptions::IsValid(std::string* reason) const {
     *reason = "lod_threshold_scale must be in [1, 10], got " + std::to_string(lod_threshold_scale);
     return false;
   }
+  if (min_component_voxels < 0) {
+    *reason = "min_component_voxels must be >= 0";
+    return false;
+  }
   if (lod_band < 0 || lod_band > 8) {
     *reason = "lod_band must be in [0, 8], got " + std::to_string(lod_band);
     return false;
@@ -488,6 +492,54 @@ bool IncrementalCarver::Step() {
   return true;
 }
 
+void IncrementalCarver::CarveAndQueue(int64_t voxel) {
+  prefetched_ = -1;
+  vis_.clear();
+  visibility_->ComputeVis(voxel, &vis_);
+  exposed_.clear();
+  changed_.clear();
+  volume_.Carve(voxel, &exposed_);
+  if (sums_ != nullptr) sums_->Release(voxel);
+  visibility_->UpdateAfterCarve(voxel, vis_, exposed_, &changed_);
+  if (sums_ != nullptr) AddArrivals();
+  vis_ready_ = false;
+  for (int64_t next : changed_) Enqueue(next);
+}
+
+int64_t IncrementalCarver::RemoveSmallComponents(int64_t min_voxels) {
+  const VoxelGrid& grid = volume_.grid();
+  const Eigen::Vector3i& n = grid.dimensions();
+  std::vector<uint64_t> seen((grid.num_voxels() + 63) / 64, 0);
+  const auto mark = [&seen](int64_t i) {
+    const bool was = (seen[i >> 6] >> (i & 63)) & 1;
+    seen[i >> 6] |= uint64_t{1} << (i & 63);
+    return !was;
+  };
+  std::vector<int64_t> component, small;
+  for (int64_t start = 0; start < grid.num_voxels(); ++start) {
+    if (!volume_.IsSolid(start) || !mark(start)) continue;
+    component.assign(1, start);
+    for (size_t k = 0; k < component.size(); ++k) {
+      const Eigen::Vector3i voxel = grid.Voxel(component[k]);
+      for (int dz = -1; dz <= 1; ++dz) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Eigen::Vector3i next = voxel + Eigen::Vector3i(dx, dy, dz);
+            if ((next.array() < 0).any() || (next.array() >= n.array()).any()) continue;
+            const int64_t index = grid.Index(next);
+            if (volume_.IsSolid(index) && mark(index)) component.push_back(index);
+          }
+        }
+      }
+    }
+    if (static_cast<int64_t>(component.size()) < min_voxels) {
+      small.insert(small.end(), component.begin(), component.end());
+    }
+  }
+  for (int64_t voxel : small) CarveAndQueue(voxel);
+  return static_cast<int64_t>(small.size());
+}
+
 std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
   std::vector<ColouredVoxel> surface;
   double error = 0.0;
@@ -651,6 +703,15 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
         progress({level, num_levels, statistics.evaluated + carver->evaluated(), carver->carved(),
                   static_cast<int64_t>(carver->queue_size()), seconds});
         next_report = seconds + progress_interval_seconds;
+      }
+    }
+    // The final level: specks left in empty space go, and carving carries on behind them.
+    for (int round = 0; level + 1 == num_levels && options.min_component_voxels > 1 && round < 4;
+         ++round) {
+      const int64_t removed = carver->RemoveSmallComponents(options.min_component_voxels);
+      if (removed == 0) break;
+      statistics.component_carved += removed;
+      while (carver->Step()) {
       }
     }
     sample(SecondsSince(start));

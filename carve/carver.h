@@ -94,6 +94,10 @@ struct CarveOptions {
   // pixels at every level (fewer while any photo's shorter side would drop below
   // kMinReducedSide pixels). Off: every level carves the full photos.
   bool lod_reduce_images = true;
+  // After the final level converges: carve every 26-connected component of solid voxels with
+  // fewer voxels than this (specks in empty space whose pixels agree by chance), then carry on
+  // carving from what they hid; repeated while any is found (at most 4 rounds). 0: keep all.
+  int min_component_voxels = 0;
   // With levels of detail: a level whose voxels are 2^k times the final ones judges with
   // threshold x lod_threshold_scale^k. A coarse voxel straddles more texture edges and spans more
   // depth, so its views' mean colours disagree more even on the true surface; at the final
@@ -141,6 +145,7 @@ struct CarveStatistics {
   int threads = 1;         // threads of the final level's carving
   int views_with_masks = 0;
   int64_t visual_hull_carved = 0;    // voxels removed by the silhouette pre-carve
+  int64_t component_carved = 0;  // small components removed (CarveOptions::min_component_voxels)
   double visual_hull_seconds = 0.0;  // its time (part of set-up)
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   double voxel_size = 0.0;
@@ -210,6 +215,12 @@ class IncrementalCarver {
   // queues the voxels those rays reach. Returns false once the CVSVL is empty (converged).
   bool Step();
 
+  // Carves every 26-connected component of solid voxels smaller than `min_voxels`: specks left in
+  // empty space because their pixels agree by chance. Each voxel is carved as Step carves one
+  // (the rays that ended in it step on and the voxels they reach are queued), so Step carries on
+  // from there. Returns the voxels carved. Cost: one pass over the solid voxels.
+  int64_t RemoveSmallComponents(int64_t min_voxels);
+
   // Colours every surface voxel from its current visible pixels (and measures the mean
   // reprojection error, surface_reprojection_error()).
   std::vector<ColouredVoxel> ColourSurface();
@@ -242,6 +253,9 @@ class IncrementalCarver {
   Consistency Evaluate(int64_t voxel, bool need_vis = true);
   // Vis(V) into vis_ (and, with `gather`, its statistics into stats_).
   void FindVis(int64_t voxel, bool gather);
+  // Carves a solid voxel whatever its consistency, updating visibility and queueing the voxels
+  // whose visibility changed.
+  void CarveAndQueue(int64_t voxel);
   // With incremental statistics: the colours of vis_'s pixels go to the voxels their rays reach.
   void AddArrivals();
   // View-parallel ray casting: one task over the views' groups that first steps the rays of

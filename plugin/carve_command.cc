@@ -153,6 +153,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("lod_band").Value(request.options.lod_band)
       .Key("lod_reduce_images").Value(request.options.lod_reduce_images)
       .Key("lod_threshold_scale").Value(request.options.lod_threshold_scale)
+      .Key("min_component_voxels").Value(request.options.min_component_voxels)
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
       .Key("num_threads").Value(ResolveNumThreads(request.options.num_threads))
       .Key("incremental_statistics").Value(request.options.incremental_statistics)
@@ -196,6 +197,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("num_voxels").Value(s.num_voxels)
       .Key("views_with_masks").Value(s.views_with_masks)
       .Key("visual_hull_carved").Value(s.visual_hull_carved)
+      .Key("component_carved").Value(s.component_carved)
       .Key("visual_hull_seconds").Value(s.visual_hull_seconds)
       .Key("initial_surface").Value(s.initial_surface)
       .Key("carved").Value(s.carved)
@@ -306,6 +308,9 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "a level whose voxels are 2^k times the final ones judges with threshold x "
                      "this^k (coarse voxels straddle more texture; only the final level uses "
                      "--threshold as given)");
+  parser->AddDefault("min_component_voxels", &request->options.min_component_voxels,
+                     "after carving, carve every connected piece of fewer solid voxels than this "
+                     "(specks in empty space) and carry on carving behind them; 0: keep all");
   parser->AddDefault("colour_calibration", &request->colour_calibration,
                      "estimate a gain and offset per photo and channel from the sparse points' "
                      "colours (Ceres, robust) and correct the photos before carving");

@@ -81,10 +81,11 @@ LoadedProject LoadProject(const std::string& command,
 
 // carve: everything `raycarve carve` takes, and what it produced.
 struct CarveRequest {
-  // The command line uses every core and automatic levels of detail by default.
+  // The command line uses every core, automatic levels of detail and removes specks by default.
   CarveRequest() {
     options.num_threads = -1;
     options.lod_levels = kAutomaticLevels;
+    options.min_component_voxels = 8;
   }
   std::string workspace_path;
   std::string input_path;

@@ -268,6 +268,59 @@ TEST(CarveVolume, RayCastingGvcAndGvcLdiConvergeToPhotoConsistentVolumes) {
   }
 }
 
+TEST(IncrementalCarver, SmallComponentsAreCarvedAndTheirRaysStepOn) {
+  const SyntheticScene scene = Scene(6, 120, 90);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  const VoxelGrid grid(scene.object_box, 24);
+  // A slab along the bottom (one big component), a lone voxel, a diagonal pair (26-connected:
+  // one component of 2) and a 3x3x3 cube, all in empty space.
+  std::vector<uint64_t> bits((grid.num_voxels() + 63) / 64, 0);
+  const auto set = [&](int x, int y, int z) {
+    const int64_t i = grid.Index(Eigen::Vector3i(x, y, z));
+    bits[i >> 6] |= uint64_t{1} << (i & 63);
+  };
+  const Eigen::Vector3i& n = grid.dimensions();
+  for (int y = 0; y < n.y(); ++y) {
+    for (int x = 0; x < n.x(); ++x) set(x, y, 0), set(x, y, 1);
+  }
+  set(5, 5, 6);
+  set(12, 12, 5), set(13, 13, 6);
+  for (int z = 4; z < 7; ++z) {
+    for (int y = 16; y < 19; ++y) {
+      for (int x = 16; x < 19; ++x) set(x, y, z);
+    }
+  }
+  IncrementalCarver carver(views, Volume(grid, std::move(bits)), Options(24, 30.0));
+  const int64_t slab = 2 * static_cast<int64_t>(n.x()) * n.y();
+  ASSERT_EQ(carver.volume().num_solid(), slab + 1 + 2 + 27);
+  // Before any carving, so that the specks still stop rays. Components of 1 and 2 voxels go with
+  // a bound of 3; the cube of 27 stays until the bound is 28.
+  EXPECT_EQ(carver.RemoveSmallComponents(3), 3);
+  EXPECT_FALSE(carver.volume().IsSolid(Eigen::Vector3i(5, 5, 6)));
+  EXPECT_FALSE(carver.volume().IsSolid(Eigen::Vector3i(12, 12, 5)));
+  EXPECT_FALSE(carver.volume().IsSolid(Eigen::Vector3i(13, 13, 6)));
+  EXPECT_TRUE(carver.volume().IsSolid(Eigen::Vector3i(17, 17, 5)));
+  EXPECT_EQ(carver.RemoveSmallComponents(27), 0);
+  EXPECT_EQ(carver.RemoveSmallComponents(28), 27);
+  EXPECT_EQ(carver.volume().num_solid(), slab);
+  // Every ray that ended in a removed voxel has stepped on: rays end in solid voxels only.
+  int on_slab = 0;
+  for (int view = 0; view < static_cast<int>(views.size()); ++view) {
+    const RayImage& rays = carver.ray_visibility()->rays(view);
+    for (int pixel = 0; pixel < rays.num_pixels(); ++pixel) {
+      const int64_t voxel = rays.CurrentVoxel(pixel);
+      ASSERT_TRUE(voxel == RayImage::kNoVoxel || carver.volume().IsSolid(voxel)) << pixel;
+      on_slab += voxel != RayImage::kNoVoxel;
+    }
+  }
+  EXPECT_GT(on_slab, 1000);
+  // The slab is one component of far more voxels: it stays.
+  EXPECT_EQ(carver.RemoveSmallComponents(28), 0);
+  while (carver.Step()) {
+  }
+  EXPECT_GT(carver.evaluated(), 0);
+}
+
 TEST(CarveVolume, LevelsOfDetailAndEvidenceOrderReachPhotoConsistentVolumesOfTheFinalGrid) {
   const SyntheticScene scene = Scene(6, 160, 120);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);

@@ -93,8 +93,8 @@ TEST(ColmapSfm, RecoversTheGeneratedCamerasUpToASimilarityAndTheProjectCarvesThe
   }
   std::printf("%s; ring radius %.4f; worst orientation error %.3f degrees\n",
               alignment.Summary().c_str(), ring, worst_degrees);
-  // Measured: RMS 0.046-0.047 against a ring radius of 5.02 (0.9%), orientations within 1.02-1.12
-  // degrees (colmap's threads make runs differ slightly)
+  // Measured: RMS 0.034-0.058 against a ring radius of 5.02 (0.7-1.2%), orientations within
+  // 0.8-1.5 degrees (colmap's runs differ, even on one thread)
   // (the scene fills a quarter of each photo: a weak geometry for SfM, but one model, no outlier).
   EXPECT_EQ(alignment.num_inliers, 16);
   EXPECT_LT(alignment.rms, 0.02 * ring);
@@ -102,7 +102,11 @@ TEST(ColmapSfm, RecoversTheGeneratedCamerasUpToASimilarityAndTheProjectCarvesThe
 
   // The SfM project carves, and its cloud, moved into the generator's frame by the cameras,
   // lies on the true surface.
-  ASSERT_EQ(testing::RunShell(Raycarve() + "carve --workspace_path " + root + "/sfm --resolution 96",
+  // Threshold 40: the recovered poses are off by about a degree, so the photos agree less on the
+  // true surface than the generator's own poses; at 30 (the default) the carve went into the
+  // objects in some runs (completeness 66-97% over five runs, against 99.1-99.9% at 40).
+  ASSERT_EQ(testing::RunShell(Raycarve() + "carve --workspace_path " + root +
+                                  "/sfm --resolution 96 --threshold 40",
                               &log),
             0)
       << log;
@@ -122,7 +126,7 @@ TEST(ColmapSfm, RecoversTheGeneratedCamerasUpToASimilarityAndTheProjectCarvesThe
     return at == std::string::npos ? -1.0 : std::stod(report.substr(at + key.size() + 4));
   };
   // At 96 voxels a voxel is about 0.067 in the generator's frame; within 0.13 (2 voxels),
-  // measured: completeness 97.6%, precision 87.7%.
+  // measured over five runs: completeness 99.1-99.99%, precision 87-97%.
   EXPECT_GT(number("completeness"), 0.7);
   EXPECT_GT(number("precision"), 0.6);
   fs::remove_all(root);

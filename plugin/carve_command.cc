@@ -374,10 +374,19 @@ int RunCarve(int argc, char** argv) {
                   run.sparse.accuracy / s.voxel_size);
     sparse_line = text;
   }
+  std::string level_line;
+  for (const LevelStatistics& level : s.levels) {
+    char text[96];
+    std::snprintf(text, sizeof(text), "%s%d voxels at threshold %.3g", level_line.empty() ? "" : ", ",
+                  level.resolution, level.threshold);
+    level_line += text;
+  }
   std::printf(
       "\ncarved %s\n"
       "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
-      "  carved          %lld voxels (%lld by the visual hull of %d masked views), %lld evaluations\n"
+      "  carved          %lld voxels (%lld by the visual hull of %d masked views, %lld in specks),"
+      " %lld evaluations\n"
+      "  levels          %zu (%s)\n"
       "  convergence     %.2f s (+ %.2f s set-up), peak memory %.1f MiB\n"
       "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more (cloud.ply)\n"
       "  sparse points   %s\n"
@@ -387,7 +396,8 @@ int RunCarve(int argc, char** argv) {
       run.model_path.c_str(), s.dimensions.x(), s.dimensions.y(), s.dimensions.z(), s.voxel_size,
       static_cast<long long>(s.num_voxels), static_cast<long long>(s.carved),
       static_cast<long long>(s.visual_hull_carved), s.views_with_masks,
-      static_cast<long long>(s.evaluated), s.carve_seconds, s.setup_seconds,
+      static_cast<long long>(s.component_carved), static_cast<long long>(s.evaluated),
+      s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds,
       s.peak_memory_bytes / (1024.0 * 1024.0), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), run.num_cloud_points, request.options.min_views,
       sparse_line.c_str(), run.output_path.c_str(), run.num_cloud_points,

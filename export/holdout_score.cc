@@ -1,6 +1,8 @@
 #include "export/holdout_score.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <opencv2/core.hpp>
@@ -37,6 +39,35 @@ HoldoutScore ScoreRendering(const Rendering& rendering, const CalibratedView& vi
     score.silhouette_iou = either == 0 ? 1.0 : static_cast<double>(both) / either;
   }
   return score;
+}
+
+double BlockMeanPsnr(const CalibratedView& view, int block) {
+  block = std::max(block, 1);
+  const cv::Mat region = view.mask.empty() ? view.valid : (view.valid & view.mask);
+  double squared = 0.0;
+  int64_t scored = 0;
+  for (int top = 0; top < view.height; top += block) {
+    for (int left = 0; left < view.width; left += block) {
+      const cv::Rect cell(left, top, std::min(block, view.width - left),
+                          std::min(block, view.height - top));
+      const cv::Scalar mean = cv::mean(view.image(cell));
+      for (int row = cell.y; row < cell.y + cell.height; ++row) {
+        const cv::Vec3b* photo = view.image.ptr<cv::Vec3b>(row);
+        const uint8_t* in = region.ptr<uint8_t>(row);
+        for (int col = cell.x; col < cell.x + cell.width; ++col) {
+          if (!in[col]) continue;
+          ++scored;
+          for (int k = 0; k < 3; ++k) {
+            const double d = photo[col][k] - mean[k];
+            squared += d * d;
+          }
+        }
+      }
+    }
+  }
+  const double mse = scored == 0 ? 0.0 : squared / (3.0 * scored);
+  return mse == 0.0 ? std::numeric_limits<double>::infinity()
+                    : 10.0 * std::log10(255.0 * 255.0 / mse);
 }
 
 cv::Mat SideBySide(const Rendering& rendering, const CalibratedView& view) {

@@ -21,6 +21,14 @@ struct HoldoutScore {
 // Scores `rendering` against `view` (its undistorted photo, valid pixels and mask).
 HoldoutScore ScoreRendering(const Rendering& rendering, const CalibratedView& view);
 
+// The PSNR of `view`'s photo against itself with every aligned block x block square of pixels
+// replaced by its mean (the last row and column of blocks may be partial), over the object
+// (mask and valid pixels; every valid pixel without a mask). What a model giving each block one
+// colour would score with perfect geometry: an estimate of the most a voxel model can reach where
+// a voxel covers about `block` pixels across (real voxels project to hexagons and mix several
+// views, so they would do worse). Infinite for a photo that is uniform within every block.
+double BlockMeanPsnr(const CalibratedView& view, int block);
+
 // photo | render | error (absolute difference, amplified 4x), side by side, RGB.
 cv::Mat SideBySide(const Rendering& rendering, const CalibratedView& view);
 

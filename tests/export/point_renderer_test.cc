@@ -72,6 +72,38 @@ TEST(HoldoutScore, PsnrOverTheSilhouettesAndTheirIou) {
   EXPECT_EQ(SideBySide(rendering, view).size(), cv::Size(300, 80));
 }
 
+TEST(HoldoutScore, BlockMeansScoreWhatOneColourPerBlockCanCarry) {
+  CalibratedView view = View();  // 100x80
+  // 2x2 squares of one colour each: 2x2 blocks lose nothing.
+  for (int row = 0; row < 80; ++row) {
+    for (int col = 0; col < 100; ++col) {
+      view.image.at<cv::Vec3b>(row, col) =
+          ((row / 2 + col / 2) % 2) ? cv::Vec3b(200, 100, 0) : cv::Vec3b(40, 100, 0);
+    }
+  }
+  EXPECT_TRUE(std::isinf(BlockMeanPsnr(view, 2)));
+  // 4x4 blocks hold two of each colour: every pixel is 80 from the block's mean in red.
+  // MSE = 80^2 / 3 per channel: PSNR = 10 log10(255^2 * 3 / 80^2).
+  EXPECT_NEAR(BlockMeanPsnr(view, 4), 10.0 * std::log10(255.0 * 255.0 * 3.0 / (80.0 * 80.0)), 1e-9);
+  // Blocks of 64: the last column of blocks is 36 pixels wide and the last row 16 high, each its
+  // own block; four uniform quadrants split there lose nothing.
+  cv::Mat quadrants = view.image.clone();
+  quadrants(cv::Rect(0, 0, 64, 64)).setTo(cv::Scalar(10, 20, 30));
+  quadrants(cv::Rect(64, 0, 36, 64)).setTo(cv::Scalar(250, 20, 30));
+  quadrants(cv::Rect(0, 64, 64, 16)).setTo(cv::Scalar(10, 220, 30));
+  quadrants(cv::Rect(64, 64, 36, 16)).setTo(cv::Scalar(10, 20, 230));
+  CalibratedView split = view;
+  split.image = quadrants;
+  EXPECT_TRUE(std::isinf(BlockMeanPsnr(split, 64)));
+  EXPECT_TRUE(std::isfinite(BlockMeanPsnr(split, 65)));
+  // Only the mask is scored: a mask over the left 20 columns, where the image is made uniform,
+  // scores infinite whatever the rest holds.
+  view.mask = cv::Mat(80, 100, CV_8UC1, cv::Scalar(0));
+  view.mask(cv::Rect(0, 0, 20, 80)).setTo(255);
+  view.image(cv::Rect(0, 0, 20, 80)).setTo(cv::Scalar(7, 8, 9));
+  EXPECT_TRUE(std::isinf(BlockMeanPsnr(view, 4)));
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

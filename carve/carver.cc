@@ -11,6 +11,7 @@
 
 #include "carve/item_buffer_visibility.h"
 #include "carve/layered_depth_visibility.h"
+#include "carve/patch_correlation.h"
 #include "carve/ray_image.h"
 
 namespace raycarve {
@@ -47,6 +48,38 @@ void GatherColours(const std::vector<CalibratedView>& views,
     const uint8_t* rgb = views[ref->view].image.data + 3 * static_cast<size_t>(ref->pixel);
     stats->back().Add(Eigen::Vector3d(rgb[0], rgb[1], rgb[2]));
   }
+}
+
+// Per view, the depth of the known surface near each pixel: around each surface point's
+// projection, within kKnownSurfaceRadiusVoxels of its projected voxel width, the farthest depth
+// of the points there (0: no point near). Empty for views no point names.
+std::vector<cv::Mat> KnownSurfaceDepths(const std::vector<CalibratedView>& views,
+                                        const VoxelGrid& grid,
+                                        const std::vector<SurfacePoint>& points) {
+  std::vector<cv::Mat> depths(views.size());
+  for (const SurfacePoint& point : points) {
+    if (!grid.Contains(grid.VoxelOf(point.xyz))) continue;
+    for (int v : point.views) {
+      const CalibratedView& view = views[v];
+      const Eigen::Vector3d pixel = view.P * point.xyz.homogeneous();
+      if (pixel.z() <= 0.0) continue;
+      if (depths[v].empty()) depths[v] = cv::Mat::zeros(view.height, view.width, CV_32F);
+      const double x = pixel.x() / pixel.z(), y = pixel.y() / pixel.z();
+      const double radius = kKnownSurfaceRadiusVoxels * 0.5 * (view.K(0, 0) + view.K(1, 1)) *
+                            grid.voxel_size() / pixel.z();
+      const int r = static_cast<int>(std::ceil(radius));
+      const int c0 = static_cast<int>(std::floor(x)), r0 = static_cast<int>(std::floor(y));
+      for (int row = std::max(0, r0 - r); row <= std::min(view.height - 1, r0 + r); ++row) {
+        float* line = depths[v].ptr<float>(row);
+        for (int col = std::max(0, c0 - r); col <= std::min(view.width - 1, c0 + r); ++col) {
+          const double dx = col + 0.5 - x, dy = row + 0.5 - y;
+          if (dx * dx + dy * dy > radius * radius) continue;
+          line[col] = std::max(line[col], static_cast<float>(pixel.z()));
+        }
+      }
+    }
+  }
+  return depths;
 }
 
 // The grid of `options` over `box`, once the carving is known to fit (CHECKed).
@@ -162,6 +195,11 @@ bool CarveOptions::IsValid(std::string* reason) const {
     *reason = "min_views must be >= 1";
     return false;
   }
+  if (!(auto_threshold_quantile > 0.0 && auto_threshold_quantile <= 1.0)) {
+    *reason = "auto_threshold_quantile must be in (0, 1], got " +
+              std::to_string(auto_threshold_quantile);
+    return false;
+  }
   if (decision == CarveDecision::kReprojection && method != CarveMethod::kRay) {
     *reason = "the reprojection decision needs ray casting (--method ray)";
     return false;
@@ -264,6 +302,10 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                           : MakeVisibility(views, volume_, options, &workers_)),
       ray_visibility_(dynamic_cast<RayCastVisibility*>(visibility_.get())),
       test_(options.consistency, options.threshold, options.min_views, options.adaptive_threshold),
+      patterns_(options.consistency == ConsistencyMethod::kPatchCorrelation),
+      min_coverage_(options.min_coverage),
+      min_views_(options.min_views),
+      pattern_threshold_(options.pattern_threshold),
       order_(options.order),
       decision_(options.decision),
       threshold_(options.threshold),
@@ -274,6 +316,13 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
     const cv::Mat usable = view.mask.empty() ? view.valid : (view.valid & view.mask);
     usable_pixels_ += usable.empty() ? static_cast<int64_t>(view.width) * view.height
                                      : cv::countNonZero(usable);
+  }
+  if (options.protect_surface_points) {
+    protected_.assign((volume_.grid().num_voxels() + 63) / 64, 0);
+    for (int64_t voxel : SurfacePointVoxels(volume_.grid(), options.surface_points)) {
+      protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
+    }
+    known_depth_ = KnownSurfaceDepths(views, volume_.grid(), options.surface_points);
   }
   view_parallel_ = ray_visibility_ != nullptr && ray_visibility_->ViewParallel() &&
                    order_ == CarveOrder::kFifo && workers_.num_groups() > 1;
@@ -340,7 +389,37 @@ Consistency IncrementalCarver::Evaluate(int64_t voxel, bool need_vis) {
     FindVis(voxel, /*gather=*/true);
   }
   prefetched_ = -1;
-  return test_.Evaluate(stats_);
+  Consistency consistency = test_.Evaluate(stats_);
+  if (min_coverage_ > 0.0 && consistency.judged) {
+    // Judged only where enough views see most of the voxel: not through a small hole.
+    const VoxelGrid& grid = volume_.grid();
+    const Eigen::Vector3d centre = grid.Centre(grid.Voxel(voxel));
+    int covered = 0;
+    for (const ViewColourStats& view_stats : stats_) {
+      if (view_stats.count == 0) continue;
+      const CalibratedView& view = views_[view_stats.view];
+      const double depth = view.Depth(centre);
+      if (depth <= 0.0) continue;
+      const Eigen::Vector3d towards = (view.centre - centre).normalized();
+      const double side = 0.5 * (view.K(0, 0) + view.K(1, 1)) * grid.voxel_size() / depth;
+      const double area = side * side * towards.cwiseAbs().sum();
+      covered += view_stats.count >= min_coverage_ * area;
+    }
+    if (covered < min_views_) {
+      consistency.judged = false;
+      consistency.consistent = true;
+    }
+  }
+  if (patterns_ && consistency.judged && consistency.consistent) {
+    const PatchCorrelation patches = CorrelatePatches(
+        views_, volume_.grid().Centre(volume_.grid().Voxel(voxel)), volume_.grid().voxel_size(),
+        stats_);
+    if (patches.textured) {
+      consistency.pattern_error = patches.error();
+      consistency.consistent = consistency.pattern_error <= pattern_threshold_;
+    }
+  }
+  return consistency;
 }
 
 void IncrementalCarver::FindVis(int64_t voxel, bool gather) {
@@ -441,6 +520,28 @@ int64_t IncrementalCarver::PeekNextSolid() const {
   return queued && volume_.IsSolid(voxel) ? voxel : -1;
 }
 
+bool IncrementalCarver::BehindKnownSurface(int64_t voxel) const {
+  if (known_depth_.empty()) return false;
+  const VoxelGrid& grid = volume_.grid();
+  const Eigen::Vector3d centre = grid.Centre(grid.Voxel(voxel));
+  for (const ViewColourStats& view_stats : stats_) {
+    if (view_stats.count == 0) continue;
+    const cv::Mat& depths = known_depth_[view_stats.view];
+    if (depths.empty()) continue;
+    const CalibratedView& view = views_[view_stats.view];
+    const Eigen::Vector3d pixel = view.P * centre.homogeneous();
+    if (pixel.z() <= 0.0) continue;
+    const int col = static_cast<int>(std::floor(pixel.x() / pixel.z()));
+    const int row = static_cast<int>(std::floor(pixel.y() / pixel.z()));
+    if (col < 0 || row < 0 || col >= depths.cols || row >= depths.rows) continue;
+    const float known = depths.at<float>(row, col);
+    if (known > 0.0f && pixel.z() > known - kKnownSurfaceMarginVoxels * grid.voxel_size()) {
+      return true;
+    }
+  }
+  return false;
+}
+
 bool IncrementalCarver::Step() {
   int64_t voxel = 0;
   if (!Pop(&voxel)) {
@@ -460,6 +561,10 @@ bool IncrementalCarver::Step() {
   if (consistency.consistent &&
       (decision_ == CarveDecision::kThreshold || !consistency.judged ||
        ReprojectionChange(consistency.colour) >= 0.0)) {
+    return true;
+  }
+  if (IsProtected(voxel) || BehindKnownSurface(voxel)) {
+    ++protected_kept_;
     return true;
   }
   exposed_.clear();
@@ -653,6 +758,20 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       for (size_t v = 0; v < views.size(); ++v) reduced_views[v] = ReduceView(views[v], factor);
     }
     const std::vector<CalibratedView>& level_views = factor > 1 ? reduced_views : views;
+    LevelStatistics level_statistics;
+    if (options.auto_threshold) {
+      level_statistics.estimate = EstimateThreshold(
+          level_views, VoxelGrid(box, resolutions[level]), options.surface_points,
+          options.consistency, options.min_views,
+          std::any_of(level_views.begin(), level_views.end(),
+                      [](const CalibratedView& view) { return !view.mask.empty(); }),
+          options.auto_threshold_quantile,
+          level_options.threshold, options.pattern_threshold);
+      level_statistics.threshold_from_data =
+          level_statistics.estimate.points_judged >= kMinThresholdPoints;
+      level_options.threshold = level_statistics.estimate.threshold;
+      level_options.pattern_threshold = level_statistics.estimate.pattern_threshold;
+    }
     if (level == 0) {
       carver = std::make_unique<IncrementalCarver>(level_views, box, level_options);
     } else {
@@ -661,7 +780,6 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     }
     // A voxel of this level holds `scale` final voxels (up to the grid's edge).
     const int64_t scale = int64_t{1} << (3 * (num_levels - 1 - level));
-    LevelStatistics level_statistics;
     level_statistics.resolution = resolutions[level];
     level_statistics.image_factor = factor;
     level_statistics.threshold = level_options.threshold;
@@ -717,6 +835,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     sample(SecondsSince(start));
     level_statistics.carved = carver->carved() + carver->visual_hull().carved;
     level_statistics.evaluated = carver->evaluated();
+    level_statistics.protected_kept = carver->protected_kept();
     level_statistics.final_solid = carver->volume().num_solid();
     level_statistics.seconds = SecondsSince(level_start);
     statistics.levels.push_back(level_statistics);

@@ -15,6 +15,7 @@
 #include "carve/consistency.h"
 #include "carve/level_of_detail.h"
 #include "carve/ray_cast_visibility.h"
+#include "carve/surface_evidence.h"
 #include "carve/view_workers.h"
 #include "carve/voxel_colour_sums.h"
 #include "carve/visual_hull.h"
@@ -49,6 +50,13 @@ std::string CarveDecisionToString(CarveDecision decision);
 bool CarveDecisionFromString(const std::string& text, CarveDecision* decision);
 
 // Incremental voxel colouring with ray-cast visibility (Batchelor, Mukundan, Green).
+// Known surface (CarveOptions::protect_surface_points): around a surface point's projection in a
+// view that saw it, within this many of its projected voxel widths, the surface is taken to lie no
+// farther than the farthest such point; a voxel closer than that by less than the margin (in
+// voxels) is at or behind the known surface in that view and is not carved by colour.
+constexpr double kKnownSurfaceRadiusVoxels = 2.0;
+constexpr double kKnownSurfaceMarginVoxels = 1.0;
+
 struct CarveOptions {
   // The smallest shorter side of a photo reduced for a coarse level of detail.
   static constexpr int kMinReducedSide = 48;
@@ -61,11 +69,19 @@ struct CarveOptions {
   // Largest consistent error, in RGB units (0-255). Negative: nothing is consistent, so every
   // voxel seen by min_views views is carved.
   double threshold = 30.0;
+  // consistency kPatchCorrelation: a voxel that passes the colour test but whose views see
+  // texture is carved when 1 - NCC of their patterns exceeds this (0..2).
+  double pattern_threshold = 0.5;
   // Adaptive allowance: the threshold grows by this times the voxel's within-view colour spread
   // (see ConsistencyTest); 0 holds every voxel to `threshold`.
   double adaptive_threshold = 0.0;
   // Views a voxel must be seen by to be judged; voxels seen by fewer stay.
   int min_views = 2;
+  // A voxel is judged only when at least min_views views each see this share of its projected
+  // outline (its visible pixels against the area of the cube's projection); otherwise it stays.
+  // A voxel seen through a small hole shows the views the hole's rim, not itself: judging it lets
+  // one wrong carve drill a tunnel. 0: any pixel counts.
+  double min_coverage = 0.0;
   // Refuse a grid whose carving structures would need more memory than this (GiB).
   double max_memory_gib = 8.0;
   // With ray casting, how Vis(V) is found (see ray_cast_visibility.h); the carving is the same
@@ -116,6 +132,20 @@ struct CarveOptions {
   // evaluating a voxel reads its sums, and Vis(V) is found only for voxels carved (or judged by
   // the reprojection decision). Same carving, 56 bytes per view and voxel holding rays.
   bool incremental_statistics = false;
+  // Points known to lie on the surface (reliable sparse points, with the views that saw them:
+  // indices into the carve's views). Used by auto_threshold and protect_surface_points.
+  std::vector<SurfacePoint> surface_points;
+  // Choose each level's threshold (and pattern_threshold) from the data (EstimateThreshold over
+  // surface_points at that level's grid and photos): with masks, the auto_threshold_quantile of
+  // the errors of the voxels known to be on the surface; without, the equal-error threshold
+  // between them and the voxels just in front of them. `threshold` (and lod_threshold_scale) and
+  // pattern_threshold are the fallback where fewer than 20 points can be judged.
+  bool auto_threshold = false;
+  double auto_threshold_quantile = 0.99;
+  // Voxels holding a surface point are never carved by the consistency test (the visual hull and
+  // the removal of small components still carve them): known surface stops carving that runs
+  // away through one wrong carve.
+  bool protect_surface_points = false;
 
   bool IsValid(std::string* reason) const;
 };
@@ -237,6 +267,12 @@ class IncrementalCarver {
   int threads() const { return view_parallel_ ? workers_.num_groups() : 1; }
   int64_t evaluated() const { return evaluated_; }
   int64_t carved() const { return carved_; }
+  // Evaluations that found a protected voxel inconsistent and kept it
+  // (CarveOptions::protect_surface_points).
+  int64_t protected_kept() const { return protected_kept_; }
+  bool IsProtected(int64_t voxel) const {
+    return !protected_.empty() && ((protected_[voxel >> 6] >> (voxel & 63)) & 1) != 0;
+  }
   size_t queue_size() const { return queue_.size() + heap_.size(); }
   // Volume, visibility structures and the CVSVL at its largest so far.
   size_t MemoryBytes() const;
@@ -267,6 +303,9 @@ class IncrementalCarver {
                      int64_t vis_voxel,
                      bool gather = true,
                      bool advance_found = false);
+  // With protection: whether V lies at or behind the known surface (within
+  // kKnownSurfaceMarginVoxels) in a view of stats_ whose known depth covers V's centre.
+  bool BehindKnownSurface(int64_t voxel) const;
   // The voxel Pop will hand out next if it is known now and still solid (fifo only), else -1.
   int64_t PeekNextSolid() const;
   // With vis_ holding Vis(V) and `colour` V's colour: the change of the reprojection error of
@@ -302,6 +341,10 @@ class IncrementalCarver {
   std::unique_ptr<VoxelColourSums> sums_;  // with incremental statistics
   bool vis_ready_ = false;
   ConsistencyTest test_;
+  bool patterns_ = false;  // kPatchCorrelation
+  double min_coverage_ = 0.0;
+  int min_views_ = 2;
+  double pattern_threshold_ = 0.5;
   CarveOrder order_;
   CarveDecision decision_;
   double threshold_;
@@ -312,6 +355,9 @@ class IncrementalCarver {
   std::deque<int64_t> queue_;                             // first in, first out
   std::priority_queue<std::pair<int64_t, int64_t>> heap_;  // (|Vis|, voxel), most first
   std::vector<uint64_t> queued_;
+  std::vector<uint64_t> protected_;  // a bit per voxel; empty without protection
+  std::vector<cv::Mat> known_depth_;  // per view, KnownSurfaceDepths; empty without protection
+  int64_t protected_kept_ = 0;
   size_t max_queue_ = 0;
   int64_t evaluated_ = 0;
   int64_t carved_ = 0;

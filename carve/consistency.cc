@@ -5,12 +5,21 @@
 namespace raycarve {
 
 std::string ConsistencyMethodToString(ConsistencyMethod method) {
-  return method == ConsistencyMethod::kMeanColour ? "mean_colour" : "standard_deviation";
+  switch (method) {
+    case ConsistencyMethod::kMeanColour:
+      return "mean_colour";
+    case ConsistencyMethod::kStandardDeviation:
+      return "standard_deviation";
+    case ConsistencyMethod::kPatchCorrelation:
+      return "ncc";
+  }
+  return "unknown";
 }
 
 bool ConsistencyMethodFromString(const std::string& text, ConsistencyMethod* method) {
   for (ConsistencyMethod candidate :
-       {ConsistencyMethod::kMeanColour, ConsistencyMethod::kStandardDeviation}) {
+       {ConsistencyMethod::kMeanColour, ConsistencyMethod::kStandardDeviation,
+        ConsistencyMethod::kPatchCorrelation}) {
     if (text == ConsistencyMethodToString(candidate)) {
       *method = candidate;
       return true;
@@ -41,8 +50,11 @@ double PooledStandardDeviation::Error(const std::vector<ViewColourStats>& views,
 }
 
 std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod method) {
-  if (method == ConsistencyMethod::kMeanColour) return std::make_unique<MeanColourDifference>();
-  return std::make_unique<PooledStandardDeviation>();
+  // kPatchCorrelation's colour part is the mean-colour test; its pattern part is in the carver.
+  if (method == ConsistencyMethod::kStandardDeviation) {
+    return std::make_unique<PooledStandardDeviation>();
+  }
+  return std::make_unique<MeanColourDifference>();
 }
 
 ConsistencyTest::ConsistencyTest(ConsistencyMethod method,

@@ -25,6 +25,9 @@ struct ViewColourStats {
 enum class ConsistencyMethod {
   kMeanColour,         // the seed paper's weighted difference of per-view mean colours
   kStandardDeviation,  // Seitz and Dyer's standard deviation of all visible pixels
+  // The mean-colour test, and where the views see texture also the agreement of their patterns
+  // (patch_correlation.h: normalised cross-correlation, blind to exposure and white balance).
+  kPatchCorrelation,
 };
 std::string ConsistencyMethodToString(ConsistencyMethod method);
 // Returns false when `text` names no method.
@@ -38,6 +41,9 @@ struct Consistency {
   Eigen::Vector3d colour = Eigen::Vector3d::Zero();  // the voxel's colour: pixel-weighted mean
   int num_views = 0;
   int num_pixels = 0;
+  // kPatchCorrelation: 1 - NCC of the views' patterns, or -1 where not measured (not textured,
+  // or already inconsistent by colour).
+  double pattern_error = -1.0;
 };
 
 // How far a voxel's visible pixels are from agreeing on one colour: the interface a new

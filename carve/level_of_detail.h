@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "carve/surface_evidence.h"
 #include "carve/volume.h"
 #include "carve/voxel_grid.h"
 
@@ -17,7 +18,12 @@ namespace raycarve {
 struct LevelStatistics {
   int resolution = 0;
   int image_factor = 1;  // the photos were reduced this many times (CarveOptions::lod_reduce_images)
-  double threshold = 0.0;  // the consistency threshold of this level (CarveOptions::lod_threshold_scale)
+  double threshold = 0.0;  // the consistency threshold this level judged with
+  // CarveOptions::auto_threshold: whether the threshold came from the surface points (false:
+  // too few could be judged, and the fallback was used); `estimate` holds what it came from.
+  bool threshold_from_data = false;
+  ThresholdEstimate estimate;
+  int64_t protected_kept = 0;  // evaluations that kept a protected voxel found inconsistent
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   int64_t start_solid = 0;  // solid voxels when the level began (after refinement and hull)
   int64_t carved = 0;

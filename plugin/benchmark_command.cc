@@ -87,6 +87,7 @@ int RunBenchmark(int argc, char** argv) {
   for (const CarveMethod method : methods) {
     CarveOptions options = request.options;
     options.method = method;
+    options.surface_points = project.surface_points;
     std::string reason;
     if (!CheckCarveFits(project.views, project.bounds.box, options, &reason)) {
       throw InputError("raycarve benchmark: " + CarveMethodToString(method) + ": " + reason);

@@ -1,4 +1,6 @@
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <cstdio>
 #include <filesystem>
@@ -66,7 +68,9 @@ CarveRun CarveProject(const CarveRequest& request) {
   LOG(INFO) << "carving a " << grid.dimensions().x() << "x" << grid.dimensions().y() << "x"
             << grid.dimensions().z() << " grid (voxel " << grid.voxel_size() << ") with "
             << views.size() << " views, " << ConsistencyMethodToString(request.options.consistency)
-            << " threshold " << request.options.threshold;
+            << " threshold "
+            << (request.options.auto_threshold ? std::string("auto (from the sparse points)")
+                                               : std::to_string(request.options.threshold));
   auto progress = [](const CarveProgress& p) {
     LOG(INFO) << "carving "
               << (p.levels > 1 ? "level " + std::to_string(p.level + 1) + "/" +
@@ -77,8 +81,28 @@ CarveRun CarveProject(const CarveRequest& request) {
               << static_cast<int64_t>(p.seconds > 0 ? p.evaluated / p.seconds : 0)
               << " evaluations/s";
   };
+  CarveOptions options = request.options;
+  options.surface_points = project.surface_points;
+  if (options.auto_threshold || options.protect_surface_points) {
+    LOG(INFO) << project.surface_points.size() << " reliable sparse points (seen by "
+              << kMinSurfaceTrack << "+ photos, error <= " << kMaxSurfaceError
+              << " px) in the volume" << (options.auto_threshold ? " choose the threshold" : "")
+              << (options.auto_threshold && options.protect_surface_points ? " and" : "")
+              << (options.protect_surface_points ? " protect their voxels" : "");
+  }
   run.result = std::make_unique<CarveResult>(
-      CarveVolume(views, run.bounds.box, request.options, progress, request.progress_seconds));
+      CarveVolume(views, run.bounds.box, options, progress, request.progress_seconds));
+  for (const LevelStatistics& level : run.result->statistics.levels) {
+    if (!options.auto_threshold) break;
+    if (level.threshold_from_data) {
+      LOG(INFO) << "level " << level.resolution << ": " << level.estimate.Summary();
+    } else {
+      LOG(WARNING) << "level " << level.resolution << ": only " << level.estimate.points_judged
+                   << " sparse points could be judged (" << kMinThresholdPoints
+                   << " needed) to choose the threshold; used " << level.threshold
+                   << " (give --threshold)";
+    }
+  }
   run.stage_seconds.emplace_back("carve_setup", run.result->statistics.setup_seconds);
   run.stage_seconds.emplace_back("carve", run.result->statistics.carve_seconds);
   run.stage_seconds.emplace_back("colour", run.result->statistics.colour_seconds);
@@ -141,7 +165,10 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("method").Value(CarveMethodToString(request.options.method))
       .Key("resolution").Value(request.options.resolution)
       .Key("consistency").Value(ConsistencyMethodToString(request.options.consistency))
-      .Key("threshold").Value(request.options.threshold)
+      .Key("threshold").Value(request.options.auto_threshold ? std::string("auto")
+                                                              : std::to_string(request.options.threshold))
+      .Key("auto_threshold_quantile").Value(request.options.auto_threshold_quantile)
+      .Key("protect_surface_points").Value(request.options.protect_surface_points)
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
       .Key("min_views").Value(request.options.min_views)
       .Key("order").Value(CarveOrderToString(request.options.order))
@@ -220,7 +247,27 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
                                                 static_cast<double>(level.dimensions.y()),
                                                 static_cast<double>(level.dimensions.z())})
         .Key("image_factor").Value(level.image_factor)
-        .Key("threshold").Value(level.threshold)
+        .Key("threshold").Value(level.threshold);
+    if (request.options.auto_threshold) {
+      const ThresholdEstimate& e = level.estimate;
+      std::vector<double> surface, front;
+      for (int q = 0; q <= 20; ++q) {
+        surface.push_back(ThresholdEstimate::Quantile(e.surface_errors, q / 20.0));
+        front.push_back(ThresholdEstimate::Quantile(e.front_errors, q / 20.0));
+      }
+      json.Key("threshold_estimate").BeginObject()
+          .Key("from_data").Value(level.threshold_from_data)
+          .Key("quantile").Value(e.quantile)
+          .Key("points_in_grid").Value(e.points_in_grid)
+          .Key("points_judged").Value(e.points_judged)
+          .Key("surface_error_quantiles_0_to_1_by_0_05").Value(surface)
+          .Key("front_offset_voxels").Value(ThresholdEstimate::kFrontOffsetVoxels)
+          .Key("front_voxels").Value(static_cast<uint64_t>(e.front_errors.size()))
+          .Key("front_error_quantiles_0_to_1_by_0_05").Value(front)
+          .Key("front_share_above_threshold").Value(e.FrontCarved())
+          .EndObject();
+    }
+    json.Key("protected_kept").Value(level.protected_kept)
         .Key("start_solid").Value(level.start_solid)
         .Key("carved").Value(level.carved)
         .Key("evaluated").Value(level.evaluated)
@@ -274,15 +321,32 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      {"ray", "gvc", "gvc_ldi"});
   parser->AddDefault("resolution", &request->options.resolution,
                      "voxels along the longest axis of the volume");
-  parser->AddDefault("consistency", &text->consistency, "photo-consistency test",
-                     {"mean_colour", "standard_deviation"});
-  parser->AddDefault("threshold", &request->options.threshold,
-                     "largest consistent error, RGB units 0-255");
+  parser->AddDefault("consistency", &text->consistency,
+                     "photo-consistency test: the seed paper's mean colours, Seitz and Dyer's "
+                     "standard deviation, or ncc (mean colours, and where the photos see texture "
+                     "the normalised cross-correlation of the voxel's patch in every view)",
+                     {"mean_colour", "standard_deviation", "ncc"});
+  parser->AddDefault("pattern_threshold", &request->options.pattern_threshold,
+                     "with --consistency ncc and a numeric --threshold: carve a textured voxel "
+                     "when 1 - NCC exceeds this (0-2); with --threshold auto, the fallback");
+  parser->AddDefault("threshold", &text->threshold,
+                     "largest consistent error, RGB units 0-255; auto: per level of detail, the "
+                     "--auto_threshold_quantile of the errors of the voxels that hold reliable "
+                     "sparse points (30 where fewer than 20 can be judged)");
+  parser->AddDefault("auto_threshold_quantile", &request->options.auto_threshold_quantile,
+                     "with --threshold auto: the share of the voxels on sparse points that the "
+                     "threshold keeps");
+  parser->AddDefault("protect_surface_points", &request->options.protect_surface_points,
+                     "never carve a voxel holding a reliable sparse point (track of 3 or more "
+                     "photos, error <= 1 px) by colour: stops carving that runs away");
   parser->AddDefault("adaptive_threshold", &request->options.adaptive_threshold,
                      "raise the threshold by this times the voxel's within-view colour spread "
                      "(texture edges); 0: a fixed threshold");
   parser->AddDefault("min_views", &request->options.min_views,
                      "views a voxel must be seen by to be judged");
+  parser->AddDefault("min_coverage", &request->options.min_coverage,
+                     "judge a voxel only when --min_views views each see at least this share of "
+                     "its projected outline (not through a small hole); 0: any pixel counts");
   parser->AddDefault("vis_lookup", &text->vis_lookup,
                      "how Vis(V) finds its rays: the paper's footprint scan, or per-voxel ray "
                      "lists (same result, more memory)",
@@ -339,6 +403,18 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
 }
 
 void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
+  if (text.threshold == "auto") {
+    request->options.auto_threshold = true;
+    request->options.threshold = kFallbackThreshold;
+  } else {
+    char* end = nullptr;
+    const double value = std::strtod(text.threshold.c_str(), &end);
+    if (text.threshold.empty() || end == nullptr || *end != '\0' || !std::isfinite(value)) {
+      throw InputError("--threshold: threshold must be a finite number or auto, got '" + text.threshold + "'");
+    }
+    request->options.auto_threshold = false;
+    request->options.threshold = value;
+  }
   ConsistencyMethodFromString(text.consistency, &request->options.consistency);
   VisLookupFromString(text.vis_lookup, &request->options.vis_lookup);
   CarveMethodFromString(text.method, &request->options.method);

@@ -62,11 +62,31 @@ struct LoadedProject {
   std::vector<CalibratedView> views;
   ViewReaderSummary view_summary;
   ColourCalibration colour;  // estimated and applied when asked (points_used 0 otherwise)
+  // The reliable sparse points (SurfacePointsOf) with the indices of the views that saw them.
+  std::vector<SurfacePoint> surface_points;
+  // With hold_out_every: the names of the held-out images (their observations were removed from
+  // the sparse points before anything used them).
+  std::vector<std::string> held_out;
 };
+
+// Reliable sparse points as surface evidence for carving: points inside `box` seen by at least
+// kMinSurfaceTrack of `views` with a mean reprojection error of at most kMaxSurfaceError pixels.
+constexpr int kMinSurfaceTrack = 3;
+constexpr double kMaxSurfaceError = 1.0;
+std::vector<SurfacePoint> SurfacePointsOf(const Reconstruction& reconstruction,
+                                          const std::vector<CalibratedView>& views,
+                                          const Eigen::AlignedBox3d& box);
+
+// Holds out every `every`-th image in name order (the first, then every k-th after it): their
+// observations leave the sparse points' tracks, and points left with fewer than two go. Returns
+// the held-out names, in name order.
+std::vector<std::string> HoldOutImages(int every, Reconstruction* reconstruction);
 
 // Resolves the workspace (see workspace.h) and the output folder (default <workspace>/raycarve,
 // refused when it is the model or photo folder), reads the model (it must have at least
-// `min_images` registered images), bounds it and loads its views, logging each stage. Throws
+// `min_images` registered images), bounds it and loads its views, logging each stage. With
+// `hold_out_every` > 0, HoldOutImages runs first, so that neither the bounds, the colour
+// calibration nor the surface points see the held-out views (which are still loaded). Throws
 // InputError naming `command` or the file on bad input.
 LoadedProject LoadProject(const std::string& command,
                           const std::string& workspace_path,
@@ -77,15 +97,21 @@ LoadedProject LoadProject(const std::string& command,
                           const ViewReaderOptions& view_options,
                           int min_images,
                           int model_index = -1,
-                          bool colour_calibration = false);
+                          bool colour_calibration = false,
+                          int hold_out_every = 0);
 
 // carve: everything `raycarve carve` takes, and what it produced.
+// --threshold auto's threshold where too few sparse points can be judged.
+constexpr double kFallbackThreshold = 30.0;
+
 struct CarveRequest {
   // The command line uses every core, automatic levels of detail and removes specks by default.
   CarveRequest() {
     options.num_threads = -1;
     options.lod_levels = kAutomaticLevels;
     options.min_component_voxels = 8;
+    options.auto_threshold = true;
+    options.protect_surface_points = true;
   }
   std::string workspace_path;
   std::string input_path;
@@ -122,6 +148,7 @@ struct CarveRun {
 // The carve flags shared by `carve` and `holdout`: AddCarveFlags declares them (the enum-valued
 // ones as text), ApplyCarveFlags converts and checks them (InputError on bad values).
 struct CarveFlagText {
+  std::string threshold = "auto";
   std::string consistency;
   std::string vis_lookup;
   std::string method;

@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <set>
 
 #include <glog/logging.h>
 #include <opencv2/imgproc.hpp>
@@ -41,11 +42,16 @@ int RunHoldout(int argc, char** argv) {
   const LoadedProject project =
       LoadProject("holdout", request.workspace_path, request.input_path, request.image_path,
                   request.output_path, request.bounds, request.view_options, /*min_images=*/3,
-                  request.model_index, request.colour_calibration);
+                  request.model_index, request.colour_calibration, every);
+  // Every k-th image in name order is held out; its observations left the sparse points before
+  // the bounds, the colour calibration and the surface evidence were taken from them.
+  const std::set<std::string> held_out_names(project.held_out.begin(), project.held_out.end());
   std::vector<CalibratedView> training, held_out;
-  for (size_t i = 0; i < project.views.size(); ++i) {
-    (i % every == 0 ? held_out : training).push_back(project.views[i]);
+  for (const CalibratedView& view : project.views) {
+    (held_out_names.count(view.name) > 0 ? held_out : training).push_back(view);
   }
+  std::sort(held_out.begin(), held_out.end(),
+            [](const CalibratedView& a, const CalibratedView& b) { return a.name < b.name; });
   if (training.size() < 2) {
     throw InputError("raycarve holdout: only " + std::to_string(training.size()) +
                      " views left to carve with; raise --every");
@@ -55,7 +61,15 @@ int RunHoldout(int argc, char** argv) {
     throw InputError("raycarve holdout: " + reason);
   }
   LOG(INFO) << "carving with " << training.size() << " views, holding out " << held_out.size();
-  const CarveResult result = CarveVolume(training, project.bounds.box, request.options);
+  CarveOptions options = request.options;
+  options.surface_points = SurfacePointsOf(project.reconstruction, training, project.bounds.box);
+  const CarveResult result = CarveVolume(training, project.bounds.box, options);
+  std::string thresholds;
+  for (const LevelStatistics& level : result.statistics.levels) {
+    thresholds += (thresholds.empty() ? "" : ", ") + std::to_string(level.resolution) + ": " +
+                  std::to_string(level.threshold);
+    if (options.auto_threshold) LOG(INFO) << level.estimate.Summary();
+  }
   LOG(INFO) << result.statistics.Summary();
   const std::vector<exporter::ColouredPoint> points =
       exporter::SurfacePoints(result, request.options.min_views);
@@ -72,7 +86,9 @@ int RunHoldout(int argc, char** argv) {
       .Key("training_views").Value(static_cast<uint64_t>(training.size()))
       .Key("cloud_points").Value(static_cast<uint64_t>(points.size()))
       .Key("render").Value(render)
-      .Key("carve").Value(result.statistics.Summary());
+      .Key("carve").Value(result.statistics.Summary())
+      .Key("thresholds").Value(thresholds)
+      .Key("surface_points").Value(static_cast<uint64_t>(options.surface_points.size()));
   json.Key("views").BeginArray();
   double psnr_sum = 0.0, iou_sum = 0.0;
   int iou_count = 0;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 
 #include <glog/logging.h>
 
@@ -130,7 +132,8 @@ LoadedProject LoadProject(const std::string& command,
                           const ViewReaderOptions& view_options,
                           int min_images,
                           int model_index,
-                          bool colour_calibration) {
+                          bool colour_calibration,
+                          int hold_out_every) {
   LoadedProject project;
   const WorkspacePaths paths =
       ResolveWorkspace(workspace_path, input_path, image_path, model_index);
@@ -153,6 +156,13 @@ LoadedProject LoadProject(const std::string& command,
                      " registered images; raycarve " + command + " needs at least " +
                      std::to_string(min_images));
   }
+  if (hold_out_every > 0) {
+    project.held_out = HoldOutImages(hold_out_every, &project.reconstruction);
+    LOG(INFO) << "holding out " << project.held_out.size() << " of " << registered
+              << " images (every " << hold_out_every << "th in name order); "
+              << project.reconstruction.points3D.size()
+              << " sparse points keep two or more observations without them";
+  }
   project.bounds = ResolveBounds(project.reconstruction, bounds_flags, paths.model_path);
   LOG(INFO) << project.bounds.Summary();
   LOG(INFO) << "loading and undistorting " << registered << " photos from " << paths.image_path;
@@ -174,7 +184,69 @@ LoadedProject LoadProject(const std::string& command,
       LOG(INFO) << project.colour.Summary();
     }
   }
+  project.surface_points =
+      SurfacePointsOf(project.reconstruction, project.views, project.bounds.box);
   return project;
+}
+
+std::vector<SurfacePoint> SurfacePointsOf(const Reconstruction& reconstruction,
+                                          const std::vector<CalibratedView>& views,
+                                          const Eigen::AlignedBox3d& box) {
+  std::map<image_t, int> view_of;
+  for (size_t v = 0; v < views.size(); ++v) view_of[views[v].image_id] = static_cast<int>(v);
+  std::vector<SurfacePoint> points;
+  for (const auto& [id, point3D] : reconstruction.points3D) {
+    if (!(point3D.error >= 0.0 && point3D.error <= kMaxSurfaceError)) continue;
+    if (!box.contains(point3D.xyz)) continue;
+    SurfacePoint point;
+    point.xyz = point3D.xyz;
+    for (const TrackElement& element : point3D.track) {
+      const auto found = view_of.find(element.image_id);
+      if (found != view_of.end()) point.views.push_back(found->second);
+    }
+    std::sort(point.views.begin(), point.views.end());
+    point.views.erase(std::unique(point.views.begin(), point.views.end()), point.views.end());
+    if (static_cast<int>(point.views.size()) >= kMinSurfaceTrack) points.push_back(std::move(point));
+  }
+  return points;
+}
+
+std::vector<std::string> HoldOutImages(int every, Reconstruction* reconstruction) {
+  CHECK_GT(every, 0);
+  std::vector<std::pair<std::string, image_t>> by_name;
+  for (const auto& [id, image] : reconstruction->images) by_name.emplace_back(image.name, id);
+  std::sort(by_name.begin(), by_name.end());
+  std::vector<std::string> names;
+  std::set<image_t> held;
+  for (size_t i = 0; i < by_name.size(); i += every) {
+    names.push_back(by_name[i].first);
+    held.insert(by_name[i].second);
+  }
+  for (auto it = reconstruction->points3D.begin(); it != reconstruction->points3D.end();) {
+    std::vector<TrackElement>& track = it->second.track;
+    track.erase(std::remove_if(track.begin(), track.end(),
+                               [&](const TrackElement& e) { return held.count(e.image_id) > 0; }),
+                track.end());
+    std::set<image_t> distinct;
+    for (const TrackElement& e : track) distinct.insert(e.image_id);
+    if (distinct.size() < 2) {
+      for (const TrackElement& e : track) {
+        Image& image = reconstruction->images.at(e.image_id);
+        if (e.point2D_idx < image.points2D.size()) {
+          image.points2D[e.point2D_idx].point3D_id = kInvalidPoint3DId;
+        }
+      }
+      it = reconstruction->points3D.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  for (image_t id : held) {
+    for (Point2D& point2D : reconstruction->images.at(id).points2D) {
+      point2D.point3D_id = kInvalidPoint3DId;
+    }
+  }
+  return names;
 }
 
 }  // namespace raycarve

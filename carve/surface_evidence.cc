@@ -1,0 +1,210 @@
+#include "carve/surface_evidence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <limits>
+
+#include "carve/footprint.h"
+#include "carve/patch_correlation.h"
+
+namespace raycarve {
+namespace {
+
+// Whether the ray from `origin` along `direction` meets the box [lo, hi] in front of the origin
+// (slab test).
+bool RayMeetsBox(const Eigen::Vector3d& origin,
+                 const Eigen::Vector3d& direction,
+                 const Eigen::Vector3d& lo,
+                 const Eigen::Vector3d& hi) {
+  double t_near = 0.0;
+  double t_far = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 3; ++axis) {
+    if (direction[axis] == 0.0) {
+      if (origin[axis] < lo[axis] || origin[axis] > hi[axis]) return false;
+      continue;
+    }
+    double t0 = (lo[axis] - origin[axis]) / direction[axis];
+    double t1 = (hi[axis] - origin[axis]) / direction[axis];
+    if (t0 > t1) std::swap(t0, t1);
+    t_near = std::max(t_near, t0);
+    t_far = std::min(t_far, t1);
+    if (t_near > t_far) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+double ThresholdEstimate::Quantile(const std::vector<double>& values, double q) {
+  if (values.empty()) return 0.0;
+  const double position = std::clamp(q, 0.0, 1.0) * (values.size() - 1);
+  const size_t below = static_cast<size_t>(std::floor(position));
+  const size_t above = std::min(values.size() - 1, below + 1);
+  const double fraction = position - below;
+  return values[below] * (1.0 - fraction) + values[above] * fraction;
+}
+
+double ThresholdEstimate::EqualError(const std::vector<double>& surface,
+                                     const std::vector<double>& front,
+                                     double front_weight) {
+  if (surface.empty()) return 0.0;
+  if (front.empty()) return surface.back();
+  // Candidates: every value of either list; the first at which the share of surface voxels above
+  // it is no longer larger than the share of front voxels at or below it.
+  std::vector<double> candidates(surface);
+  candidates.insert(candidates.end(), front.begin(), front.end());
+  std::sort(candidates.begin(), candidates.end());
+  for (double t : candidates) {
+    const double surface_carved =
+        static_cast<double>(surface.end() - std::upper_bound(surface.begin(), surface.end(), t)) /
+        surface.size();
+    const double front_kept =
+        static_cast<double>(std::upper_bound(front.begin(), front.end(), t) - front.begin()) /
+        front.size();
+    if (surface_carved <= front_weight * front_kept) return t;
+  }
+  return candidates.back();
+}
+
+double ThresholdEstimate::FrontCarved() const {
+  if (front_flags.empty()) return 0.0;
+  int64_t carved = 0;
+  for (const auto& [error, pattern_error] : front_flags) {
+    carved += error > threshold || pattern_error > pattern_threshold;
+  }
+  return static_cast<double>(carved) / front_flags.size();
+}
+
+std::string ThresholdEstimate::Summary() const {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(1) << "threshold " << threshold << " ("
+       << (masked ? "their 99% quantile: masks" : "weighted equal error: no masks") << ") from "
+       << points_judged << " of " << points_in_grid
+       << " surface points: surface voxels' error median " << Quantile(surface_errors, 0.5)
+       << ", 90% " << Quantile(surface_errors, 0.9) << ", 95% " << Quantile(surface_errors, 0.95)
+       << ", 99% " << Quantile(surface_errors, 0.99) << "; voxels " << kFrontOffsetVoxels
+       << " in front: median " << Quantile(front_errors, 0.5) << ", "
+       << std::setprecision(0) << 100.0 * FrontCarved() << "% carved";
+  if (!surface_pattern_errors.empty()) {
+    text << std::setprecision(2) << "; patterns (1 - NCC): threshold " << pattern_threshold
+         << " from " << surface_pattern_errors.size() << " textured surface voxels (median "
+         << Quantile(surface_pattern_errors, 0.5) << "), front median "
+         << Quantile(front_pattern_errors, 0.5);
+  }
+  return text.str();
+}
+
+void GatherVoxelPixels(const CalibratedView& view,
+                       const VoxelGrid& grid,
+                       const Eigen::Vector3i& voxel,
+                       ViewColourStats* stats) {
+  const Footprint footprint = ComputeFootprint(view.P, view.width, view.height, grid, voxel);
+  if (footprint.empty()) return;
+  const Eigen::Vector3d lo = grid.Corner(voxel, 0);
+  const Eigen::Vector3d hi = grid.Corner(voxel, 7);
+  const Eigen::Matrix3d world_from_pixel =
+      view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse();
+  for (int row = footprint.row_min; row <= footprint.row_max; ++row) {
+    const uint8_t* valid = view.valid.empty() ? nullptr : view.valid.ptr<uint8_t>(row);
+    const uint8_t* mask = view.mask.empty() ? nullptr : view.mask.ptr<uint8_t>(row);
+    const uint8_t* rgb = view.image.ptr<uint8_t>(row);
+    for (int col = footprint.col_min; col <= footprint.col_max; ++col) {
+      if ((valid != nullptr && valid[col] == 0) || (mask != nullptr && mask[col] == 0)) continue;
+      const Eigen::Vector3d direction = world_from_pixel * Eigen::Vector3d(col + 0.5, row + 0.5, 1);
+      if (!RayMeetsBox(view.centre, direction, lo, hi)) continue;
+      stats->Add(Eigen::Vector3d(rgb[3 * col], rgb[3 * col + 1], rgb[3 * col + 2]));
+    }
+  }
+}
+
+ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
+                                    const VoxelGrid& grid,
+                                    const std::vector<SurfacePoint>& points,
+                                    ConsistencyMethod test_method,
+                                    int min_views,
+                                    bool masked,
+                                    double quantile,
+                                    double fallback,
+                                    double pattern_fallback,
+                                    int min_points) {
+  ThresholdEstimate estimate;
+  estimate.quantile = quantile;
+  const ConsistencyTest test(test_method, 0.0, min_views);
+  std::vector<ViewColourStats> stats;
+  // The error of `voxel` judged from `point`'s views, or a negative value when not judged.
+  const bool patterns = test_method == ConsistencyMethod::kPatchCorrelation;
+  double pattern_error = -1.0;  // of the last voxel error_of judged
+  auto error_of = [&](const Eigen::Vector3i& voxel, const SurfacePoint& point) {
+    stats.clear();
+    for (int v : point.views) {
+      ViewColourStats view_stats;
+      view_stats.view = v;
+      GatherVoxelPixels(views[v], grid, voxel, &view_stats);
+      if (view_stats.count > 0) stats.push_back(view_stats);
+    }
+    const Consistency consistency = test.Evaluate(stats);
+    pattern_error = -1.0;
+    if (patterns && consistency.judged) {
+      const PatchCorrelation patches =
+          CorrelatePatches(views, grid.Centre(voxel), grid.voxel_size(), stats);
+      if (patches.textured) pattern_error = patches.error();
+    }
+    return consistency.judged ? consistency.error : -1.0;
+  };
+  for (const SurfacePoint& point : points) {
+    const Eigen::Vector3i voxel = grid.VoxelOf(point.xyz);
+    if (!grid.Contains(voxel) || static_cast<int>(point.views.size()) < min_views) continue;
+    ++estimate.points_in_grid;
+    const double surface = error_of(voxel, point);
+    if (surface < 0.0) continue;
+    ++estimate.points_judged;
+    estimate.surface_errors.push_back(surface);
+    if (pattern_error >= 0.0) estimate.surface_pattern_errors.push_back(pattern_error);
+    Eigen::Vector3d towards = Eigen::Vector3d::Zero();
+    for (int v : point.views) towards += (views[v].centre - point.xyz).normalized();
+    if (towards.norm() < 1e-9) continue;
+    const Eigen::Vector3i front = grid.VoxelOf(
+        point.xyz + towards.normalized() * ThresholdEstimate::kFrontOffsetVoxels * grid.voxel_size());
+    if (!grid.Contains(front) || front == voxel) continue;
+    const double front_error = error_of(front, point);
+    if (front_error < 0.0) continue;
+    estimate.front_errors.push_back(front_error);
+    estimate.front_flags.emplace_back(front_error, pattern_error);
+    if (pattern_error >= 0.0) estimate.front_pattern_errors.push_back(pattern_error);
+  }
+  std::sort(estimate.surface_errors.begin(), estimate.surface_errors.end());
+  std::sort(estimate.front_errors.begin(), estimate.front_errors.end());
+  std::sort(estimate.surface_pattern_errors.begin(), estimate.surface_pattern_errors.end());
+  std::sort(estimate.front_pattern_errors.begin(), estimate.front_pattern_errors.end());
+  estimate.masked = masked;
+  auto choose = [&](const std::vector<double>& surface, const std::vector<double>& front) {
+    return masked || front.empty() ? ThresholdEstimate::Quantile(surface, quantile)
+                                   : ThresholdEstimate::EqualError(surface, front, ThresholdEstimate::kFrontWeight);
+  };
+  estimate.threshold = estimate.points_judged >= min_points
+                           ? choose(estimate.surface_errors, estimate.front_errors)
+                           : fallback;
+  estimate.pattern_threshold =
+      static_cast<int>(estimate.surface_pattern_errors.size()) >= min_points
+          ? choose(estimate.surface_pattern_errors, estimate.front_pattern_errors)
+          : pattern_fallback;
+  if (!patterns) estimate.pattern_threshold = std::numeric_limits<double>::infinity();
+  return estimate;
+}
+
+std::vector<int64_t> SurfacePointVoxels(const VoxelGrid& grid,
+                                        const std::vector<SurfacePoint>& points) {
+  std::vector<int64_t> voxels;
+  voxels.reserve(points.size());
+  for (const SurfacePoint& point : points) {
+    const Eigen::Vector3i voxel = grid.VoxelOf(point.xyz);
+    if (grid.Contains(voxel)) voxels.push_back(grid.Index(voxel));
+  }
+  std::sort(voxels.begin(), voxels.end());
+  voxels.erase(std::unique(voxels.begin(), voxels.end()), voxels.end());
+  return voxels;
+}
+
+}  // namespace raycarve

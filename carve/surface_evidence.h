@@ -1,0 +1,105 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "calib/calibrated_view.h"
+#include "carve/consistency.h"
+#include "carve/voxel_grid.h"
+
+namespace raycarve {
+
+// The fewest judged surface points from which EstimateThreshold takes a threshold.
+constexpr int kMinThresholdPoints = 20;
+
+// A point known to lie on the object's surface (a reliable COLMAP sparse point) and the views
+// that observed it (indices into the carve's views).
+struct SurfacePoint {
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  std::vector<int> views;
+};
+
+// The distribution of a consistency test's error over voxels that hold a known surface point
+// ("surface") and over voxels `kFrontOffsetVoxels` voxels in front of it, towards the mean of
+// its views' centres ("front": empty space from which the views see different parts of the
+// surface), at one grid. Each voxel is judged as the carve would judge it once the space in
+// front of the surface is carved: per view of the point's track, the usable pixels (valid, on the
+// object where there is a mask) whose ray through the pixel centre meets the voxel's cube.
+struct ThresholdEstimate {
+  static constexpr double kFrontOffsetVoxels = 2.0;
+  // Without masks: a wrongly carved surface voxel is allowed to be this many times as likely as
+  // a kept front voxel. Known surface (CarveOptions::protect_surface_points) stops a wrong carve
+  // from running away, while every kept front voxel is a floater in the model that also hides
+  // what lies behind it (measured on the generated scenes: 1 keeps floaters, 3 and 5 about equal).
+  static constexpr double kFrontWeight = 3.0;
+
+  int points_in_grid = 0;  // surface points inside the grid with at least min_views views
+  int points_judged = 0;   // of them, those whose voxel had pixels in at least min_views views
+  std::vector<double> surface_errors;  // sorted ascending
+  std::vector<double> front_errors;    // sorted ascending (voxels inside the grid only)
+  double quantile = 0.0;   // the share of surface voxels the threshold keeps
+  double threshold = 0.0;  // the chosen threshold (RGB units); see EstimateThreshold
+  // With kPatchCorrelation: 1 - NCC of the textured voxels among them (sorted), and the chosen
+  // pattern threshold.
+  std::vector<double> surface_pattern_errors;
+  std::vector<double> front_pattern_errors;
+  double pattern_threshold = 0.0;
+  // Per front voxel: (error, pattern error or -1), for FrontCarved.
+  std::vector<std::pair<double, double>> front_flags;
+
+  bool masked = false;     // which rule chose the threshold (EstimateThreshold)
+
+  // The q-quantile (0..1) of sorted `values` by linear interpolation; 0 when empty.
+  static double Quantile(const std::vector<double>& values, double q);
+  // The weighted equal-error threshold of two sorted lists: the smallest t (a value of either) at
+  // which the share of `surface` above t is at most front_weight x the share of `front` at or
+  // below t.
+  static double EqualError(const std::vector<double>& surface,
+                           const std::vector<double>& front,
+                           double front_weight = 1.0);
+  // Share of front voxels the threshold would carve (error above it; with patterns, also those
+  // whose pattern error exceeds the pattern threshold).
+  double FrontCarved() const;
+  std::string Summary() const;
+};
+
+// Measures the errors of `test_method` at `grid` over `points` (see ThresholdEstimate) and
+// chooses the threshold (likewise the pattern threshold, from the textured voxels):
+// - `masked` (the views have object masks, so the visual hull has removed the empty space the
+//   views see against the background): the `quantile` of the surface voxels' errors, the
+//   smallest threshold that keeps that share of them. What colour leaves is bounded by the hull,
+//   while a wrongly carved surface voxel leaves a hole that the voxels behind it, seen through
+//   it, widen: the errors cost unequally.
+// - not masked: colour alone must carve all of the empty space: the smallest threshold at which
+//   the share of surface voxels carved is at most kFrontWeight times the share of front voxels
+//   kept (EqualError).
+// `fallback` (`pattern_fallback`) is used when fewer than `min_points` points (textured points)
+// could be judged.
+ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
+                                    const VoxelGrid& grid,
+                                    const std::vector<SurfacePoint>& points,
+                                    ConsistencyMethod test_method,
+                                    int min_views,
+                                    bool masked,
+                                    double quantile,
+                                    double fallback,
+                                    double pattern_fallback,
+                                    int min_points = kMinThresholdPoints);
+
+// The statistics of one voxel in one view as EstimateThreshold gathers them: the usable pixels
+// of `view` whose ray meets the cube of `voxel` (added to `stats`).
+void GatherVoxelPixels(const CalibratedView& view,
+                       const VoxelGrid& grid,
+                       const Eigen::Vector3i& voxel,
+                       ViewColourStats* stats);
+
+// The indices of the voxels of `grid` holding a point of `points` (sorted, unique; points
+// outside the grid are skipped).
+std::vector<int64_t> SurfacePointVoxels(const VoxelGrid& grid,
+                                        const std::vector<SurfacePoint>& points);
+
+}  // namespace raycarve

@@ -55,6 +55,10 @@ bool CarveDecisionFromString(const std::string& text, CarveDecision* decision);
 // farther than the farthest such point; a voxel closer than that by less than the margin (in
 // voxels) is at or behind the known surface in that view and is not carved by colour.
 constexpr double kKnownSurfaceRadiusVoxels = 2.0;
+// ... or this many times the view's spacing of the known surface (the median distance from an
+// observation to its nearest neighbour in that photo), when that is wider: finer grids need the
+// same cover of the photo.
+constexpr double kKnownSurfaceRadiusSpacings = 1.0;
 constexpr double kKnownSurfaceMarginVoxels = 1.0;
 
 struct CarveOptions {

@@ -66,8 +66,10 @@ int RunHoldout(int argc, char** argv) {
   const CarveResult result = CarveVolume(training, project.bounds.box, options);
   std::string thresholds;
   for (const LevelStatistics& level : result.statistics.levels) {
-    thresholds += (thresholds.empty() ? "" : ", ") + std::to_string(level.resolution) + ": " +
-                  std::to_string(level.threshold);
+    char text[64];
+    std::snprintf(text, sizeof(text), "%s%d: %.1f", thresholds.empty() ? "" : ", ",
+                  level.resolution, level.threshold);
+    thresholds += text;
     if (options.auto_threshold) LOG(INFO) << level.estimate.Summary();
   }
   LOG(INFO) << result.statistics.Summary();

@@ -51,8 +51,9 @@ void GatherColours(const std::vector<CalibratedView>& views,
 }
 
 // Per view, the depth of the known surface near each pixel: around each surface point's
-// projection, within kKnownSurfaceRadiusVoxels of its projected voxel width, the farthest depth
-// of the points there (0: no point near). Empty for views no point names.
+// projection, within kKnownSurfaceRadiusVoxels of its projected voxel width or
+// kKnownSurfaceRadiusSpacings of the view's observation spacing, whichever is wider, the farthest
+// depth of the points there (0: no point near). Empty for views no point names.
 std::vector<cv::Mat> KnownSurfaceDepths(const std::vector<CalibratedView>& views,
                                         const VoxelGrid& grid,
                                         const std::vector<SurfacePoint>& points) {

@@ -1,8 +1,11 @@
 #pragma once
 
+#include <algorithm>
+#include <map>
 #include <vector>
 
 #include "calib/calibrated_view.h"
+#include "carve/surface_evidence.h"
 #include "carve/visibility.h"
 #include "carve/volume.h"
 #include "samples/synthetic_scene.h"
@@ -37,6 +40,26 @@ inline std::vector<CalibratedView> SceneViews(const SyntheticScene& scene, bool 
                                        image.name + ".png"));
   }
   return views;
+}
+
+// The scene's sparse points seen by at least `min_track` views as surface evidence (views indexed
+// as SceneViews orders them).
+inline std::vector<SurfacePoint> SceneSurfacePoints(const SyntheticScene& scene, int min_track = 3) {
+  std::map<image_t, int> index;
+  for (const auto& [id, image] : scene.reconstruction.images) {
+    const int next = static_cast<int>(index.size());
+    index[id] = next;
+  }
+  std::vector<SurfacePoint> points;
+  for (const auto& [id, point3D] : scene.reconstruction.points3D) {
+    SurfacePoint point;
+    point.xyz = point3D.xyz;
+    for (const TrackElement& element : point3D.track) point.views.push_back(index.at(element.image_id));
+    std::sort(point.views.begin(), point.views.end());
+    point.views.erase(std::unique(point.views.begin(), point.views.end()), point.views.end());
+    if (static_cast<int>(point.views.size()) >= min_track) points.push_back(point);
+  }
+  return points;
 }
 
 // Brute force: whether the ray from `origin` along `direction` (t > 0) passes through the

@@ -520,30 +520,11 @@ TEST(CarveVolume, CarvesTheGeneratedSceneToItsTrueSurface) {
 namespace raycarve {
 namespace {
 
-// The scene's sparse points as surface evidence (views indexed as SceneViews orders them).
-std::vector<SurfacePoint> SurfacePointsOf(const SyntheticScene& scene) {
-  std::map<image_t, int> index;
-  for (const auto& [id, image] : scene.reconstruction.images) {
-    const int next = static_cast<int>(index.size());
-    index[id] = next;
-  }
-  std::vector<SurfacePoint> points;
-  for (const auto& [id, point3D] : scene.reconstruction.points3D) {
-    SurfacePoint point;
-    point.xyz = point3D.xyz;
-    for (const TrackElement& element : point3D.track) point.views.push_back(index.at(element.image_id));
-    std::sort(point.views.begin(), point.views.end());
-    point.views.erase(std::unique(point.views.begin(), point.views.end()), point.views.end());
-    if (point.views.size() >= 3) points.push_back(point);
-  }
-  return points;
-}
-
 TEST(CarveVolume, KnownSurfaceIsNotCarvedByColourEvenWhereNothingIsConsistent) {
   const SyntheticScene scene = Scene(6, 160, 120);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
   CarveOptions options = Options(32, -1.0);  // every judged voxel is inconsistent
-  options.surface_points = SurfacePointsOf(scene);
+  options.surface_points = testing::SceneSurfacePoints(scene);
   ASSERT_GT(options.surface_points.size(), 50u);
   const VoxelGrid grid(scene.object_box, 32);
   const std::vector<int64_t> known = SurfacePointVoxels(grid, options.surface_points);
@@ -634,7 +615,7 @@ TEST(CarveVolume, TheDataDrivenDefaultsCarveGeneratedScenesWithRealPhotoFaultsTo
   }
   cases.emplace_back("specular highlights", highlights, 0.80);
 
-  const std::vector<SurfacePoint> points = SurfacePointsOf(scene);
+  const std::vector<SurfacePoint> points = testing::SceneSurfacePoints(scene);
   for (const auto& [name, views, least_precision] : cases) {
     CarveOptions old_default = Options(96, 30.0);
     CarveOptions data = Options(96, 30.0);

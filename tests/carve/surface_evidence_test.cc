@@ -12,25 +12,6 @@
 namespace raycarve {
 namespace {
 
-// The scene's sparse points as surface evidence: views are indexed as SceneViews orders them.
-std::vector<SurfacePoint> PointsOf(const SyntheticScene& scene, int min_track = 3) {
-  std::map<image_t, int> index;
-  for (const auto& [id, image] : scene.reconstruction.images) {
-    const int next = static_cast<int>(index.size());
-    index[id] = next;
-  }
-  std::vector<SurfacePoint> points;
-  for (const auto& [id, point3D] : scene.reconstruction.points3D) {
-    SurfacePoint point;
-    point.xyz = point3D.xyz;
-    for (const TrackElement& element : point3D.track) point.views.push_back(index.at(element.image_id));
-    std::sort(point.views.begin(), point.views.end());
-    point.views.erase(std::unique(point.views.begin(), point.views.end()), point.views.end());
-    if (static_cast<int>(point.views.size()) >= min_track) points.push_back(point);
-  }
-  return points;
-}
-
 SyntheticScene TexturedScene() {
   SyntheticSceneOptions options = testing::SceneOptions(8, 320, 240, false, 1500);
   options.detail_texture = true;
@@ -89,7 +70,7 @@ TEST(GatherVoxelPixels, CountsExactlyThePixelsWhoseRayMeetsTheCube) {
 TEST(EstimateThreshold, SeparatesTheSurfaceFromTheSpaceInFrontAndChoosesByTheDocumentedRule) {
   const SyntheticScene scene = TexturedScene();
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
-  const std::vector<SurfacePoint> points = PointsOf(scene);
+  const std::vector<SurfacePoint> points = testing::SceneSurfacePoints(scene);
   ASSERT_GT(points.size(), 100u);
   const VoxelGrid grid(scene.object_box, 96);
   const ThresholdEstimate unmasked = EstimateThreshold(
@@ -136,7 +117,7 @@ TEST(PatchCorrelation, IgnoresExposureAndWhiteBalanceAndTellsTheSurfaceFromTheSp
     changed += offset;
     exposed[v].image = changed;
   }
-  const std::vector<SurfacePoint> points = PointsOf(scene);
+  const std::vector<SurfacePoint> points = testing::SceneSurfacePoints(scene);
   const VoxelGrid grid(scene.object_box, 96);
   const ThresholdEstimate plain = EstimateThreshold(
       views, grid, points, ConsistencyMethod::kPatchCorrelation, 2, false, 0.99, 30, 0.5);

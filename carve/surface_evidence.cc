@@ -170,6 +170,9 @@ ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
     if (!grid.Contains(front) || front == voxel) continue;
     const double front_error = error_of(front, point);
     if (front_error < 0.0) continue;
+    if (surface <= ThresholdEstimate::kNoEvidence && front_error <= ThresholdEstimate::kNoEvidence) {
+      ++estimate.uninformative;
+    }
     estimate.front_errors.push_back(front_error);
     estimate.front_flags.emplace_back(front_error, pattern_error);
     if (pattern_error >= 0.0) estimate.front_pattern_errors.push_back(pattern_error);
@@ -183,9 +186,18 @@ ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
     return masked || front.empty() ? ThresholdEstimate::Quantile(surface, quantile)
                                    : ThresholdEstimate::EqualError(surface, front, ThresholdEstimate::kFrontWeight);
   };
-  estimate.threshold = estimate.points_judged >= min_points
-                           ? choose(estimate.surface_errors, estimate.front_errors)
-                           : fallback;
+  // The equal-error rule weighs only the points whose two voxels colour can tell apart at all:
+  // as many exact agreements as there are uninformative pairs leave both lists (each list is
+  // sorted, so they are its first values).
+  const size_t drop = masked ? 0 : static_cast<size_t>(estimate.uninformative);
+  const std::vector<double> rule_surface(
+      estimate.surface_errors.begin() + std::min(drop, estimate.surface_errors.size()),
+      estimate.surface_errors.end());
+  const std::vector<double> rule_front(
+      estimate.front_errors.begin() + std::min(drop, estimate.front_errors.size()),
+      estimate.front_errors.end());
+  estimate.threshold = estimate.points_judged >= min_points ? choose(rule_surface, rule_front)
+                                                            : fallback;
   estimate.pattern_threshold =
       static_cast<int>(estimate.surface_pattern_errors.size()) >= min_points
           ? choose(estimate.surface_pattern_errors, estimate.front_pattern_errors)

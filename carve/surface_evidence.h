@@ -36,9 +36,14 @@ struct ThresholdEstimate {
   // from running away, while every kept front voxel is a floater in the model that also hides
   // what lies behind it (measured on the generated scenes: 1 keeps floaters, 3 and 5 about equal).
   static constexpr double kFrontWeight = 3.0;
+  // Errors at or below this (RGB) are agreement to the last quantisation step: a point whose
+  // surface and front voxels both agree so well (a plain or saturated region) says nothing about
+  // where to put the threshold, and the no-mask rule leaves it out.
+  static constexpr double kNoEvidence = 1.0;
 
   int points_in_grid = 0;  // surface points inside the grid with at least min_views views
   int points_judged = 0;   // of them, those whose voxel had pixels in at least min_views views
+  int uninformative = 0;   // of them, those whose surface and front errors are both <= kNoEvidence
   std::vector<double> surface_errors;  // sorted ascending
   std::vector<double> front_errors;    // sorted ascending (voxels inside the grid only)
   double quantile = 0.0;   // the share of surface voxels the threshold keeps

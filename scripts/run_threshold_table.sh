@@ -14,7 +14,8 @@ out=out/threshold_table
 mkdir -p "$out"
 json_number() { grep -o "\"$2\": [-0-9.e+]*" "$1" | head -1 | sed 's/.*: //'; }
 if [ ! -d "$out/paper/sparse" ]; then
-  build/plugin/raycarve synth --output_path "$out/paper" --scene paper > "$out/paper.synth.log" 2>&1
+  build/plugin/raycarve synth --output_path "$out/paper" --scene paper --views 14 --width 800 \
+    --height 600 > "$out/paper.synth.log" 2>&1
 fi
 projects=()
 for set in templeSparseRing dinoSparseRing dinoRing; do

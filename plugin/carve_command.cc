@@ -284,6 +284,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
         .Key("within_2_voxels").Value(run.sparse.precision)
         .Key("distance_90_percent_voxels").Value(run.sparse.accuracy / voxel)
         .Key("mean_distance_voxels").Value(run.sparse.mean_reconstruction_to_reference / voxel)
+        .Key("reliable_ones_kept_by_known_surface").Value(request.options.protect_surface_points)
         .EndObject();
   }
   json.Key("stage_seconds").BeginObject();
@@ -444,10 +445,13 @@ int RunCarve(int argc, char** argv) {
   const CarveStatistics& s = run.result->statistics;
   std::string sparse_line = "none in the volume";
   if (run.has_sparse) {
-    char text[160];
-    std::snprintf(text, sizeof(text), "%zu in the volume: %.1f%% within 2 voxels of the cloud, 90%% within %.2f voxels",
+    char text[240];
+    std::snprintf(text, sizeof(text), "%zu in the volume: %.1f%% within 2 voxels of the cloud, 90%% within %.2f voxels%s",
                   run.sparse.num_reconstruction, 100.0 * run.sparse.precision,
-                  run.sparse.accuracy / s.voxel_size);
+                  run.sparse.accuracy / s.voxel_size,
+                  request.options.protect_surface_points
+                      ? "\n                  (known surface keeps the reliable ones' voxels: no independent measure)"
+                      : "");
     sparse_line = text;
   }
   std::string level_line;

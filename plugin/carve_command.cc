@@ -338,7 +338,7 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "with --threshold auto: the share of the voxels on sparse points that the "
                      "threshold keeps");
   parser->AddDefault("protect_surface_points", &request->options.protect_surface_points,
-                     "never carve a voxel holding a reliable sparse point (track of 3 or more "
+                     "never carve a voxel holding a reliable sparse point (track of 2 or more "
                      "photos, error <= 1 px) by colour: stops carving that runs away");
   parser->AddDefault("adaptive_threshold", &request->options.adaptive_threshold,
                      "raise the threshold by this times the voxel's within-view colour spread "

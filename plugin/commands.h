@@ -71,7 +71,9 @@ struct LoadedProject {
 
 // Reliable sparse points as surface evidence for carving: points inside `box` seen by at least
 // kMinSurfaceTrack of `views` with a mean reprojection error of at most kMaxSurfaceError pixels.
-constexpr int kMinSurfaceTrack = 3;
+// (Measured on the Middlebury sets' held-out views at 128 voxels: tracks of 2 or more gave +1.58
+// dB over silhouettes only on average, 3 or more +1.40; the generated scenes gained too.)
+constexpr int kMinSurfaceTrack = 2;
 constexpr double kMaxSurfaceError = 1.0;
 std::vector<SurfacePoint> SurfacePointsOf(const Reconstruction& reconstruction,
                                           const std::vector<CalibratedView>& views,

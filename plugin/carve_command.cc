@@ -331,12 +331,13 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "with --consistency ncc and a numeric --threshold: carve a textured voxel "
                      "when 1 - NCC exceeds this (0-2); with --threshold auto, the fallback");
   parser->AddDefault("threshold", &text->threshold,
-                     "largest consistent error, RGB units 0-255; auto: per level of detail, the "
-                     "--auto_threshold_quantile of the errors of the voxels that hold reliable "
-                     "sparse points (30 where fewer than 20 can be judged)");
+                     "largest consistent error, RGB units 0-255; auto: per level of detail from "
+                     "the reliable sparse points: with masks the --auto_threshold_quantile of "
+                     "their voxels' errors, without masks the weighted equal error against the "
+                     "voxels just in front (30 where fewer than 20 can be judged)");
   parser->AddDefault("auto_threshold_quantile", &request->options.auto_threshold_quantile,
-                     "with --threshold auto: the share of the voxels on sparse points that the "
-                     "threshold keeps");
+                     "with --threshold auto and masks: the share of the voxels on sparse points "
+                     "that the threshold keeps");
   parser->AddDefault("protect_surface_points", &request->options.protect_surface_points,
                      "never carve a voxel holding a reliable sparse point (track of 2 or more "
                      "photos, error <= 1 px) by colour: stops carving that runs away");

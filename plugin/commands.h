@@ -107,13 +107,15 @@ LoadedProject LoadProject(const std::string& command,
 constexpr double kFallbackThreshold = 30.0;
 
 struct CarveRequest {
-  // The command line uses every core, automatic levels of detail and removes specks by default.
+  // The command line uses every core, automatic levels of detail, removes specks, takes the
+  // threshold from the data, keeps known surface and judges with the patch test by default.
   CarveRequest() {
     options.num_threads = -1;
     options.lod_levels = kAutomaticLevels;
     options.min_component_voxels = 8;
     options.auto_threshold = true;
     options.protect_surface_points = true;
+    options.consistency = ConsistencyMethod::kPatchCorrelation;
   }
   std::string workspace_path;
   std::string input_path;

@@ -784,7 +784,9 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     }
     const std::vector<CalibratedView>& level_views = factor > 1 ? reduced_views : views;
     LevelStatistics level_statistics;
-    if (options.auto_threshold) {
+    const bool auto_pattern = options.consistency == ConsistencyMethod::kPatchCorrelation &&
+                              (options.auto_threshold || options.auto_pattern_threshold);
+    if (options.auto_threshold || auto_pattern) {
       level_statistics.estimate = EstimateThreshold(
           level_views, VoxelGrid(box, resolutions[level]), options.surface_points,
           options.consistency, options.min_views,
@@ -794,8 +796,10 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
           level_options.threshold, options.pattern_threshold);
       level_statistics.threshold_from_data =
           level_statistics.estimate.points_judged >= kMinThresholdPoints;
-      level_options.threshold = level_statistics.estimate.threshold;
-      level_options.pattern_threshold = level_statistics.estimate.pattern_threshold;
+      if (options.auto_threshold) level_options.threshold = level_statistics.estimate.threshold;
+      if (auto_pattern) {
+        level_options.pattern_threshold = level_statistics.estimate.pattern_threshold;
+      }
     }
     if (level == 0) {
       carver = std::make_unique<IncrementalCarver>(level_views, box, level_options);
@@ -808,6 +812,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     level_statistics.resolution = resolutions[level];
     level_statistics.image_factor = factor;
     level_statistics.threshold = level_options.threshold;
+    level_statistics.pattern_threshold = level_options.pattern_threshold;
     level_statistics.dimensions = carver->volume().grid().dimensions();
     level_statistics.start_solid = carver->volume().num_solid();
     level_statistics.setup_seconds = SecondsSince(level_start);

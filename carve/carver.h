@@ -146,6 +146,9 @@ struct CarveOptions {
   // pattern_threshold are the fallback where fewer than 20 points can be judged.
   bool auto_threshold = false;
   double auto_threshold_quantile = 0.99;
+  // kPatchCorrelation: choose pattern_threshold from the data as auto_threshold does, also when
+  // `threshold` is given.
+  bool auto_pattern_threshold = false;
   // Voxels holding a surface point are never carved by the consistency test (the visual hull and
   // the removal of small components still carve them): known surface stops carving that runs
   // away through one wrong carve.

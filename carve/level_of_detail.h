@@ -19,6 +19,7 @@ struct LevelStatistics {
   int resolution = 0;
   int image_factor = 1;  // the photos were reduced this many times (CarveOptions::lod_reduce_images)
   double threshold = 0.0;  // the consistency threshold this level judged with
+  double pattern_threshold = 0.0;  // and, with kPatchCorrelation, its pattern threshold
   // CarveOptions::auto_threshold: whether the threshold came from the surface points (false:
   // too few could be judged, and the fallback was used); `estimate` holds what it came from.
   bool threshold_from_data = false;

@@ -168,6 +168,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("threshold").Value(request.options.auto_threshold ? std::string("auto")
                                                               : std::to_string(request.options.threshold))
       .Key("auto_threshold_quantile").Value(request.options.auto_threshold_quantile)
+      .Key("pattern_threshold").Value(request.options.auto_pattern_threshold ? std::string("auto") : std::to_string(request.options.pattern_threshold))
       .Key("protect_surface_points").Value(request.options.protect_surface_points)
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
       .Key("min_views").Value(request.options.min_views)
@@ -248,7 +249,9 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
                                                 static_cast<double>(level.dimensions.z())})
         .Key("image_factor").Value(level.image_factor)
         .Key("threshold").Value(level.threshold);
-    if (request.options.auto_threshold) {
+    const bool patterns = request.options.consistency == ConsistencyMethod::kPatchCorrelation;
+    if (patterns) json.Key("pattern_threshold").Value(level.pattern_threshold);
+    if (request.options.auto_threshold || (patterns && request.options.auto_pattern_threshold)) {
       const ThresholdEstimate& e = level.estimate;
       std::vector<double> surface, front;
       for (int q = 0; q <= 20; ++q) {
@@ -327,9 +330,11 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "standard deviation, or ncc (mean colours, and where the photos see texture "
                      "the normalised cross-correlation of the voxel's patch in every view)",
                      {"mean_colour", "standard_deviation", "ncc"});
-  parser->AddDefault("pattern_threshold", &request->options.pattern_threshold,
-                     "with --consistency ncc and a numeric --threshold: carve a textured voxel "
-                     "when 1 - NCC exceeds this (0-2); with --threshold auto, the fallback");
+  parser->AddDefault("pattern_threshold", &text->pattern_threshold,
+                     "with --consistency ncc: carve a textured voxel when 1 - NCC of its "
+                     "patterns exceeds this (0-2); auto: per level from the sparse points, by "
+                     "--threshold auto's rule, also when --threshold is a number (0.5 where too "
+                     "few can be judged)");
   parser->AddDefault("threshold", &text->threshold,
                      "largest consistent error, RGB units 0-255; auto: per level of detail from "
                      "the reliable sparse points: with masks the --auto_threshold_quantile of "
@@ -405,6 +410,20 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
 }
 
 void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
+  if (text.pattern_threshold == "auto") {
+    request->options.auto_pattern_threshold = true;
+    request->options.pattern_threshold = kFallbackPatternThreshold;
+  } else {
+    char* end = nullptr;
+    const double value = std::strtod(text.pattern_threshold.c_str(), &end);
+    if (text.pattern_threshold.empty() || end == nullptr || *end != '\0' ||
+        !(value >= 0.0 && value <= 2.0)) {
+      throw InputError("--pattern_threshold: must be a number in [0, 2] or auto, got '" +
+                       text.pattern_threshold + "'");
+    }
+    request->options.auto_pattern_threshold = false;
+    request->options.pattern_threshold = value;
+  }
   if (text.threshold == "auto") {
     request->options.auto_threshold = true;
     request->options.threshold = kFallbackThreshold;
@@ -458,8 +477,14 @@ int RunCarve(int argc, char** argv) {
   std::string level_line;
   for (const LevelStatistics& level : s.levels) {
     char text[96];
-    std::snprintf(text, sizeof(text), "%s%d voxels at threshold %.3g", level_line.empty() ? "" : ", ",
-                  level.resolution, level.threshold);
+    if (request.options.consistency == ConsistencyMethod::kPatchCorrelation) {
+      std::snprintf(text, sizeof(text), "%s%d voxels at threshold %.3g, pattern %.2f",
+                    level_line.empty() ? "" : "; ", level.resolution, level.threshold,
+                    level.pattern_threshold);
+    } else {
+      std::snprintf(text, sizeof(text), "%s%d voxels at threshold %.3g",
+                    level_line.empty() ? "" : ", ", level.resolution, level.threshold);
+    }
     level_line += text;
   }
   std::printf(

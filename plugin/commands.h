@@ -105,17 +105,18 @@ LoadedProject LoadProject(const std::string& command,
 // carve: everything `raycarve carve` takes, and what it produced.
 // --threshold auto's threshold where too few sparse points can be judged.
 constexpr double kFallbackThreshold = 30.0;
+// --pattern_threshold auto's where too few textured sparse points can be judged.
+constexpr double kFallbackPatternThreshold = 0.5;
 
 struct CarveRequest {
   // The command line uses every core, automatic levels of detail, removes specks, takes the
-  // threshold from the data, keeps known surface and judges with the patch test by default.
+  // threshold from the data and keeps known surface by default.
   CarveRequest() {
     options.num_threads = -1;
     options.lod_levels = kAutomaticLevels;
     options.min_component_voxels = 8;
     options.auto_threshold = true;
     options.protect_surface_points = true;
-    options.consistency = ConsistencyMethod::kPatchCorrelation;
   }
   std::string workspace_path;
   std::string input_path;
@@ -153,6 +154,7 @@ struct CarveRun {
 // ones as text), ApplyCarveFlags converts and checks them (InputError on bad values).
 struct CarveFlagText {
   std::string threshold = "auto";
+  std::string pattern_threshold = "auto";
   std::string consistency;
   std::string vis_lookup;
   std::string method;

@@ -67,8 +67,13 @@ int RunHoldout(int argc, char** argv) {
   std::string thresholds;
   for (const LevelStatistics& level : result.statistics.levels) {
     char text[64];
-    std::snprintf(text, sizeof(text), "%s%d: %.1f", thresholds.empty() ? "" : ", ",
-                  level.resolution, level.threshold);
+    if (options.consistency == ConsistencyMethod::kPatchCorrelation) {
+      std::snprintf(text, sizeof(text), "%s%d: %.1f / %.2f", thresholds.empty() ? "" : ", ",
+                    level.resolution, level.threshold, level.pattern_threshold);
+    } else {
+      std::snprintf(text, sizeof(text), "%s%d: %.1f", thresholds.empty() ? "" : ", ",
+                    level.resolution, level.threshold);
+    }
     thresholds += text;
     if (options.auto_threshold) LOG(INFO) << level.estimate.Summary();
   }

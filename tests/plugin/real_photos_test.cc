@@ -41,8 +41,8 @@ TEST(RealPhotos, TempleCarvesOntoItsSparsePointsAndRendersItsHeldOutSilhouettes)
   EXPECT_EQ(JsonNumber(report, "masks_from_backdrop"), 16);
 
   // Held-out views at the command's defaults, against the silhouettes alone (nothing carved by
-  // colour): measured PSNR 14.18 against 12.98 dB, silhouette IoU 0.721 against 0.695 over the 4
-  // held-out views (--threshold 60: 14.11 dB, 0.719).
+  // colour): measured PSNR 13.91 against 12.98 dB, silhouette IoU 0.708 against 0.695 over the 4
+  // held-out views (--consistency ncc: 14.18 dB, 0.721).
   auto held_out = [&](const std::string& name, const std::string& flags) {
     std::string output;
     EXPECT_EQ(testing::RunShell(raycarve + "holdout" + input + " --output_path " + root + "/" +
@@ -57,7 +57,7 @@ TEST(RealPhotos, TempleCarvesOntoItsSparsePointsAndRendersItsHeldOutSilhouettes)
       held_out("silhouettes", " --threshold 1000000 --consistency mean_colour");
   EXPECT_GT(JsonNumber(defaults, "mean_silhouette_iou"), 0.66);
   EXPECT_GT(JsonNumber(defaults, "mean_psnr_db"), 13.5);
-  EXPECT_GT(JsonNumber(defaults, "mean_psnr_db"), JsonNumber(silhouettes, "mean_psnr_db") + 0.8);
+  EXPECT_GT(JsonNumber(defaults, "mean_psnr_db"), JsonNumber(silhouettes, "mean_psnr_db") + 0.5);
   EXPECT_GT(JsonNumber(defaults, "mean_silhouette_iou"),
             JsonNumber(silhouettes, "mean_silhouette_iou") - 0.01);
   std::filesystem::remove_all(root);

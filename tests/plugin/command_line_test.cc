@@ -411,6 +411,8 @@ TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
   ExpectUserError(base + " --resolution 0", {"resolution must be in [1, 4096]"});
   ExpectUserError(base + " --resolution 4000 --max_memory_gib 1", {"GiB", "lower the resolution"});
   ExpectUserError(base + " --threshold nan", {"threshold must be a finite number"});
+  ExpectUserError(base + " --threshold auto7", {"--threshold", "auto7"});
+  ExpectUserError(base + " --pattern_threshold 3", {"--pattern_threshold", "[0, 2]", "'3'"});
   ExpectUserError(base + " --consistency median", {"not one of: mean_colour, standard_deviation"});
   ExpectUserError(base + " --method zbuffer", {"not one of: ray, gvc, gvc_ldi"});
 

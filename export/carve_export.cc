@@ -1,8 +1,10 @@
 #include "export/carve_export.h"
 
-#include <filesystem>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+
+#include <glog/logging.h>
 
 #include <pcl/PolygonMesh.h>
 #include <pcl/conversions.h>
@@ -103,6 +105,63 @@ MeshSummary WriteVoxelMeshPly(const CarveResult& result, const std::string& path
   }
   RenameIntoPlace(temporary, path);
   return {vertices.size(), mesh.polygons.size()};
+}
+
+bool ModelMeshOptions::IsValid(std::string* reason) const {
+  if (!(edge_pixels >= 0.0) || !std::isfinite(edge_pixels)) {
+    *reason = "mesh edge length in pixels must be >= 0";
+    return false;
+  }
+  if (smoothing_iterations < 0) {
+    *reason = "mesh smoothing iterations must be >= 0";
+    return false;
+  }
+  if (max_triangles < 0 || (max_triangles > 0 && max_triangles < 4)) {
+    *reason = "mesh face budget must be 0 (none) or at least 4";
+    return false;
+  }
+  if (min_views < 1) {
+    *reason = "mesh colouring needs min_views >= 1";
+    return false;
+  }
+  if (refine_passes < 0) {
+    *reason = "mesh refinement passes must be >= 0";
+    return false;
+  }
+  return true;
+}
+
+ModelMesh MeshCarvedModel(const CarveResult& result,
+                          const std::vector<CalibratedView>& views,
+                          const ModelMeshOptions& options) {
+  std::string reason;
+  CHECK(options.IsValid(&reason)) << reason;
+  const VoxelGrid& grid = result.volume.grid();
+  SurfaceMeshOptions geometry;
+  geometry.smoothing_iterations = options.smoothing_iterations;
+  geometry.max_triangles = options.max_triangles;
+  if (options.edge_pixels > 0.0) {
+    const double pixel = MedianPixelFootprint(views, grid.Box().center());
+    geometry.max_edge_length = std::max(0.25 * grid.voxel_size(), options.edge_pixels * pixel);
+  }
+  ModelMesh model;
+  model.mesh = MeshSolidVoxels(result.volume, geometry, &model.geometry);
+  if (model.mesh.empty()) return model;
+  MeshRefinementOptions refinement;
+  refinement.passes = options.refine_passes;
+  refinement.search_range = grid.voxel_size();
+  refinement.patch_radius = 0.5 * grid.voxel_size();
+  refinement.depth_tolerance = grid.voxel_size();
+  refinement.voxel_size = grid.voxel_size();
+  refinement.min_views = std::max(2, options.min_views);
+  if (refinement.passes > 0) {
+    model.refinement = RefineMeshFromPhotos(views, refinement, &model.mesh);
+  }
+  MeshColouringOptions colouring;
+  colouring.min_views = options.min_views;
+  colouring.depth_tolerance = grid.voxel_size();
+  model.colouring = ColourMeshFromPhotos(views, colouring, &model.mesh, &model.seen_by);
+  return model;
 }
 
 }  // namespace exporter

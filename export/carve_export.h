@@ -4,7 +4,11 @@
 #include <vector>
 
 #include "carve/carver.h"
+#include "calib/calibrated_view.h"
+#include "export/mesh_colouring.h"
+#include "export/mesh_refinement.h"
 #include "export/point_cloud_io.h"
+#include "export/surface_mesh.h"
 
 namespace raycarve {
 namespace exporter {
@@ -26,6 +30,36 @@ struct MeshSummary {
 // voxel no view sees). Written through PCL as binary PLY (vertex x y z red green blue; faces),
 // under a temporary name and renamed. Throws InputError naming the path on failure.
 MeshSummary WriteVoxelMeshPly(const CarveResult& result, const std::string& path);
+
+// What the user takes away: the carved volume as a smooth welded mesh coloured from the photos.
+struct ModelMeshOptions {
+  // Edges are split until none is longer than this many photo pixels (the median over the views
+  // of a pixel's width at the volume's centre), so that colours can carry detail finer than the
+  // iso-surface's spacing (about a voxel). Never finer than a quarter of a voxel. 0: no
+  // splitting, the default: at 2 pixels the Middlebury sets' held-out PSNR fell (dinoRing 20.05
+  // to 19.88 dB, templeSparseRing 15.66 to 15.54) for 5x the triangles and time, because the
+  // geometry's error, not the vertex spacing, limits the colours there.
+  double edge_pixels = 0.0;
+  int64_t max_triangles = 0;      // face budget (0: none)
+  int smoothing_iterations = 20;  // windowed-sinc passes (0: the stair-stepped iso-surface)
+  int min_views = 2;              // vertices seen by fewer photos take their neighbours' colour
+  // Passes of RefineMeshFromPhotos (search +-1 voxel along the normals, patches half a voxel
+  // across) before colouring; 0: the smoothed iso-surface as it is.
+  int refine_passes = 2;
+  bool IsValid(std::string* reason) const;
+};
+struct ModelMesh {
+  TriangleMesh mesh;
+  SurfaceMeshSummary geometry;
+  MeshRefinementSummary refinement;
+  MeshColouringSummary colouring;
+  std::vector<std::vector<uint32_t>> seen_by;  // per vertex, the views (indices) that see it
+};
+// Meshes the result's solid voxels (MeshSolidVoxels) and colours the mesh from `views`
+// (ColourMeshFromPhotos, depth tolerance one voxel).
+ModelMesh MeshCarvedModel(const CarveResult& result,
+                          const std::vector<CalibratedView>& views,
+                          const ModelMeshOptions& options);
 
 }  // namespace exporter
 }  // namespace raycarve

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include <glog/logging.h>
@@ -115,10 +116,29 @@ CarveRun CarveProject(const CarveRequest& request) {
   const std::vector<exporter::ColouredPoint> points = exporter::SurfacePoints(*run.result, request.options.min_views);
   exporter::WritePointCloudPly(points, (out / "cloud.ply").string());
   run.num_cloud_points = points.size();
-  const exporter::MeshSummary mesh =
-      exporter::WriteVoxelMeshPly(*run.result, (out / "mesh.ply").string());
-  run.num_mesh_triangles = mesh.num_triangles;
-  run.stage_seconds.emplace_back("export", SecondsSince(stage));
+  if (request.mesh_kind == "voxels") {
+    const exporter::MeshSummary mesh =
+        exporter::WriteVoxelMeshPly(*run.result, (out / "mesh.ply").string());
+    run.num_mesh_triangles = mesh.num_triangles;
+    run.num_mesh_vertices = mesh.num_vertices;
+    run.stage_seconds.emplace_back("export", SecondsSince(stage));
+  } else {
+    run.stage_seconds.emplace_back("export", SecondsSince(stage));
+    stage = Clock::now();
+    exporter::ModelMesh model = exporter::MeshCarvedModel(*run.result, views, request.mesh);
+    LOG(INFO) << model.geometry.Summary();
+    if (!model.mesh.empty()) {
+      LOG(INFO) << model.refinement.Summary();
+      LOG(INFO) << model.colouring.Summary();
+    }
+    run.mesh_topology = exporter::AnalyseTopology(model.mesh);
+    exporter::WriteMeshPly(model.mesh, (out / "mesh.ply").string());
+    run.num_mesh_triangles = model.mesh.triangles.size();
+    run.num_mesh_vertices = model.mesh.vertices.size();
+    run.mesh_colouring = model.colouring;
+    run.mesh_refinement = model.refinement;
+    run.stage_seconds.emplace_back("mesh", SecondsSince(stage));
+  }
 
   // COLMAP's sparse points lie on the true surface: how far they are from the carved one.
   const Eigen::AlignedBox3d grid_box = run.result->volume.grid().Box();
@@ -297,9 +317,34 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("cloud").Value("cloud.ply")
       .Key("cloud_points").Value(static_cast<uint64_t>(run.num_cloud_points))
       .Key("mesh").Value("mesh.ply")
+      .Key("mesh_kind").Value(request.mesh_kind)
       .Key("mesh_triangles").Value(static_cast<uint64_t>(run.num_mesh_triangles))
+      .Key("mesh_vertices").Value(static_cast<uint64_t>(run.num_mesh_vertices))
       .Key("convergence").Value("convergence.csv")
       .EndObject();
+  if (request.mesh_kind == "smooth") {
+    const exporter::MeshTopology& t = run.mesh_topology;
+    const exporter::MeshColouringSummary& c = run.mesh_colouring;
+    json.Key("mesh").BeginObject()
+        .Key("closed_manifold").Value(t.IsClosedManifold())
+        .Key("components").Value(static_cast<int64_t>(t.components))
+        .Key("boundary_edges").Value(static_cast<int64_t>(t.boundary_edges))
+        .Key("non_manifold_edges").Value(static_cast<int64_t>(t.non_manifold_edges))
+        .Key("non_manifold_vertices").Value(static_cast<int64_t>(t.non_manifold_vertices))
+        .Key("edge_pixels").Value(request.mesh.edge_pixels)
+        .Key("max_faces").Value(static_cast<int64_t>(request.mesh.max_triangles))
+        .Key("smoothing_iterations").Value(request.mesh.smoothing_iterations)
+        .Key("refine_passes").Value(request.mesh.refine_passes)
+        .Key("refinement_vertices_moved").Value(run.mesh_refinement.moved)
+        .Key("refinement_mean_abs_offset_voxels")
+        .Value(run.mesh_refinement.mean_abs_offset / run.result->volume.grid().voxel_size())
+        .Key("vertices_coloured_from_photos").Value(c.from_photos)
+        .Key("vertices_coloured_from_neighbours").Value(c.from_neighbours)
+        .Key("vertices_uncoloured").Value(c.uncoloured)
+        .Key("share_seen").Value(c.SeenShare())
+        .Key("mean_photos_per_vertex").Value(c.mean_views)
+        .EndObject();
+  }
   json.EndObject();
   return json.str();
 }
@@ -406,6 +451,20 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "RGB distance from the backdrop colour beyond which a pixel is object");
   parser->AddDefault("visual_hull", &request->options.visual_hull,
                      "with masks, carve the silhouettes' visual hull before colouring");
+  parser->AddDefault("mesh", &request->mesh_kind,
+                     "mesh.ply: a smooth welded surface coloured from the photos, or the voxels' "
+                     "faces in their mean colours",
+                     {"smooth", "voxels"});
+  parser->AddDefault("mesh_edge_pixels", &request->mesh.edge_pixels,
+                     "smooth mesh: split edges longer than this many photo pixels, so colours "
+                     "keep the photos' detail (0: no splitting)");
+  parser->AddDefault("mesh_max_faces", &request->mesh_max_faces,
+                     "smooth mesh: at most this many triangles, by decimation (0: no budget)");
+  parser->AddDefault("mesh_smoothing_iterations", &request->mesh.smoothing_iterations,
+                     "smooth mesh: windowed-sinc smoothing passes (0: the stair-stepped surface)");
+  parser->AddDefault("mesh_refine_passes", &request->mesh.refine_passes,
+                     "smooth mesh: passes moving vertices along their normals (up to a voxel) to "
+                     "where the photos agree best (0: none)");
   AddBoundsFlags(parser, &request->bounds);
 }
 
@@ -447,6 +506,14 @@ void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
   std::string reason;
   if (!request->view_options.background.IsValid(&reason)) throw InputError(reason);
   if (!request->options.IsValid(&reason)) throw InputError(reason);
+  if (request->mesh_max_faces > static_cast<uint64_t>(std::numeric_limits<int32_t>::max())) {
+    throw InputError("--mesh_max_faces: at most " +
+                     std::to_string(std::numeric_limits<int32_t>::max()) + ", got " +
+                     std::to_string(request->mesh_max_faces));
+  }
+  request->mesh.max_triangles = static_cast<int64_t>(request->mesh_max_faces);
+  request->mesh.min_views = request->options.min_views;
+  if (!request->mesh.IsValid(&reason)) throw InputError("--mesh_*: " + reason);
 }
 
 int RunCarve(int argc, char** argv) {
@@ -456,7 +523,8 @@ int RunCarve(int argc, char** argv) {
       "carve",
       "Carves a coloured voxel model from a COLMAP project by incremental voxel colouring with "
       "ray-cast visibility, and writes cloud.ply (points with normals and colours, laid out like "
-      "COLMAP's fused.ply), mesh.ply (the voxel surface), report.json and convergence.csv.");
+      "COLMAP's fused.ply), mesh.ply (a smooth welded surface coloured from the photos), "
+      "report.json and convergence.csv.");
   AddCarveFlags(&parser, &request, &text);
   if (!parser.Parse(argc, argv)) return 0;
   ApplyCarveFlags(text, &request);
@@ -508,6 +576,18 @@ int RunCarve(int argc, char** argv) {
       static_cast<long long>(s.visible_surface), run.num_cloud_points, request.options.min_views,
       sparse_line.c_str(), run.output_path.c_str(), run.num_cloud_points,
       run.num_mesh_triangles, run.output_path.c_str());
+  if (request.mesh_kind == "smooth" && run.num_mesh_triangles > 0) {
+    const exporter::MeshColouringSummary& c = run.mesh_colouring;
+    std::printf("  mesh            %zu triangles, %zu vertices, %lld component%s, %s;\n"
+                "                  %.1f%% of its vertices coloured from %d+ photos (%.1f each), "
+                "the rest from seen neighbours\n",
+                run.num_mesh_triangles, run.num_mesh_vertices,
+                static_cast<long long>(run.mesh_topology.components),
+                run.mesh_topology.components == 1 ? "" : "s",
+                run.mesh_topology.IsClosedManifold() ? "closed and 2-manifold"
+                                                     : "NOT closed 2-manifold (see report.json)",
+                100.0 * c.SeenShare(), request.mesh.min_views, c.mean_views);
+  }
   return 0;
 }
 

@@ -12,6 +12,7 @@
 #include "calib/reconstruction.h"
 #include "calib/view_reader.h"
 #include "carve/carver.h"
+#include "export/carve_export.h"
 #include "export/point_cloud_compare.h"
 #include "plugin/option_parser.h"
 
@@ -129,6 +130,11 @@ struct CarveRequest {
   bool colour_calibration = false;   // per-photo gains and offsets from the sparse points
   std::string background = "auto";  // as given on the command line, for the report
   double progress_seconds = 2.0;     // between progress lines
+  // mesh.ply: "smooth" (welded, coloured from the photos) or "voxels" (the voxel faces, each
+  // voxel's mean colour).
+  std::string mesh_kind = "smooth";
+  exporter::ModelMeshOptions mesh;
+  uint64_t mesh_max_faces = 0;  // as given; copied into mesh.max_triangles
 };
 
 struct CarveRun {
@@ -145,6 +151,10 @@ struct CarveRun {
   std::vector<std::pair<std::string, double>> stage_seconds;
   size_t num_cloud_points = 0;
   size_t num_mesh_triangles = 0;
+  size_t num_mesh_vertices = 0;
+  exporter::MeshTopology mesh_topology;
+  exporter::MeshColouringSummary mesh_colouring;  // the smooth mesh's (vertices 0 otherwise)
+  exporter::MeshRefinementSummary mesh_refinement;
   // The model's sparse points inside the grid against the cloud (accuracy: their 90% distance).
   bool has_sparse = false;
   exporter::CloudComparison sparse;

@@ -11,6 +11,7 @@
 #include "carve/carver.h"
 #include "export/carve_export.h"
 #include "export/holdout_score.h"
+#include "export/mesh_renderer.h"
 #include "export/point_renderer.h"
 #include "export/volume_renderer.h"
 #include "plugin/commands.h"
@@ -22,7 +23,7 @@ int RunHoldout(int argc, char** argv) {
   CarveRequest request;
   CarveFlagText text;
   int every = 4;
-  std::string render = "volume";
+  std::string render = "mesh";
   OptionParser parser(
       "holdout",
       "Held-out evaluation: carves the project without every k-th view, renders the carved model "
@@ -32,9 +33,10 @@ int RunHoldout(int argc, char** argv) {
   AddCarveFlags(&parser, &request, &text);
   parser.AddDefault("every", &every, "leave out views 1, 1 + k, 1 + 2k, ... (k >= 2)");
   parser.AddDefault("render", &render,
-                    "how the model is drawn: the carved volume (a ray per pixel to the first "
-                    "solid voxel, in its colour) or the cloud's points as square splats",
-                    {"volume", "splats"});
+                    "how the model is drawn: the smooth mesh coloured from the training photos "
+                    "(what carve writes as mesh.ply), the carved volume (a ray per pixel to the "
+                    "first solid voxel, in its colour) or the cloud's points as square splats",
+                    {"mesh", "volume", "splats"});
   if (!parser.Parse(argc, argv)) return 0;
   ApplyCarveFlags(text, &request);
   if (every < 2) throw InputError("raycarve holdout: --every must be at least 2");
@@ -81,6 +83,14 @@ int RunHoldout(int argc, char** argv) {
   const std::vector<exporter::ColouredPoint> points =
       exporter::SurfacePoints(result, request.options.min_views);
   const double point_size = result.volume.grid().voxel_size();
+  exporter::ModelMesh model;
+  if (render == "mesh") {
+    // Coloured from the training views only: the held-out photos never reach the model.
+    model = exporter::MeshCarvedModel(result, training, request.mesh);
+    LOG(INFO) << model.geometry.Summary();
+    if (!model.mesh.empty()) LOG(INFO) << model.refinement.Summary();
+    if (!model.mesh.empty()) LOG(INFO) << model.colouring.Summary();
+  }
 
   const std::filesystem::path out = std::filesystem::path(project.output_path) / "holdout";
   std::error_code error;
@@ -93,6 +103,8 @@ int RunHoldout(int argc, char** argv) {
       .Key("training_views").Value(static_cast<uint64_t>(training.size()))
       .Key("cloud_points").Value(static_cast<uint64_t>(points.size()))
       .Key("render").Value(render)
+      .Key("mesh_triangles").Value(static_cast<uint64_t>(model.mesh.triangles.size()))
+      .Key("mesh_seconds").Value(model.geometry.seconds + model.colouring.seconds)
       .Key("carve").Value(result.statistics.Summary())
       .Key("thresholds").Value(thresholds)
       .Key("surface_points").Value(static_cast<uint64_t>(options.surface_points.size()));
@@ -112,6 +124,8 @@ int RunHoldout(int argc, char** argv) {
       exporter::VolumeRendering drawn = exporter::RenderVolume(result.volume, result.surface, view);
       uncoloured = drawn.uncoloured_pixels;
       rendering = std::move(drawn);
+    } else if (render == "mesh") {
+      rendering = exporter::RenderMesh(model.mesh, view);
     } else {
       rendering = exporter::RenderPoints(points, view, point_size);
     }

@@ -1,0 +1,270 @@
+#include "export/mesh_colouring.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include <glog/logging.h>
+#include <opencv2/imgproc.hpp>
+
+#include "export/mesh_renderer.h"
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+// Below this (RGB units), disagreement between photos is noise and quantisation, not an outlier.
+constexpr double kMinOutlierDistance = 12.0;
+
+struct Sample {
+  Eigen::Vector3f colour;
+  float weight;
+};
+
+// Bilinear sample of an RGB image at a COLMAP pixel position (pixel centres at +0.5); false
+// outside the image's centres.
+bool SampleBilinear(const cv::Mat& image, const Eigen::Vector2d& pixel, Eigen::Vector3f* colour) {
+  const double u = pixel.x() - 0.5, v = pixel.y() - 0.5;
+  if (!(u >= 0.0 && v >= 0.0 && u <= image.cols - 1 && v <= image.rows - 1)) return false;
+  const int c0 = std::min(static_cast<int>(u), image.cols - 2 < 0 ? 0 : image.cols - 2);
+  const int r0 = std::min(static_cast<int>(v), image.rows - 2 < 0 ? 0 : image.rows - 2);
+  const int c1 = std::min(c0 + 1, image.cols - 1), r1 = std::min(r0 + 1, image.rows - 1);
+  const float fu = static_cast<float>(u - c0), fv = static_cast<float>(v - r0);
+  const cv::Vec3b& p00 = image.at<cv::Vec3b>(r0, c0);
+  const cv::Vec3b& p01 = image.at<cv::Vec3b>(r0, c1);
+  const cv::Vec3b& p10 = image.at<cv::Vec3b>(r1, c0);
+  const cv::Vec3b& p11 = image.at<cv::Vec3b>(r1, c1);
+  for (int k = 0; k < 3; ++k) {
+    (*colour)[k] = (1 - fv) * ((1 - fu) * p00[k] + fu * p01[k]) + fv * ((1 - fu) * p10[k] + fu * p11[k]);
+  }
+  return true;
+}
+
+float WeightedMedian(std::vector<std::pair<float, float>>* values) {
+  std::sort(values->begin(), values->end());
+  float total = 0.0f;
+  for (const auto& v : *values) total += v.second;
+  float running = 0.0f;
+  for (const auto& v : *values) {
+    running += v.second;
+    if (running >= 0.5f * total) return v.first;
+  }
+  return values->back().first;
+}
+
+// The weighted mean of the samples without those far from their per-channel median.
+Eigen::Vector3f RobustColour(const std::vector<Sample>& samples, double outlier_factor) {
+  Eigen::Vector3f median;
+  std::vector<std::pair<float, float>> values(samples.size());
+  for (int k = 0; k < 3; ++k) {
+    for (size_t i = 0; i < samples.size(); ++i) values[i] = {samples[i].colour[k], samples[i].weight};
+    median[k] = WeightedMedian(&values);
+  }
+  std::vector<float> distances(samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) distances[i] = (samples[i].colour - median).norm();
+  std::vector<float> sorted = distances;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double limit = std::max(kMinOutlierDistance, outlier_factor * sorted[sorted.size() / 2]);
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  float weight = 0.0f;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (distances[i] > limit) continue;
+    sum += samples[i].weight * samples[i].colour;
+    weight += samples[i].weight;
+  }
+  return weight > 0.0f ? Eigen::Vector3f(sum / weight) : median;
+}
+
+Eigen::Matrix<uint8_t, 3, 1> ToRgb(const Eigen::Vector3f& colour) {
+  Eigen::Matrix<uint8_t, 3, 1> rgb;
+  for (int k = 0; k < 3; ++k) {
+    rgb[k] = static_cast<uint8_t>(std::clamp(std::lround(colour[k]), 0L, 255L));
+  }
+  return rgb;
+}
+
+}  // namespace
+
+bool SamplePhoto(const CalibratedView& view, const Eigen::Vector2d& pixel, Eigen::Vector3f* colour) {
+  const int col = static_cast<int>(std::floor(pixel.x()));
+  const int row = static_cast<int>(std::floor(pixel.y()));
+  if (col < 0 || row < 0 || col >= view.width || row >= view.height) return false;
+  if (view.valid.at<uint8_t>(row, col) == 0) return false;
+  if (!view.mask.empty() && view.mask.at<uint8_t>(row, col) == 0) return false;
+  return SampleBilinear(view.image, pixel, colour);
+}
+
+std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<CalibratedView>& views,
+                                                             const TriangleMesh& mesh,
+                                                             double depth_tolerance,
+                                                             std::vector<uint8_t>* on_rim,
+                                                             double voxel_size,
+                                                             double rim_voxels) {
+  CHECK(mesh.normals.size() == mesh.vertices.size()) << "the mesh needs vertex normals";
+  const size_t n = mesh.vertices.size();
+  std::vector<std::vector<VertexSighting>> sightings(n);
+  if (on_rim != nullptr) on_rim->assign(n, 0);
+  TriangleMesh shape;  // drawn without colours: only the depth is wanted
+  shape.vertices = mesh.vertices;
+  shape.triangles = mesh.triangles;
+  for (size_t v = 0; v < views.size(); ++v) {
+    const CalibratedView& view = views[v];
+    const Rendering drawn = RenderMesh(shape, view);
+    // Distance (pixels) from each object pixel to the nearest background pixel.
+    cv::Mat to_background;
+    if (on_rim != nullptr && !view.mask.empty() && voxel_size > 0.0) {
+      cv::distanceTransform(view.mask, to_background, cv::DIST_L2, 3);
+    }
+    const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d world = mesh.vertices[i].cast<double>();
+      const double depth = view.Depth(world);
+      if (!(depth > 0.0)) continue;
+      const Eigen::Vector2d pixel = view.Project(world);
+      const int col = static_cast<int>(std::floor(pixel.x()));
+      const int row = static_cast<int>(std::floor(pixel.y()));
+      if (col < 0 || row < 0 || col >= view.width || row >= view.height) continue;
+      if (depth > drawn.depth.at<float>(row, col) + depth_tolerance) continue;
+      if (!to_background.empty() && view.mask.at<uint8_t>(row, col) != 0 &&
+          to_background.at<float>(row, col) <= rim_voxels * focal * voxel_size / depth) {
+        (*on_rim)[i] = 1;
+      }
+      const double facing = mesh.normals[i].cast<double>().dot((view.centre - world).normalized());
+      if (!(facing > 0.0)) continue;
+      if (view.valid.at<uint8_t>(row, col) == 0) continue;
+      if (!view.mask.empty() && view.mask.at<uint8_t>(row, col) == 0) continue;
+      sightings[i].push_back({static_cast<uint32_t>(v), static_cast<float>(facing)});
+    }
+  }
+  return sightings;
+}
+
+bool MeshColouringOptions::IsValid(std::string* reason) const {
+  if (min_views < 1) {
+    *reason = "mesh colouring needs min_views >= 1";
+    return false;
+  }
+  if (!(depth_tolerance > 0.0) || !std::isfinite(depth_tolerance)) {
+    *reason = "mesh colouring needs a depth tolerance > 0";
+    return false;
+  }
+  if (!(outlier_factor > 0.0)) {
+    *reason = "mesh colouring needs an outlier factor > 0";
+    return false;
+  }
+  return true;
+}
+
+std::string MeshColouringSummary::Summary() const {
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "mesh colours: %lld of %lld vertices (%.1f%%) from the photos (%.1f photos each), "
+                "%lld from seen neighbours, %lld uncoloured, in %.2f s",
+                static_cast<long long>(from_photos), static_cast<long long>(vertices),
+                100.0 * SeenShare(), mean_views, static_cast<long long>(from_neighbours),
+                static_cast<long long>(uncoloured), seconds);
+  return text;
+}
+
+MeshColouringSummary ColourMeshFromPhotos(const std::vector<CalibratedView>& views,
+                                          const MeshColouringOptions& options,
+                                          TriangleMesh* mesh,
+                                          std::vector<std::vector<uint32_t>>* seen_by) {
+  std::string reason;
+  CHECK(options.IsValid(&reason)) << reason;
+  CHECK(mesh->normals.size() == mesh->vertices.size()) << "the mesh needs vertex normals";
+  const auto start = std::chrono::steady_clock::now();
+  const size_t n = mesh->vertices.size();
+  MeshColouringSummary summary;
+  summary.vertices = static_cast<int64_t>(n);
+  const std::vector<std::vector<VertexSighting>> sightings =
+      FindVertexSightings(views, *mesh, options.depth_tolerance);
+  std::vector<std::vector<Sample>> samples(n);
+  if (seen_by != nullptr) seen_by->assign(n, {});
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d world = mesh->vertices[i].cast<double>();
+    for (const VertexSighting& sighting : sightings[i]) {
+      Eigen::Vector3f colour;
+      if (!SamplePhoto(views[sighting.view], views[sighting.view].Project(world), &colour)) continue;
+      samples[i].push_back({colour, sighting.facing});
+      if (seen_by != nullptr) (*seen_by)[i].push_back(sighting.view);
+    }
+  }
+
+  // Colour from the photos where enough saw the vertex; the rest from coloured neighbours,
+  // ring by ring.
+  std::vector<Eigen::Vector3f> colours(n, Eigen::Vector3f::Zero());
+  std::vector<char> known(n, 0);
+  double views_sum = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    if (static_cast<int>(samples[i].size()) < options.min_views) continue;
+    colours[i] = RobustColour(samples[i], options.outlier_factor);
+    known[i] = 1;
+    ++summary.from_photos;
+    views_sum += samples[i].size();
+  }
+  summary.mean_views = summary.from_photos > 0 ? views_sum / summary.from_photos : 0.0;
+  std::vector<std::vector<int>> neighbours(n);
+  for (const Eigen::Vector3i& t : mesh->triangles) {
+    for (int k = 0; k < 3; ++k) {
+      neighbours[t[k]].push_back(t[(k + 1) % 3]);
+      neighbours[t[k]].push_back(t[(k + 2) % 3]);
+    }
+  }
+  std::vector<int> frontier;
+  for (size_t i = 0; i < n; ++i) {
+    if (!known[i]) frontier.push_back(static_cast<int>(i));
+  }
+  while (!frontier.empty()) {
+    std::vector<std::pair<int, Eigen::Vector3f>> filled;
+    std::vector<int> still;
+    for (int i : frontier) {
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      int count = 0;
+      for (int j : neighbours[i]) {
+        if (!known[j]) continue;
+        sum += colours[j];
+        ++count;
+      }
+      if (count > 0) {
+        filled.emplace_back(i, sum / count);
+      } else {
+        still.push_back(i);
+      }
+    }
+    if (filled.empty()) break;
+    for (const auto& [i, colour] : filled) {
+      colours[i] = colour;
+      known[i] = 1;
+    }
+    summary.from_neighbours += static_cast<int64_t>(filled.size());
+    frontier.swap(still);
+  }
+  mesh->colours.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    if (known[i]) {
+      mesh->colours[i] = ToRgb(colours[i]);
+    } else {
+      mesh->colours[i] = Eigen::Matrix<uint8_t, 3, 1>(128, 128, 128);
+      ++summary.uncoloured;
+    }
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+double MedianPixelFootprint(const std::vector<CalibratedView>& views, const Eigen::Vector3d& point) {
+  std::vector<double> widths;
+  for (const CalibratedView& view : views) {
+    const double depth = view.Depth(point);
+    const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
+    if (depth > 0.0 && focal > 0.0) widths.push_back(depth / focal);
+  }
+  if (widths.empty()) return 0.0;
+  std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
+  return widths[widths.size() / 2];
+}
+
+}  // namespace exporter
+}  // namespace raycarve

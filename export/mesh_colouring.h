@@ -1,0 +1,78 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "calib/calibrated_view.h"
+#include "export/surface_mesh.h"
+
+namespace raycarve {
+namespace exporter {
+
+struct MeshColouringOptions {
+  // Vertices seen by fewer photos than this take the colour of their seen neighbours instead.
+  int min_views = 2;
+  // A vertex is seen in a photo when it faces the camera, projects onto a valid (and, with a
+  // mask, object) pixel, and lies at most this far (world units) behind the mesh's own depth at
+  // that pixel. Must be > 0; a voxel's size is the natural scale.
+  double depth_tolerance = 0.0;
+  // Samples further than this many times the median distance from the samples' median colour
+  // (at least kMinOutlierDistance RGB units) are left out: a highlight, an occluder the model
+  // does not hold, a photo whose pose is off.
+  double outlier_factor = 2.5;
+
+  bool IsValid(std::string* reason) const;
+};
+
+struct MeshColouringSummary {
+  int64_t vertices = 0;
+  int64_t from_photos = 0;      // seen by min_views or more photos
+  int64_t from_neighbours = 0;  // seen by fewer: the mean of their coloured neighbours
+  int64_t uncoloured = 0;       // no coloured vertex connects to them: grey 128
+  double mean_views = 0.0;      // photos per vertex coloured from photos
+  double seconds = 0.0;
+  double SeenShare() const { return vertices > 0 ? static_cast<double>(from_photos) / vertices : 0.0; }
+  std::string Summary() const;
+};
+
+// One view that sees a vertex: it faces the camera (the cosine between its normal and the ray to
+// the camera is `facing` > 0), projects onto a valid (and, with a mask, object) pixel, and lies at
+// most `depth_tolerance` behind the mesh's own depth there (RenderMesh's depth buffer).
+struct VertexSighting {
+  uint32_t view = 0;
+  float facing = 0.0f;
+};
+// Per vertex, the views that see it, in increasing view order. Needs mesh.normals.
+// `on_rim`, when given, gets per vertex whether it lies on a silhouette's rim: in some view with
+// a mask it is not hidden (at most depth_tolerance behind the mesh's depth, facing or not) and
+// projects onto an object pixel within `rim_voxels` voxel widths (`voxel_size`, projected at
+// its depth) of the background.
+std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<CalibratedView>& views,
+                                                             const TriangleMesh& mesh,
+                                                             double depth_tolerance,
+                                                             std::vector<uint8_t>* on_rim = nullptr,
+                                                             double voxel_size = 0.0,
+                                                             double rim_voxels = 1.0);
+
+// The colour of `view`'s photo at a COLMAP pixel position, bilinear between pixel centres; false
+// where the position is outside the photo's data (invalid pixels) or, with a mask, off the object.
+bool SamplePhoto(const CalibratedView& view, const Eigen::Vector2d& pixel, Eigen::Vector3f* colour);
+
+// Colours every vertex of `mesh` from the photos at their own resolution: in each view the mesh
+// is drawn with a depth buffer (RenderMesh) to find the vertices the view sees; each seen vertex
+// takes a sample (bilinear, at its projection) weighted by the cosine between its normal and the
+// ray to the camera; the vertex's colour is the weighted mean of its samples without outliers.
+// Needs mesh->normals. `seen_by`, when given, gets per vertex the indices (into `views`) of the
+// views that see it, in increasing order.
+MeshColouringSummary ColourMeshFromPhotos(const std::vector<CalibratedView>& views,
+                                          const MeshColouringOptions& options,
+                                          TriangleMesh* mesh,
+                                          std::vector<std::vector<uint32_t>>* seen_by = nullptr);
+
+// The median over the views of the width, in world units, that one pixel covers at `point`
+// (depth / focal length): the scale of the photos' own detail there. 0 without views.
+double MedianPixelFootprint(const std::vector<CalibratedView>& views, const Eigen::Vector3d& point);
+
+}  // namespace exporter
+}  // namespace raycarve

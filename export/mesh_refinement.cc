@@ -1,0 +1,188 @@
+#include "export/mesh_refinement.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include <glog/logging.h>
+
+#include "export/mesh_colouring.h"
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+constexpr int kPatchSamples = 5;
+
+// Two unit vectors spanning the plane normal to `n`.
+void TangentBasis(const Eigen::Vector3d& n, Eigen::Vector3d* u, Eigen::Vector3d* w) {
+  const Eigen::Vector3d helper =
+      std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  *u = n.cross(helper).normalized();
+  *w = n.cross(*u);
+}
+
+}  // namespace
+
+bool MeshRefinementOptions::IsValid(std::string* reason) const {
+  if (passes < 0) {
+    *reason = "mesh refinement passes must be >= 0";
+    return false;
+  }
+  if (!(search_range > 0.0) || !(patch_radius > 0.0) || !(depth_tolerance > 0.0) ||
+      !(voxel_size > 0.0)) {
+    *reason = "mesh refinement needs a search range, patch radius and depth tolerance > 0";
+    return false;
+  }
+  if (steps_per_side < 1 || min_views < 2 || smoothing_passes < 0) {
+    *reason = "mesh refinement needs steps_per_side >= 1, min_views >= 2, smoothing_passes >= 0";
+    return false;
+  }
+  if (!(min_gain > 0.0 && min_gain <= 1.0)) {
+    *reason = "mesh refinement min_gain must lie in (0, 1]";
+    return false;
+  }
+  return true;
+}
+
+std::string MeshRefinementSummary::Summary() const {
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "mesh refinement: %lld of %lld vertices judged, %lld moved; mean offset %.3g "
+                "(|%.3g|) along the normals, in %.2f s",
+                static_cast<long long>(judged), static_cast<long long>(vertices),
+                static_cast<long long>(moved), mean_offset, mean_abs_offset, seconds);
+  return text;
+}
+
+MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& views,
+                                           const MeshRefinementOptions& options,
+                                           TriangleMesh* mesh) {
+  std::string reason;
+  CHECK(options.IsValid(&reason)) << reason;
+  const auto start = std::chrono::steady_clock::now();
+  const size_t n = mesh->vertices.size();
+  MeshRefinementSummary summary;
+  summary.vertices = static_cast<int64_t>(n);
+  if (mesh->normals.size() != n) ComputeVertexNormals(mesh);
+  std::vector<std::vector<int>> neighbours(n);
+  for (const Eigen::Vector3i& t : mesh->triangles) {
+    for (int k = 0; k < 3; ++k) {
+      neighbours[t[k]].push_back(t[(k + 1) % 3]);
+      neighbours[t[k]].push_back(t[(k + 2) % 3]);
+    }
+  }
+  const int steps = 2 * options.steps_per_side + 1;
+  const double step = options.search_range / options.steps_per_side;
+  double offset_sum = 0.0, abs_offset_sum = 0.0;
+  for (int pass = 0; pass < options.passes; ++pass) {
+    std::vector<uint8_t> on_rim;
+    const std::vector<std::vector<VertexSighting>> sightings = FindVertexSightings(
+        views, *mesh, options.depth_tolerance, &on_rim, options.voxel_size, 1.0);
+    std::vector<float> offsets(n, 0.0f);
+    summary.judged = summary.moved = 0;
+    std::vector<Eigen::Vector3f> patch(static_cast<size_t>(kPatchSamples) * views.size());
+    for (size_t i = 0; i < n; ++i) {
+      const std::vector<VertexSighting>& seen = sightings[i];
+      if (static_cast<int>(seen.size()) < options.min_views) continue;
+      ++summary.judged;
+      const Eigen::Vector3d centre = mesh->vertices[i].cast<double>();
+      const Eigen::Vector3d normal = mesh->normals[i].cast<double>();
+      Eigen::Vector3d u, w;
+      TangentBasis(normal, &u, &w);
+      const Eigen::Vector3d around[kPatchSamples] = {
+          Eigen::Vector3d::Zero(), options.patch_radius * u, -options.patch_radius * u,
+          options.patch_radius * w, -options.patch_radius * w};
+      double best_cost = std::numeric_limits<double>::infinity(), stay_cost = best_cost;
+      int best = options.steps_per_side;
+      // A silhouette's rim holds the surface where the mask says: no moving inwards there.
+      const int first_step = on_rim[i] ? options.steps_per_side : 0;
+      for (int s = first_step; s < steps; ++s) {
+        const double t = (s - options.steps_per_side) * step;
+        const Eigen::Vector3d point = centre + t * normal;
+        // Sample the patch in every view that sees the vertex; a view whose patch leaves its
+        // photo's data (or the object's mask) says the offset is wrong.
+        int views_used = 0;
+        bool outside = false;
+        Eigen::Matrix<float, 3, kPatchSamples> mean = Eigen::Matrix<float, 3, kPatchSamples>::Zero();
+        for (const VertexSighting& sighting : seen) {
+          const CalibratedView& view = views[sighting.view];
+          for (int k = 0; k < kPatchSamples && !outside; ++k) {
+            Eigen::Vector3f colour;
+            if (!SamplePhoto(view, view.Project(point + around[k]), &colour)) {
+              outside = k == 0;  // only the centre must stay on the object
+              colour = Eigen::Vector3f::Constant(-1.0f);
+            }
+            patch[views_used * kPatchSamples + k] = colour;
+          }
+          if (outside) break;
+          ++views_used;
+        }
+        if (outside) continue;
+        // Mean over the patch samples that every view has, then the spread about it.
+        double cost = 0.0;
+        int terms = 0;
+        for (int k = 0; k < kPatchSamples; ++k) {
+          Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+          int count = 0;
+          bool complete = true;
+          for (int v = 0; v < views_used; ++v) {
+            const Eigen::Vector3f& c = patch[v * kPatchSamples + k];
+            if (c.x() < 0.0f) {
+              complete = false;
+              break;
+            }
+            sum += c;
+            ++count;
+          }
+          if (!complete || count < 2) continue;
+          mean.col(k) = sum / count;
+          for (int v = 0; v < views_used; ++v) {
+            cost += (patch[v * kPatchSamples + k] - mean.col(k)).squaredNorm();
+            ++terms;
+          }
+        }
+        if (terms == 0) continue;
+        cost /= terms;
+        if (s == options.steps_per_side) stay_cost = cost;
+        if (cost < best_cost) {
+          best_cost = cost;
+          best = s;
+        }
+      }
+      if (best != options.steps_per_side && std::isfinite(stay_cost) &&
+          best_cost < options.min_gain * stay_cost) {
+        offsets[i] = static_cast<float>((best - options.steps_per_side) * step);
+        ++summary.moved;
+      } else if (!std::isfinite(stay_cost) && std::isfinite(best_cost)) {
+        // Staying puts the vertex off the object in a photo that sees it: take the best.
+        offsets[i] = static_cast<float>((best - options.steps_per_side) * step);
+        ++summary.moved;
+      }
+    }
+    for (int s = 0; s < options.smoothing_passes; ++s) {
+      std::vector<float> smoothed(n);
+      for (size_t i = 0; i < n; ++i) {
+        double sum = offsets[i];
+        for (int j : neighbours[i]) sum += offsets[j];
+        smoothed[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
+      }
+      offsets.swap(smoothed);
+    }
+    for (size_t i = 0; i < n; ++i) {
+      mesh->vertices[i] += offsets[i] * mesh->normals[i];
+      offset_sum += offsets[i];
+      abs_offset_sum += std::abs(offsets[i]);
+    }
+    ComputeVertexNormals(mesh);
+  }
+  if (options.passes > 0 && n > 0) {
+    summary.mean_offset = offset_sum / (static_cast<double>(n) * options.passes);
+    summary.mean_abs_offset = abs_offset_sum / (static_cast<double>(n) * options.passes);
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace exporter
+}  // namespace raycarve

@@ -1,0 +1,53 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "calib/calibrated_view.h"
+#include "export/surface_mesh.h"
+
+namespace raycarve {
+namespace exporter {
+
+// Moves a mesh's vertices along their normals to where the photos agree best.
+//
+// Voxel colouring keeps every voxel whose photos agree to within the threshold, so its surface
+// lies up to a voxel or so outside the true one (in front of it as the photos see it), and the
+// iso-surface adds half a voxel more. Each pass: every vertex that two or more photos see (as
+// FindVertexSightings says) tries offsets along its normal within +-search_range, and at each it
+// compares small patches (the point and 4 points around it on the tangent plane) across those
+// photos: the cost is the mean over photos and patch samples of the squared RGB distance to the
+// photos' mean. The vertex's offset is the cheapest one where that is clearly better than staying
+// (below `min_gain` x the cost of staying), else 0; offsets are then averaged over each vertex's
+// neighbours (smoothing passes) before the vertices move, and normals are recomputed.
+struct MeshRefinementOptions {
+  int passes = 2;                   // search and move passes
+  double search_range = 0.0;        // world units either side; must be > 0 (about a voxel)
+  int steps_per_side = 4;           // offsets tried on each side of 0
+  double patch_radius = 0.0;        // world units from the centre to the 4 tangent samples (> 0)
+  double depth_tolerance = 0.0;     // for FindVertexSightings (> 0)
+  double voxel_size = 0.0;          // vertices within a voxel of a mask's edge only move out (> 0)
+  int min_views = 2;                // photos needed to judge a vertex
+  double min_gain = 0.8;            // an offset must cost below this share of staying
+  int smoothing_passes = 3;         // neighbour averaging of the offsets
+
+  bool IsValid(std::string* reason) const;
+};
+
+struct MeshRefinementSummary {
+  int64_t vertices = 0;
+  int64_t judged = 0;     // seen by min_views photos, in the last pass
+  int64_t moved = 0;      // given a non-zero offset before smoothing, in the last pass
+  double mean_offset = 0.0;  // signed, along the normal (negative: inwards), over all passes
+  double mean_abs_offset = 0.0;
+  double seconds = 0.0;
+  std::string Summary() const;
+};
+
+MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& views,
+                                           const MeshRefinementOptions& options,
+                                           TriangleMesh* mesh);
+
+}  // namespace exporter
+}  // namespace raycarve

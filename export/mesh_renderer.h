@@ -1,0 +1,19 @@
+#pragma once
+
+#include "calib/calibrated_view.h"
+#include "export/point_renderer.h"
+#include "export/surface_mesh.h"
+
+namespace raycarve {
+namespace exporter {
+
+// Draws a triangle mesh into one view's pinhole camera (K, cam_from_world, size; its pixels are
+// not used) with a depth buffer: a pixel is covered when its centre (COLMAP convention) lies in
+// a triangle's projection, takes the depth of the nearest such triangle along the optical axis,
+// and the perspective-correct blend of its vertices' colours (grey 128 where the mesh has none).
+// Triangles with a vertex at or behind the camera plane are skipped. Both sides are drawn, so a
+// mesh's inside never shows through a hole. Cost: the triangles' projected area.
+Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view);
+
+}  // namespace exporter
+}  // namespace raycarve

@@ -1,0 +1,378 @@
+#include "export/surface_mesh.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <numeric>
+#include <unordered_map>
+
+#include <pcl/PolygonMesh.h>
+#include <pcl/conversions.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <vtkAdaptiveSubdivisionFilter.h>
+#include <vtkCellArray.h>
+#include <vtkDataArray.h>
+#include <vtkDecimatePro.h>
+#include <vtkFlyingEdges3D.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataNormals.h>
+#include <vtkSmartPointer.h>
+#include <vtkWindowedSincPolyDataFilter.h>
+
+#include "calib/atomic_file.h"
+#include "calib/input_error.h"
+
+// A mesh vertex as the PLY holds it: position, normal, colour (PCL packs red, green and blue into
+// one float field named rgb and writes them as three uchar properties).
+struct EIGEN_ALIGN16 MeshVertex {
+  PCL_ADD_POINT4D;
+  PCL_ADD_NORMAL4D;
+  PCL_ADD_RGB;
+  PCL_MAKE_ALIGNED_OPERATOR_NEW
+};
+POINT_CLOUD_REGISTER_POINT_STRUCT(MeshVertex,
+                                  (float, x, x)(float, y, y)(float, z, z)
+                                  (float, normal_x, normal_x)(float, normal_y, normal_y)
+                                  (float, normal_z, normal_z)(float, rgb, rgb))
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+TriangleMesh FromPolyData(vtkPolyData* poly) {
+  TriangleMesh mesh;
+  vtkPoints* points = poly->GetPoints();
+  const vtkIdType num_points = points == nullptr ? 0 : points->GetNumberOfPoints();
+  mesh.vertices.resize(num_points);
+  for (vtkIdType i = 0; i < num_points; ++i) {
+    double p[3];
+    points->GetPoint(i, p);
+    mesh.vertices[i] = Eigen::Vector3f(static_cast<float>(p[0]), static_cast<float>(p[1]),
+                                       static_cast<float>(p[2]));
+  }
+  vtkDataArray* normals = poly->GetPointData()->GetNormals();
+  if (normals != nullptr && normals->GetNumberOfTuples() == num_points) {
+    mesh.normals.resize(num_points);
+    for (vtkIdType i = 0; i < num_points; ++i) {
+      double n[3];
+      normals->GetTuple(i, n);
+      mesh.normals[i] = Eigen::Vector3d(n[0], n[1], n[2]).normalized().cast<float>();
+    }
+  }
+  vtkCellArray* polys = poly->GetPolys();
+  mesh.triangles.reserve(polys->GetNumberOfCells());
+  vtkIdType count = 0;
+  const vtkIdType* ids = nullptr;
+  for (polys->InitTraversal(); polys->GetNextCell(count, ids);) {
+    if (count != 3) continue;  // flying edges and the filters after it make triangles only
+    mesh.triangles.emplace_back(static_cast<int>(ids[0]), static_cast<int>(ids[1]),
+                                static_cast<int>(ids[2]));
+  }
+  return mesh;
+}
+
+}  // namespace
+
+bool SurfaceMeshOptions::IsValid(std::string* reason) const {
+  if (smoothing_iterations < 0) {
+    *reason = "mesh smoothing iterations must be >= 0";
+    return false;
+  }
+  if (!(smoothing_pass_band > 0.0 && smoothing_pass_band <= 2.0)) {
+    *reason = "mesh smoothing pass band must lie in (0, 2]";
+    return false;
+  }
+  if (!(max_edge_length >= 0.0) || !std::isfinite(max_edge_length)) {
+    *reason = "mesh maximum edge length must be >= 0";
+    return false;
+  }
+  if (max_triangles < 0 || (max_triangles > 0 && max_triangles < 4)) {
+    *reason = "mesh face budget must be 0 (none) or at least 4";
+    return false;
+  }
+  return true;
+}
+
+std::string SurfaceMeshSummary::Summary() const {
+  char text[200];
+  std::snprintf(text, sizeof(text), "mesh: %lld triangles, %lld vertices (iso-surface %lld) in %.2f s",
+                static_cast<long long>(triangles), static_cast<long long>(vertices),
+                static_cast<long long>(iso_surface_triangles), seconds);
+  return text;
+}
+
+TriangleMesh MeshSolidVoxels(const Volume& volume,
+                             const SurfaceMeshOptions& options,
+                             SurfaceMeshSummary* summary) {
+  const auto start = std::chrono::steady_clock::now();
+  SurfaceMeshSummary local;
+  SurfaceMeshSummary& result = summary != nullptr ? *summary : local;
+  result = SurfaceMeshSummary();
+  const VoxelGrid& grid = volume.grid();
+  const Eigen::Vector3i dims = grid.dimensions();
+  // One voxel of empty space all round, so that the surface closes at the grid's border.
+  const Eigen::Vector3i padded = dims + Eigen::Vector3i::Constant(2);
+  const double size = grid.voxel_size();
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(padded.x(), padded.y(), padded.z());
+  image->SetSpacing(size, size, size);
+  const Eigen::Vector3d first = grid.Centre(Eigen::Vector3i(-1, -1, -1));
+  image->SetOrigin(first.x(), first.y(), first.z());
+  image->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  auto* occupancy = static_cast<unsigned char*>(image->GetScalarPointer());
+  std::fill(occupancy, occupancy + static_cast<int64_t>(padded.x()) * padded.y() * padded.z(), 0);
+  int64_t solid = 0;
+  for (int z = 0; z < dims.z(); ++z) {
+    for (int y = 0; y < dims.y(); ++y) {
+      for (int x = 0; x < dims.x(); ++x) {
+        if (!volume.IsSolid(grid.Index(Eigen::Vector3i(x, y, z)))) continue;
+        occupancy[(x + 1) + static_cast<int64_t>(padded.x()) *
+                                ((y + 1) + static_cast<int64_t>(padded.y()) * (z + 1))] = 1;
+        ++solid;
+      }
+    }
+  }
+  if (solid == 0) {
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return TriangleMesh();
+  }
+
+  vtkNew<vtkFlyingEdges3D> contour;
+  contour->SetInputData(image);
+  contour->SetValue(0, 0.5);
+  contour->ComputeNormalsOff();
+  contour->ComputeGradientsOff();
+  contour->ComputeScalarsOff();
+  contour->Update();
+  vtkSmartPointer<vtkPolyData> surface = contour->GetOutput();
+  result.iso_surface_triangles = surface->GetNumberOfPolys();
+
+  if (options.smoothing_iterations > 0) {
+    vtkNew<vtkWindowedSincPolyDataFilter> smoother;
+    smoother->SetInputData(surface);
+    smoother->SetNumberOfIterations(options.smoothing_iterations);
+    smoother->SetPassBand(options.smoothing_pass_band);
+    smoother->BoundarySmoothingOff();
+    smoother->FeatureEdgeSmoothingOff();
+    smoother->NonManifoldSmoothingOn();
+    smoother->NormalizeCoordinatesOn();
+    smoother->Update();
+    surface = smoother->GetOutput();
+  }
+
+  if (options.max_edge_length > 0.0) {
+    // Each split at least halves an edge; estimate the triangles it would make from the mean
+    // edge length, and split only as far as the budget allows.
+    double edge_sum = 0.0;
+    int64_t edge_count = 0;
+    vtkCellArray* polys = surface->GetPolys();
+    vtkIdType count = 0;
+    const vtkIdType* ids = nullptr;
+    for (polys->InitTraversal(); polys->GetNextCell(count, ids);) {
+      for (vtkIdType k = 0; k < count; ++k) {
+        double a[3], b[3];
+        surface->GetPoint(ids[k], a);
+        surface->GetPoint(ids[(k + 1) % count], b);
+        edge_sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                              (a[2] - b[2]) * (a[2] - b[2]));
+        ++edge_count;
+      }
+    }
+    double edge = options.max_edge_length;
+    if (options.max_triangles > 0 && edge_count > 0) {
+      const double mean_edge = edge_sum / edge_count;
+      const double growth = static_cast<double>(options.max_triangles) /
+                            std::max<int64_t>(1, surface->GetNumberOfPolys());
+      // Triangles grow with (mean edge / max edge)^2.
+      edge = std::max(edge, mean_edge / std::sqrt(std::max(growth, 1.0)));
+    }
+    vtkNew<vtkAdaptiveSubdivisionFilter> splitter;
+    splitter->SetInputData(surface);
+    splitter->SetMaximumEdgeLength(edge);
+    splitter->Update();
+    surface = splitter->GetOutput();
+  }
+
+  if (options.max_triangles > 0 && surface->GetNumberOfPolys() > options.max_triangles) {
+    vtkNew<vtkDecimatePro> decimate;
+    decimate->SetInputData(surface);
+    decimate->SetTargetReduction(1.0 - static_cast<double>(options.max_triangles) /
+                                           surface->GetNumberOfPolys());
+    decimate->PreserveTopologyOn();
+    decimate->SplittingOff();
+    decimate->BoundaryVertexDeletionOff();
+    decimate->Update();
+    surface = decimate->GetOutput();
+  }
+
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(surface);
+  normals->SplittingOff();
+  normals->ConsistencyOn();
+  normals->AutoOrientNormalsOn();
+  normals->ComputePointNormalsOn();
+  normals->ComputeCellNormalsOff();
+  normals->Update();
+  TriangleMesh mesh = FromPolyData(normals->GetOutput());
+  result.triangles = static_cast<int64_t>(mesh.triangles.size());
+  result.vertices = static_cast<int64_t>(mesh.vertices.size());
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return mesh;
+}
+
+void ComputeVertexNormals(TriangleMesh* mesh) {
+  std::vector<Eigen::Vector3d> sums(mesh->vertices.size(), Eigen::Vector3d::Zero());
+  for (const Eigen::Vector3i& t : mesh->triangles) {
+    const Eigen::Vector3d a = mesh->vertices[t[0]].cast<double>();
+    const Eigen::Vector3d b = mesh->vertices[t[1]].cast<double>();
+    const Eigen::Vector3d c = mesh->vertices[t[2]].cast<double>();
+    const Eigen::Vector3d area_normal = (b - a).cross(c - a);  // twice the area, along the normal
+    for (int k = 0; k < 3; ++k) sums[t[k]] += area_normal;
+  }
+  mesh->normals.resize(mesh->vertices.size());
+  for (size_t i = 0; i < sums.size(); ++i) {
+    const double norm = sums[i].norm();
+    mesh->normals[i] = norm > 0.0 ? Eigen::Vector3f((sums[i] / norm).cast<float>()) : Eigen::Vector3f::Zero();
+  }
+}
+
+MeshTopology AnalyseTopology(const TriangleMesh& mesh) {
+  MeshTopology topology;
+  const int num_vertices = static_cast<int>(mesh.vertices.size());
+  // Directed edges: key (min, max); count of uses and the balance of their directions.
+  struct EdgeUse {
+    int count = 0;
+    int forward = 0;  // uses running min -> max
+  };
+  std::unordered_map<uint64_t, EdgeUse> edges;
+  edges.reserve(mesh.triangles.size() * 2);
+  std::vector<int> parent(num_vertices);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&parent](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  std::vector<bool> used(num_vertices, false);
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+      ++topology.degenerate_triangles;
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      const uint64_t key = (static_cast<uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+      EdgeUse& use = edges[key];
+      ++use.count;
+      if (a < b) ++use.forward;
+      used[a] = true;
+      parent[find(a)] = find(b);
+    }
+  }
+  topology.edges = static_cast<int64_t>(edges.size());
+  for (const auto& [key, use] : edges) {
+    if (use.count == 1) ++topology.boundary_edges;
+    if (use.count > 2) ++topology.non_manifold_edges;
+    if (use.count == 2 && use.forward != 1) ++topology.inconsistent_edges;
+  }
+  for (int v = 0; v < num_vertices; ++v) {
+    if (used[v] && find(v) == v) ++topology.components;
+  }
+  // Fans: around each vertex, its triangles joined through the edges they share at it.
+  std::vector<std::vector<int>> around(num_vertices);
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const Eigen::Vector3i& t = mesh.triangles[i];
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    for (int k = 0; k < 3; ++k) around[t[k]].push_back(static_cast<int>(i));
+  }
+  for (int v = 0; v < num_vertices; ++v) {
+    const std::vector<int>& fan = around[v];
+    if (fan.size() < 2) continue;
+    // Union the triangles at v that share another vertex (the edge v-w).
+    std::vector<int> group(fan.size());
+    std::iota(group.begin(), group.end(), 0);
+    auto root = [&group](int i) {
+      while (group[i] != i) i = group[i] = group[group[i]];
+      return i;
+    };
+    std::unordered_map<int, int> first_with;  // other vertex -> a triangle index in fan
+    for (size_t i = 0; i < fan.size(); ++i) {
+      const Eigen::Vector3i& t = mesh.triangles[fan[i]];
+      for (int k = 0; k < 3; ++k) {
+        if (t[k] == v) continue;
+        auto [it, inserted] = first_with.emplace(t[k], static_cast<int>(i));
+        if (!inserted) group[root(static_cast<int>(i))] = root(it->second);
+      }
+    }
+    int roots = 0;
+    for (size_t i = 0; i < fan.size(); ++i) {
+      if (root(static_cast<int>(i)) == static_cast<int>(i)) ++roots;
+    }
+    if (roots > 1) ++topology.non_manifold_vertices;
+  }
+  return topology;
+}
+
+void WriteMeshPly(const TriangleMesh& mesh, const std::string& path) {
+  const std::string temporary = TemporaryPathFor(path);
+  if (mesh.triangles.empty()) {
+    // PCL refuses to write a mesh without vertices; an empty carve still gets a valid PLY with
+    // the same elements and properties.
+    std::ofstream file(temporary, std::ios::binary);
+    file << "ply\nformat binary_little_endian 1.0\ncomment raycarve: empty mesh\nelement vertex 0\n"
+            "property float x\nproperty float y\nproperty float z\nproperty float nx\n"
+            "property float ny\nproperty float nz\nproperty uchar red\nproperty uchar green\n"
+            "property uchar blue\nelement face 0\nproperty list uchar int vertex_indices\n"
+            "end_header\n";
+    if (!file) throw InputError(temporary + ": cannot write the mesh");
+    file.close();
+    RenameIntoPlace(temporary, path);
+    return;
+  }
+  pcl::PointCloud<MeshVertex> vertices;
+  vertices.reserve(mesh.vertices.size());
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    MeshVertex v;
+    v.x = mesh.vertices[i].x();
+    v.y = mesh.vertices[i].y();
+    v.z = mesh.vertices[i].z();
+    const Eigen::Vector3f n = i < mesh.normals.size() ? mesh.normals[i] : Eigen::Vector3f::Zero();
+    v.normal_x = n.x();
+    v.normal_y = n.y();
+    v.normal_z = n.z();
+    if (i < mesh.colours.size()) {
+      v.r = mesh.colours[i][0];
+      v.g = mesh.colours[i][1];
+      v.b = mesh.colours[i][2];
+    } else {
+      v.r = v.g = v.b = 128;
+    }
+    v.a = 255;
+    vertices.push_back(v);
+  }
+  vertices.width = static_cast<uint32_t>(vertices.size());
+  vertices.height = 1;
+  pcl::PolygonMesh polygon_mesh;
+  pcl::toPCLPointCloud2(vertices, polygon_mesh.cloud);
+  polygon_mesh.polygons.reserve(mesh.triangles.size());
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    pcl::Vertices face;
+    face.vertices = {static_cast<pcl::index_t>(t[0]), static_cast<pcl::index_t>(t[1]),
+                     static_cast<pcl::index_t>(t[2])};
+    polygon_mesh.polygons.push_back(face);
+  }
+  if (pcl::io::savePLYFileBinary(temporary, polygon_mesh) != 0) {
+    throw InputError(temporary + ": PCL could not write the mesh");
+  }
+  RenameIntoPlace(temporary, path);
+}
+
+}  // namespace exporter
+}  // namespace raycarve

@@ -1,0 +1,88 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "carve/volume.h"
+
+namespace raycarve {
+namespace exporter {
+
+// A welded triangle mesh: each vertex is stored once and shared by the triangles around it.
+// World coordinates of the model.
+struct TriangleMesh {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<Eigen::Vector3f> normals;                  // unit, outward; one per vertex
+  std::vector<Eigen::Matrix<uint8_t, 3, 1>> colours;     // RGB per vertex; empty until coloured
+  std::vector<Eigen::Vector3i> triangles;                // counter-clockwise seen from outside
+
+  bool empty() const { return triangles.empty(); }
+};
+
+// How the carved volume becomes a smooth surface.
+struct SurfaceMeshOptions {
+  // Windowed-sinc smoothing of the iso-surface (VTK's vtkWindowedSincPolyDataFilter): passes,
+  // and the pass band (0-2; smaller smooths more). The iso-surface of solid/empty voxels is
+  // stair-stepped at the voxel size; smoothing takes the steps off without shrinking it.
+  int smoothing_iterations = 20;
+  double smoothing_pass_band = 0.05;
+  // Edges longer than this (world units) are split until none is (0: none split), so that
+  // vertex colours can carry detail finer than a voxel.
+  double max_edge_length = 0.0;
+  // At most this many triangles (0: no budget): the mesh is decimated with its topology kept
+  // (VTK's vtkDecimatePro), and edges are split only as far as the budget allows.
+  int64_t max_triangles = 0;
+
+  bool IsValid(std::string* reason) const;
+};
+
+struct SurfaceMeshSummary {
+  int64_t iso_surface_triangles = 0;  // before splitting and decimation
+  int64_t triangles = 0;
+  int64_t vertices = 0;
+  double seconds = 0.0;
+  std::string Summary() const;
+};
+
+// The surface of the solid voxels as one welded, closed, 2-manifold triangle mesh: the
+// iso-surface at occupancy 1/2 (VTK's flying edges; space outside the grid counts as empty, so
+// the mesh is closed where the volume meets the grid's border), smoothed, split and decimated as
+// the options say, with outward vertex normals (VTK's vtkPolyDataNormals, no splitting, so
+// vertices stay shared). Colours are left empty. An empty volume gives an empty mesh.
+TriangleMesh MeshSolidVoxels(const Volume& volume,
+                             const SurfaceMeshOptions& options,
+                             SurfaceMeshSummary* summary = nullptr);
+
+// Sets every vertex normal to the area-weighted mean of its triangles' normals (the winding's
+// side), normalised; a vertex in no triangle of non-zero area keeps a zero normal.
+void ComputeVertexNormals(TriangleMesh* mesh);
+
+// The mesh's topology, counted from its triangles.
+struct MeshTopology {
+  int64_t edges = 0;
+  int64_t boundary_edges = 0;      // in one triangle only
+  int64_t non_manifold_edges = 0;  // in three or more triangles
+  int64_t non_manifold_vertices = 0;  // whose triangles form more than one fan
+  int64_t inconsistent_edges = 0;  // shared by two triangles that run it the same way
+  int64_t components = 0;          // connected through shared vertices
+  int64_t degenerate_triangles = 0;  // repeating a vertex
+  // Every edge in exactly two triangles that run it in opposite directions, and every vertex one
+  // fan: a closed, oriented 2-manifold.
+  bool IsClosedManifold() const {
+    return boundary_edges == 0 && non_manifold_edges == 0 && non_manifold_vertices == 0 &&
+           inconsistent_edges == 0 && degenerate_triangles == 0;
+  }
+};
+MeshTopology AnalyseTopology(const TriangleMesh& mesh);
+
+// Writes the mesh as binary little-endian PLY through PCL: vertex x y z nx ny nz red green blue
+// (grey 128 where `colours` is empty), face vertex_indices. An empty mesh gives a valid PLY with
+// no vertices and no faces. Written to a temporary name and renamed; throws InputError naming
+// the path on failure.
+void WriteMeshPly(const TriangleMesh& mesh, const std::string& path);
+
+}  // namespace exporter
+}  // namespace raycarve

@@ -8,6 +8,9 @@
 #include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
 
+#include "export/holdout_score.h"
+#include "export/mesh_renderer.h"
+#include "export/volume_renderer.h"
 #include "samples/synthetic_scene.h"
 #include "tests/carve/carve_fixture.h"
 #include "tests/test_support.h"
@@ -73,6 +76,122 @@ TEST(CarveExport, FilesOpenWithPCLAndHaveTheExpectedFields) {
     ASSERT_TRUE(box.contains(Eigen::Vector3d(vertex.x, vertex.y, vertex.z)));
   }
   std::filesystem::remove_all(folder);
+}
+
+TEST(CarveExport, TheSmoothMeshIsClosedAndNearerTheTruthAndItsPhotoColoursBeatVoxelMeans) {
+  // 9 views; the 5th is held out: the carve, the mesh and its colours never see it.
+  SyntheticSceneOptions options = testing::SceneOptions(9, 320, 240, false, 3000);
+  options.detail_texture = true;  // texture finer than a voxel
+  const SyntheticScene scene = GenerateSyntheticScene(options);
+  std::vector<CalibratedView> views = testing::SceneViews(scene, /*with_masks=*/true);
+  const CalibratedView held_out = views[4];
+  views.erase(views.begin() + 4);
+  // The command's defaults: automatic levels, specks removed, threshold and known surface from
+  // the sparse points (here the scene's true points).
+  CarveOptions carve;
+  carve.resolution = 96;
+  carve.lod_levels = kAutomaticLevels;
+  carve.min_component_voxels = 8;
+  carve.auto_threshold = true;
+  carve.protect_surface_points = true;
+  carve.surface_points = testing::SceneSurfacePoints(scene, 2);
+  for (SurfacePoint& point : carve.surface_points) {
+    // The held-out view's index goes; the later ones move down.
+    point.views.erase(std::remove(point.views.begin(), point.views.end(), 4), point.views.end());
+    for (int& v : point.views) v -= v > 4;
+  }
+  const CarveResult result = CarveVolume(views, scene.object_box, carve);
+  const double voxel = result.volume.grid().voxel_size();
+  const ModelMesh model = MeshCarvedModel(result, views, ModelMeshOptions());
+  ASSERT_FALSE(model.mesh.empty());
+  const MeshTopology topology = AnalyseTopology(model.mesh);
+  EXPECT_TRUE(topology.IsClosedManifold());
+  ASSERT_EQ(model.mesh.colours.size(), model.mesh.vertices.size());
+  ASSERT_EQ(model.seen_by.size(), model.mesh.vertices.size());
+  EXPECT_EQ(model.colouring.from_photos + model.colouring.from_neighbours + model.colouring.uncoloured,
+            static_cast<int64_t>(model.mesh.vertices.size()));
+
+  // Geometry: the mesh's vertices against the cloud's points (voxel centres), both from the truth.
+  const std::vector<ColouredPoint> cloud = SurfacePoints(result, 2);
+  auto share_near = [voxel](const std::vector<Eigen::Vector3d>& points) {
+    int near = 0;
+    for (const Eigen::Vector3d& p : points) near += TrueSurfaceDistance(p) <= voxel;
+    return static_cast<double>(near) / points.size();
+  };
+  std::vector<Eigen::Vector3d> mesh_points, cloud_points;
+  for (size_t i = 0; i < model.mesh.vertices.size(); ++i) {
+    if (model.seen_by[i].size() >= 2) mesh_points.push_back(model.mesh.vertices[i].cast<double>());
+  }
+  for (const ColouredPoint& p : cloud) cloud_points.push_back(p.xyz.cast<double>());
+  const double mesh_near = share_near(mesh_points), cloud_near = share_near(cloud_points);
+
+  // Colour: at the scene's true surface points (the sparse points carry their true colour), the
+  // nearest mesh vertex seen twice against the nearest cloud point (a voxel's mean colour), where
+  // both lie within a voxel.
+  double mesh_error = 0.0, voxel_error = 0.0;
+  int compared = 0;
+  for (const auto& [id, point3D] : scene.reconstruction.points3D) {
+    const Eigen::Vector3f p = point3D.xyz.cast<float>();
+    const Eigen::Vector3f truth = point3D.color.cast<float>();
+    int best_vertex = -1, best_point = -1;
+    float vertex_distance = static_cast<float>(voxel), point_distance = vertex_distance;
+    for (size_t i = 0; i < model.mesh.vertices.size(); ++i) {
+      const float d = (model.mesh.vertices[i] - p).norm();
+      if (d < vertex_distance && model.seen_by[i].size() >= 2) {
+        vertex_distance = d;
+        best_vertex = static_cast<int>(i);
+      }
+    }
+    for (size_t i = 0; i < cloud.size(); ++i) {
+      const float d = (cloud[i].xyz - p).norm();
+      if (d < point_distance) {
+        point_distance = d;
+        best_point = static_cast<int>(i);
+      }
+    }
+    if (best_vertex < 0 || best_point < 0) continue;
+    mesh_error += (model.mesh.colours[best_vertex].cast<float>() - truth).norm();
+    voxel_error += (cloud[best_point].rgb.cast<float>() - truth).norm();
+    ++compared;
+  }
+  ASSERT_GT(compared, 200);
+  mesh_error /= compared;
+  voxel_error /= compared;
+
+  // For the record (not asserted): the held-out photo against the mesh and the volume drawn
+  // into it. This scene's ground is a plane of no thickness, carved into a lace one voxel thick
+  // whose smoothed surface covers less of the photo than its voxel cubes do (with a fixed
+  // threshold of 30 and no sparse points the mesh's IoU fell from 0.81 to 0.64).
+  const HoldoutScore mesh_score = ScoreRendering(RenderMesh(model.mesh, held_out), held_out);
+  const HoldoutScore volume_score =
+      ScoreRendering(RenderVolume(result.volume, result.surface, held_out), held_out);
+  std::cout << "within a voxel of the truth: mesh vertices seen twice " << mesh_near
+            << ", cloud points " << cloud_near << "; RGB error at " << compared
+            << " true points: mesh " << mesh_error << ", voxel means " << voxel_error
+            << "; held-out PSNR mesh " << mesh_score.psnr << " dB (IoU "
+            << mesh_score.silhouette_iou << "), volume " << volume_score.psnr << " dB (IoU "
+            << volume_score.silhouette_iou << "); " << model.colouring.Summary() << "\n";
+  // Measured: within a voxel of the truth 0.31 (mesh) vs 0.23 (cloud: the carve at these
+  // defaults is fat); RGB error 38.4 vs 53.4; held-out PSNR 12.17 vs 12.22 dB, IoU 0.920 vs 0.937.
+  EXPECT_GE(mesh_near, cloud_near);
+  EXPECT_LT(mesh_error, 0.9 * voxel_error);
+}
+
+TEST(CarveExport, AnEmptyCarveGivesAnEmptyMesh) {
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(4, 80, 60));
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  CarveOptions carve;
+  carve.resolution = 16;
+  carve.threshold = 0.0;  // nothing is consistent: every voxel two views see goes
+  carve.min_component_voxels = 1000000;
+  const CarveResult result = CarveVolume(views, scene.object_box, carve);
+  const ModelMesh model = MeshCarvedModel(result, views, ModelMeshOptions());
+  if (result.volume.num_solid() == 0) {
+    EXPECT_TRUE(model.mesh.empty());
+    EXPECT_EQ(model.colouring.vertices, 0);
+  } else {
+    EXPECT_TRUE(AnalyseTopology(model.mesh).IsClosedManifold());
+  }
 }
 
 }  // namespace

@@ -1,0 +1,89 @@
+#include "export/mesh_renderer.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+// A 40x30 pinhole view at the origin looking down +z (x right, y down), f = 50.
+CalibratedView Straight() {
+  CalibratedView view;
+  view.width = 40;
+  view.height = 30;
+  view.K << 50, 0, 20, 0, 50, 15, 0, 0, 1;
+  view.cam_from_world.rotation = Eigen::Quaterniond::Identity();
+  view.cam_from_world.translation = Eigen::Vector3d::Zero();
+  view.centre = Eigen::Vector3d::Zero();
+  view.P = view.K * view.cam_from_world.ToMatrix();
+  return view;
+}
+
+// The world point at depth z that projects to COLMAP pixel (x, y).
+Eigen::Vector3f Unproject(const CalibratedView& view, double x, double y, double z) {
+  return Eigen::Vector3f(static_cast<float>((x - view.K(0, 2)) / view.K(0, 0) * z),
+                         static_cast<float>((y - view.K(1, 2)) / view.K(1, 1) * z),
+                         static_cast<float>(z));
+}
+
+TEST(RenderMesh, ARectangleCoversExactlyThePixelCentresInsideItAtItsDepth) {
+  const CalibratedView view = Straight();
+  // Pixel corners 10..30 across, 5..20 down, at depth 4: centres 10.5..29.5, 5.5..19.5 inside.
+  TriangleMesh mesh;
+  mesh.vertices = {Unproject(view, 10, 5, 4), Unproject(view, 30, 5, 4), Unproject(view, 30, 20, 4),
+                   Unproject(view, 10, 20, 4)};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const Rendering rendering = RenderMesh(mesh, view);
+  for (int row = 0; row < view.height; ++row) {
+    for (int col = 0; col < view.width; ++col) {
+      const bool inside = col >= 10 && col < 30 && row >= 5 && row < 20;
+      ASSERT_EQ(rendering.silhouette.at<uint8_t>(row, col) != 0, inside) << col << "," << row;
+      if (inside) {
+        EXPECT_NEAR(rendering.depth.at<float>(row, col), 4.0f, 1e-5f);
+        EXPECT_EQ(rendering.image.at<cv::Vec3b>(row, col), cv::Vec3b(128, 128, 128));
+      } else {
+        EXPECT_TRUE(std::isinf(rendering.depth.at<float>(row, col)));
+      }
+    }
+  }
+}
+
+TEST(RenderMesh, TheNearestTriangleWinsAndColoursBlendPerspectiveCorrectly) {
+  const CalibratedView view = Straight();
+  TriangleMesh mesh;
+  // A far red square over the whole view and a near slanted one, black at its left edge (depth
+  // 2) and white at its right (depth 6), over columns 10..30.
+  mesh.vertices = {Unproject(view, 0, 0, 10),  Unproject(view, 40, 0, 10), Unproject(view, 40, 30, 10),
+                   Unproject(view, 0, 30, 10), Unproject(view, 10, 0, 2),  Unproject(view, 30, 0, 6),
+                   Unproject(view, 30, 30, 6), Unproject(view, 10, 30, 2)};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+  mesh.colours = {{255, 0, 0}, {255, 0, 0}, {255, 0, 0}, {255, 0, 0},
+                  {0, 0, 0},   {255, 255, 255}, {255, 255, 255}, {0, 0, 0}};
+  const Rendering rendering = RenderMesh(mesh, view);
+  EXPECT_EQ(rendering.image.at<cv::Vec3b>(15, 5), cv::Vec3b(255, 0, 0));
+  EXPECT_NEAR(rendering.depth.at<float>(15, 5), 10.0f, 1e-4f);
+  for (int col = 10; col < 30; ++col) {
+    // Screen position s in [0, 1] across the slanted square; depth and colour follow the plane:
+    // 1/z is linear in s, the colour is linear along the surface.
+    const double s = (col + 0.5 - 10) / 20.0;
+    const double z = 1.0 / ((1 - s) / 2.0 + s / 6.0);
+    const double along = (z - 2.0) / 4.0;  // 0 at the black edge, 1 at the white one
+    EXPECT_NEAR(rendering.depth.at<float>(15, col), z, 1e-4) << col;
+    EXPECT_NEAR(rendering.image.at<cv::Vec3b>(15, col)[1], 255.0 * along, 1.0) << col;
+  }
+}
+
+TEST(RenderMesh, TrianglesReachingBehindTheCameraAreSkipped) {
+  const CalibratedView view = Straight();
+  TriangleMesh mesh;
+  mesh.vertices = {{-1, -1, 3}, {1, -1, 3}, {0, 1, -1}};
+  mesh.triangles = {{0, 1, 2}};
+  const Rendering rendering = RenderMesh(mesh, view);
+  EXPECT_EQ(cv::countNonZero(rendering.silhouette), 0);
+}
+
+}  // namespace
+}  // namespace exporter
+}  // namespace raycarve

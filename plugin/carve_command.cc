@@ -576,6 +576,15 @@ int RunCarve(int argc, char** argv) {
       static_cast<long long>(s.visible_surface), run.num_cloud_points, request.options.min_views,
       sparse_line.c_str(), run.output_path.c_str(), run.num_cloud_points,
       run.num_mesh_triangles, run.output_path.c_str());
+  if (s.final_solid == 0 || s.visible_surface == 0) {
+    std::printf(
+        "  warning         the carve kept nothing %s: the files are valid but empty. Try a higher "
+        "--threshold (or auto), --protect_surface_points 1, and check that the photos see the "
+        "volume (--bbox, the masks in %s/masks)\n",
+        s.final_solid == 0 ? "(every voxel was found inconsistent or unseen)"
+                           : "that a photo sees",
+        run.output_path.c_str());
+  }
   if (request.mesh_kind == "smooth" && run.num_mesh_triangles > 0) {
     const exporter::MeshColouringSummary& c = run.mesh_colouring;
     std::printf("  mesh            %zu triangles, %zu vertices, %lld component%s, %s;\n"

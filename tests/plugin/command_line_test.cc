@@ -228,6 +228,42 @@ TEST_F(CommandLine, CarveWritesCloudMeshReportAndCurve) {
   // The last row of the curve is the final count.
   const std::string last = csv.substr(csv.rfind('\n', csv.size() - 2) + 1);
   EXPECT_EQ(std::stod(last.substr(last.find(',') + 1)), carved) << last;
+  // The mesh is the smooth one, closed and coloured from the photos.
+  EXPECT_NE(report.find("\"mesh_kind\": \"smooth\""), std::string::npos) << report;
+  EXPECT_NE(report.find("\"closed_manifold\": true"), std::string::npos) << report;
+  EXPECT_GT(JsonNumber(report, "vertices_coloured_from_photos"), 0);
+  EXPECT_GT(JsonNumber(report, "mesh_triangles"), 0);
+  const std::string mesh = testing::ReadFileBytes(out + "/mesh.ply");
+  for (const char* property : {"property float nx", "property uchar red", "element face "}) {
+    EXPECT_NE(mesh.find(property), std::string::npos) << property;
+  }
+}
+
+TEST_F(CommandLine, ACarveThatKeepsNothingWritesValidEmptyFilesAndSaysWhatToTry) {
+  const std::string out = *root_ + "/carved_empty";
+  std::string output;
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + out +
+                    " --resolution 16 --threshold 0 --protect_surface_points 0 "
+                    "--min_component_voxels 100000",
+                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("kept nothing"), std::string::npos) << output;
+  EXPECT_EQ(output.find("PCL"), std::string::npos) << output;
+  const std::string report = testing::ReadFileBytes(out + "/report.json");
+  EXPECT_EQ(JsonNumber(report, "final_solid"), 0);
+  EXPECT_EQ(JsonNumber(report, "mesh_triangles"), 0);
+  for (const char* file : {"cloud.ply", "mesh.ply"}) {
+    const std::string bytes = testing::ReadFileBytes(out + "/" + file);
+    EXPECT_EQ(bytes.rfind("ply\n", 0), 0u) << file;
+    EXPECT_NE(bytes.find("element vertex 0\n"), std::string::npos) << file;
+  }
+  // The empty files are read back as empty, not as errors.
+  ASSERT_EQ(Run("render --input " + out + "/cloud.ply --input_path " + Project() +
+                    "/sparse/0 --output_path " + out + "/render",
+                &output),
+            0)
+      << output;
 }
 
 TEST_F(CommandLine, CompareMeasuresTheCarvedCloudAgainstTheGroundTruth) {

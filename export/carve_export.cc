@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <random>
 
 #include <glog/logging.h>
 
@@ -14,6 +16,9 @@
 
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
+              "the point visibility file is written little-endian by memcpy");
 
 namespace raycarve {
 namespace exporter {
@@ -162,6 +167,74 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   colouring.depth_tolerance = grid.voxel_size();
   model.colouring = ColourMeshFromPhotos(views, colouring, &model.mesh, &model.seen_by);
   return model;
+}
+
+std::vector<ColouredPoint> SampleMeshPoints(const ModelMesh& model,
+                                            double spacing,
+                                            int min_views,
+                                            uint64_t seed,
+                                            std::vector<std::vector<uint32_t>>* visibility) {
+  CHECK(spacing > 0.0);
+  const TriangleMesh& mesh = model.mesh;
+  CHECK(model.seen_by.size() == mesh.vertices.size());
+  CHECK(mesh.normals.size() == mesh.vertices.size() && mesh.colours.size() == mesh.vertices.size());
+  std::mt19937_64 random(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::vector<ColouredPoint> points;
+  if (visibility != nullptr) visibility->clear();
+  const double per_area = 1.0 / (spacing * spacing);
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>();
+    const Eigen::Vector3d b = mesh.vertices[t[1]].cast<double>();
+    const Eigen::Vector3d c = mesh.vertices[t[2]].cast<double>();
+    const double expected = 0.5 * (b - a).cross(c - a).norm() * per_area;
+    int count = static_cast<int>(expected);
+    if (uniform(random) < expected - count) ++count;
+    for (int k = 0; k < count; ++k) {
+      // Uniform over the triangle.
+      double u = uniform(random), v = uniform(random);
+      if (u + v > 1.0) {
+        u = 1.0 - u;
+        v = 1.0 - v;
+      }
+      const double w[3] = {1.0 - u - v, u, v};
+      const int nearest = w[0] >= w[1] && w[0] >= w[2] ? 0 : (w[1] >= w[2] ? 1 : 2);
+      const std::vector<uint32_t>& seen = model.seen_by[t[nearest]];
+      if (static_cast<int>(seen.size()) < min_views) continue;
+      Eigen::Vector3d position = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero(),
+                      colour = Eigen::Vector3d::Zero();
+      for (int j = 0; j < 3; ++j) {
+        position += w[j] * mesh.vertices[t[j]].cast<double>();
+        normal += w[j] * mesh.normals[t[j]].cast<double>();
+        colour += w[j] * mesh.colours[t[j]].cast<double>();
+      }
+      if (!(normal.norm() > 1e-6)) continue;
+      ColouredPoint point;
+      point.xyz = position.cast<float>();
+      point.normal = normal.normalized().cast<float>();
+      point.rgb = ToRgb(colour.cast<float>());
+      points.push_back(point);
+      if (visibility != nullptr) visibility->push_back(seen);
+    }
+  }
+  return points;
+}
+
+void WritePointVisibility(const std::vector<std::vector<uint32_t>>& visibility, const std::string& path) {
+  const std::string temporary = TemporaryPathFor(path);
+  std::ofstream file(temporary, std::ios::binary);
+  auto put = [&file](auto value) {
+    // Little-endian on every platform this builds for (x86-64, arm64).
+    file.write(reinterpret_cast<const char*>(&value), sizeof(value));
+  };
+  put(static_cast<uint64_t>(visibility.size()));
+  for (const std::vector<uint32_t>& images : visibility) {
+    put(static_cast<uint32_t>(images.size()));
+    for (uint32_t image : images) put(image);
+  }
+  file.close();
+  if (!file) throw InputError(temporary + ": cannot write the point visibility");
+  RenameIntoPlace(temporary, path);
 }
 
 }  // namespace exporter

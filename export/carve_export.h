@@ -61,5 +61,23 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
                           const std::vector<CalibratedView>& views,
                           const ModelMeshOptions& options);
 
+// The model's cloud, sampled on its smooth mesh about one point per `spacing` x `spacing` of
+// surface (a photo pixel's footprint gives the density of COLMAP's own fused clouds, which its
+// meshers' defaults expect), at fixed pseudo-random places (`seed`) in each triangle, with the
+// blend of the triangle's vertex colours and normals (unit, outward). A point is kept where its
+// nearest corner is seen by `min_views` or more photos; `visibility` gets, per point, the indices
+// of the views that see that corner (ModelMesh::seen_by).
+std::vector<ColouredPoint> SampleMeshPoints(const ModelMesh& model,
+                                            double spacing,
+                                            int min_views,
+                                            uint64_t seed,
+                                            std::vector<std::vector<uint32_t>>* visibility);
+
+// Writes COLMAP's point visibility file (what it writes as fused.ply.vis beside a fused cloud):
+// little-endian uint64 point count, then per point a uint32 count and that many uint32 image
+// indices (positions in the dense workspace's image list). Written to a temporary name and
+// renamed; throws InputError naming the path on failure.
+void WritePointVisibility(const std::vector<std::vector<uint32_t>>& visibility, const std::string& path);
+
 }  // namespace exporter
 }  // namespace raycarve

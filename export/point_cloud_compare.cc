@@ -109,6 +109,28 @@ CloudComparison CompareClouds(const std::vector<Eigen::Vector3f>& reference,
   return result;
 }
 
+double MedianNeighbourSpacing(const std::vector<Eigen::Vector3f>& points) {
+  std::vector<Eigen::Vector3f> finite;
+  finite.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) {
+    if (p.allFinite()) finite.push_back(p);
+  }
+  if (finite.size() < 2) return 0.0;
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(ToCloud(finite));
+  std::vector<double> distances;
+  distances.reserve(finite.size());
+  pcl::Indices index(2);
+  std::vector<float> squared(2);
+  for (const Eigen::Vector3f& q : finite) {
+    if (tree.nearestKSearch(pcl::PointXYZ(q.x(), q.y(), q.z()), 2, index, squared) < 2) continue;
+    distances.push_back(std::sqrt(static_cast<double>(squared[1])));
+  }
+  if (distances.empty()) return 0.0;
+  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+  return distances[distances.size() / 2];
+}
+
 std::vector<Eigen::Vector3f> ReadComparablePoints(const std::string& path, int mesh_samples) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": file not found");
   pcl::PolygonMesh mesh;

@@ -47,5 +47,9 @@ CloudComparison CompareClouds(const std::vector<Eigen::Vector3f>& reference,
 // when it cannot be read or holds no points.
 std::vector<Eigen::Vector3f> ReadComparablePoints(const std::string& path, int mesh_samples);
 
+// The median distance from a point to its nearest other point (PCL k-d tree): a cloud's own
+// sampling step. Non-finite points are left out; 0 with fewer than two points.
+double MedianNeighbourSpacing(const std::vector<Eigen::Vector3f>& points);
+
 }  // namespace exporter
 }  // namespace raycarve

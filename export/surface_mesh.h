@@ -84,5 +84,12 @@ MeshTopology AnalyseTopology(const TriangleMesh& mesh);
 // the path on failure.
 void WriteMeshPly(const TriangleMesh& mesh, const std::string& path);
 
+// Reads a PLY mesh or point cloud to draw (what `holdout --model` scores): vertex positions,
+// colours where the file has them (grey 128 otherwise), polygons fanned into triangles (none for
+// a cloud), normals recomputed from the faces. Vertices with a non-finite coordinate are
+// refused. Throws InputError naming the path when it is missing, PCL cannot parse it, a face
+// refers to a vertex that is not there, or there is nothing to draw.
+TriangleMesh ReadMeshOrCloudPly(const std::string& path);
+
 }  // namespace exporter
 }  // namespace raycarve

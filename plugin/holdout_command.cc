@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <set>
 
 #include <glog/logging.h>
@@ -12,6 +13,7 @@
 #include "export/carve_export.h"
 #include "export/holdout_score.h"
 #include "export/mesh_renderer.h"
+#include "export/point_cloud_compare.h"
 #include "export/point_renderer.h"
 #include "export/volume_renderer.h"
 #include "plugin/commands.h"
@@ -24,6 +26,8 @@ int RunHoldout(int argc, char** argv) {
   CarveFlagText text;
   int every = 4;
   std::string render = "mesh";
+  std::string other_path;
+  double splat_size = 0.0;
   OptionParser parser(
       "holdout",
       "Held-out evaluation: carves the project without every k-th view, renders the carved model "
@@ -37,6 +41,12 @@ int RunHoldout(int argc, char** argv) {
                     "(what carve writes as mesh.ply), the carved volume (a ray per pixel to the "
                     "first solid voxel, in its colour) or the cloud's points as square splats",
                     {"mesh", "volume", "splats"});
+  parser.AddDefault("model", &other_path,
+                    "score this PLY mesh or cloud instead of carving (COLMAP's fused.ply, another "
+                    "tool's mesh with vertex colours), on the same held-out views");
+  parser.AddDefault("point_size", &splat_size,
+                    "splat side (world units) for a cloud given by --model (0: 1.5 x the cloud's "
+                    "median neighbour spacing)");
   if (!parser.Parse(argc, argv)) return 0;
   ApplyCarveFlags(text, &request);
   if (every < 2) throw InputError("raycarve holdout: --every must be at least 2");
@@ -58,38 +68,67 @@ int RunHoldout(int argc, char** argv) {
     throw InputError("raycarve holdout: only " + std::to_string(training.size()) +
                      " views left to carve with; raise --every");
   }
-  std::string reason;
-  if (!CheckCarveFits(training, project.bounds.box, request.options, &reason)) {
-    throw InputError("raycarve holdout: " + reason);
-  }
-  LOG(INFO) << "carving with " << training.size() << " views, holding out " << held_out.size();
-  CarveOptions options = request.options;
-  options.surface_points = SurfacePointsOf(project.reconstruction, training, project.bounds.box);
-  const CarveResult result = CarveVolume(training, project.bounds.box, options);
-  std::string thresholds;
-  for (const LevelStatistics& level : result.statistics.levels) {
-    char text[64];
-    if (options.consistency == ConsistencyMethod::kPatchCorrelation) {
-      std::snprintf(text, sizeof(text), "%s%d: %.1f / %.2f", thresholds.empty() ? "" : ", ",
-                    level.resolution, level.threshold, level.pattern_threshold);
-    } else {
-      std::snprintf(text, sizeof(text), "%s%d: %.1f", thresholds.empty() ? "" : ", ",
-                    level.resolution, level.threshold);
-    }
-    thresholds += text;
-    if (options.auto_threshold) LOG(INFO) << level.estimate.Summary();
-  }
-  LOG(INFO) << result.statistics.Summary();
-  const std::vector<exporter::ColouredPoint> points =
-      exporter::SurfacePoints(result, request.options.min_views);
-  const double point_size = result.volume.grid().voxel_size();
+  // Block PSNR's block: about a voxel of the grid the carve uses (or would use).
+  const VoxelGrid grid(project.bounds.box, request.options.resolution);
+  std::unique_ptr<CarveResult> result;
+  std::vector<exporter::ColouredPoint> points;
+  double point_size = grid.voxel_size();
   exporter::ModelMesh model;
-  if (render == "mesh") {
-    // Coloured from the training views only: the held-out photos never reach the model.
-    model = exporter::MeshCarvedModel(result, training, request.mesh);
-    LOG(INFO) << model.geometry.Summary();
-    if (!model.mesh.empty()) LOG(INFO) << model.refinement.Summary();
-    if (!model.mesh.empty()) LOG(INFO) << model.colouring.Summary();
+  std::string thresholds;
+  CarveOptions options = request.options;
+  if (!other_path.empty()) {
+    // Someone else's model: nothing is carved; a mesh is drawn as it is, a cloud as splats.
+    model.mesh = exporter::ReadMeshOrCloudPly(other_path);
+    if (model.mesh.triangles.empty()) {
+      render = "splats";
+      std::vector<Eigen::Vector3f> xyz;
+      for (size_t i = 0; i < model.mesh.vertices.size(); ++i) {
+        exporter::ColouredPoint point;
+        point.xyz = model.mesh.vertices[i];
+        point.rgb = model.mesh.colours[i];
+        points.push_back(point);
+        xyz.push_back(point.xyz);
+      }
+      point_size = splat_size > 0.0 ? splat_size : 1.5 * exporter::MedianNeighbourSpacing(xyz);
+      if (!(point_size > 0.0)) {
+        throw InputError(other_path + ": cannot tell the cloud's spacing; give --point_size");
+      }
+      LOG(INFO) << other_path << ": " << points.size() << " points, drawn as splats of "
+                << point_size;
+    } else {
+      render = "mesh";
+      LOG(INFO) << other_path << ": " << model.mesh.triangles.size() << " triangles";
+    }
+  } else {
+    std::string reason;
+    if (!CheckCarveFits(training, project.bounds.box, request.options, &reason)) {
+      throw InputError("raycarve holdout: " + reason);
+    }
+    LOG(INFO) << "carving with " << training.size() << " views, holding out " << held_out.size();
+    options.surface_points = SurfacePointsOf(project.reconstruction, training, project.bounds.box);
+    result = std::make_unique<CarveResult>(CarveVolume(training, project.bounds.box, options));
+    for (const LevelStatistics& level : result->statistics.levels) {
+      char text[64];
+      if (options.consistency == ConsistencyMethod::kPatchCorrelation) {
+        std::snprintf(text, sizeof(text), "%s%d: %.1f / %.2f", thresholds.empty() ? "" : ", ",
+                      level.resolution, level.threshold, level.pattern_threshold);
+      } else {
+        std::snprintf(text, sizeof(text), "%s%d: %.1f", thresholds.empty() ? "" : ", ",
+                      level.resolution, level.threshold);
+      }
+      thresholds += text;
+      if (options.auto_threshold) LOG(INFO) << level.estimate.Summary();
+    }
+    LOG(INFO) << result->statistics.Summary();
+    points = exporter::SurfacePoints(*result, request.options.min_views);
+    point_size = result->volume.grid().voxel_size();
+    if (render == "mesh") {
+      // Coloured from the training views only: the held-out photos never reach the model.
+      model = exporter::MeshCarvedModel(*result, training, request.mesh);
+      LOG(INFO) << model.geometry.Summary();
+      if (!model.mesh.empty()) LOG(INFO) << model.refinement.Summary();
+      if (!model.mesh.empty()) LOG(INFO) << model.colouring.Summary();
+    }
   }
 
   const std::filesystem::path out = std::filesystem::path(project.output_path) / "holdout";
@@ -104,16 +143,19 @@ int RunHoldout(int argc, char** argv) {
       .Key("cloud_points").Value(static_cast<uint64_t>(points.size()))
       .Key("render").Value(render)
       .Key("mesh_triangles").Value(static_cast<uint64_t>(model.mesh.triangles.size()))
-      .Key("mesh_seconds").Value(model.geometry.seconds + model.colouring.seconds)
-      .Key("carve").Value(result.statistics.Summary())
+      .Key("mesh_seconds")
+      .Value(model.geometry.seconds + model.refinement.seconds + model.colouring.seconds)
+      .Key("model").Value(other_path.empty() ? std::string("carved") : other_path)
+      .Key("carve").Value(result ? result->statistics.Summary() : std::string())
       .Key("thresholds").Value(thresholds)
       .Key("surface_points").Value(static_cast<uint64_t>(options.surface_points.size()));
   json.Key("views").BeginArray();
-  double psnr_sum = 0.0, iou_sum = 0.0;
+  double psnr_sum = 0.0, iou_sum = 0.0, volume_psnr_sum = 0.0, volume_iou_sum = 0.0;
   int iou_count = 0;
   // What one colour per voxel could carry at best: the photo against its own means over blocks
   // of about a voxel's projected width (at the volume's centre).
-  const Eigen::Vector3d volume_centre = result.volume.grid().Box().center();
+  const Eigen::Vector3d volume_centre = grid.Box().center();
+  const double block_size = grid.voxel_size();
   double block_psnr_sum = 0.0;
   std::printf("%-24s %10s %12s %10s %16s\n", "held-out view", "PSNR dB", "scored px", "sil. IoU",
               "block PSNR dB");
@@ -121,7 +163,7 @@ int RunHoldout(int argc, char** argv) {
     int uncoloured = 0;
     exporter::Rendering rendering;
     if (render == "volume") {
-      exporter::VolumeRendering drawn = exporter::RenderVolume(result.volume, result.surface, view);
+      exporter::VolumeRendering drawn = exporter::RenderVolume(result->volume, result->surface, view);
       uncoloured = drawn.uncoloured_pixels;
       rendering = std::move(drawn);
     } else if (render == "mesh") {
@@ -130,9 +172,17 @@ int RunHoldout(int argc, char** argv) {
       rendering = exporter::RenderPoints(points, view, point_size);
     }
     const exporter::HoldoutScore score = exporter::ScoreRendering(rendering, view);
+    // The mesh is scored beside the voxel volume it was made from, drawn into the same view.
+    exporter::HoldoutScore volume_score = score;
+    if (render == "mesh" && result) {
+      volume_score = exporter::ScoreRendering(
+          exporter::RenderVolume(result->volume, result->surface, view), view);
+    }
+    volume_psnr_sum += volume_score.psnr;
+    volume_iou_sum += std::max(0.0, volume_score.silhouette_iou);
     const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
     const int block = std::max(
-        1, static_cast<int>(std::lround(focal * point_size / view.Depth(volume_centre))));
+        1, static_cast<int>(std::lround(focal * block_size / view.Depth(volume_centre))));
     const double block_psnr = exporter::BlockMeanPsnr(view, block);
     block_psnr_sum += block_psnr;
     psnr_sum += score.psnr;
@@ -150,6 +200,8 @@ int RunHoldout(int argc, char** argv) {
         .Key("uncoloured_pixels").Value(uncoloured)
         .Key("block_pixels").Value(block)
         .Key("block_mean_psnr_db").Value(block_psnr)
+        .Key("volume_psnr_db").Value(volume_score.psnr)
+        .Key("volume_silhouette_iou").Value(volume_score.silhouette_iou)
         .EndObject();
     cv::Mat bgr;
     cv::cvtColor(exporter::SideBySide(rendering, view), bgr, cv::COLOR_RGB2BGR);
@@ -160,17 +212,33 @@ int RunHoldout(int argc, char** argv) {
   const double mean_psnr = psnr_sum / held_out.size();
   const double mean_iou = iou_count > 0 ? iou_sum / iou_count : -1.0;
   const double mean_block_psnr = block_psnr_sum / held_out.size();
+  const double mean_volume_psnr = volume_psnr_sum / held_out.size();
+  const double mean_volume_iou = iou_count > 0 ? volume_iou_sum / iou_count : -1.0;
   json.Key("mean_psnr_db").Value(mean_psnr).Key("mean_silhouette_iou").Value(mean_iou)
-      .Key("mean_block_mean_psnr_db").Value(mean_block_psnr).EndObject();
+      .Key("mean_block_mean_psnr_db").Value(mean_block_psnr)
+      .Key("mean_volume_psnr_db").Value(mean_volume_psnr)
+      .Key("mean_volume_silhouette_iou").Value(mean_volume_iou).EndObject();
+  if (render == "mesh" && result) {
+    // The model that was scored, for a look at it.
+    exporter::WriteMeshPly(model.mesh, (out / "mesh.ply").string());
+  }
   const std::string report = (out / "holdout.json").string();
   WriteTextFileAtomically(report, json.str());
   std::printf("mean over %zu held-out views: PSNR %.2f dB, silhouette IoU %s\n"
               "block PSNR: each photo against its own means over blocks a voxel wide, on the "
               "object: about the most one colour per voxel can score (mean %.2f dB)\n"
-              "wrote %s and %s/<view>.png (photo | render | error x4)\n",
+              "wrote %s, %s/<view>.png (photo | render | error x4)%s\n",
               held_out.size(), mean_psnr,
               iou_count > 0 ? std::to_string(mean_iou).c_str() : "n/a (no masks)", mean_block_psnr,
-              report.c_str(), out.string().c_str());
+              report.c_str(), out.string().c_str(),
+              render == "mesh" && result ? " and mesh.ply" : "");
+  if (render == "mesh" && result) {
+    std::printf("the voxel volume drawn into the same views: PSNR %.2f dB, silhouette IoU %s "
+                "(the mesh: %+.2f dB)\n",
+                mean_volume_psnr,
+                iou_count > 0 ? std::to_string(mean_volume_iou).c_str() : "n/a (no masks)",
+                mean_psnr - mean_volume_psnr);
+  }
   return 0;
 }
 

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "export/mesh_renderer.h"
+#include "export/parallel_ranges.h"
 
 namespace raycarve {
 namespace exporter {
@@ -108,33 +109,44 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
   TriangleMesh shape;  // drawn without colours: only the depth is wanted
   shape.vertices = mesh.vertices;
   shape.triangles = mesh.triangles;
-  for (size_t v = 0; v < views.size(); ++v) {
-    const CalibratedView& view = views[v];
-    const Rendering drawn = RenderMesh(shape, view);
-    // Distance (pixels) from each object pixel to the nearest background pixel.
-    cv::Mat to_background;
-    if (on_rim != nullptr && !view.mask.empty() && voxel_size > 0.0) {
-      cv::distanceTransform(view.mask, to_background, cv::DIST_L2, 3);
-    }
-    const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
-    for (size_t i = 0; i < n; ++i) {
-      const Eigen::Vector3d world = mesh.vertices[i].cast<double>();
-      const double depth = view.Depth(world);
-      if (!(depth > 0.0)) continue;
-      const Eigen::Vector2d pixel = view.Project(world);
-      const int col = static_cast<int>(std::floor(pixel.x()));
-      const int row = static_cast<int>(std::floor(pixel.y()));
-      if (col < 0 || row < 0 || col >= view.width || row >= view.height) continue;
-      if (depth > drawn.depth.at<float>(row, col) + depth_tolerance) continue;
-      if (!to_background.empty() && view.mask.at<uint8_t>(row, col) != 0 &&
-          to_background.at<float>(row, col) <= rim_voxels * focal * voxel_size / depth) {
-        (*on_rim)[i] = 1;
+  // Each view on its own (in parallel): the vertices it sees, and which lie on its mask's rim.
+  std::vector<std::vector<std::pair<uint32_t, float>>> per_view(views.size());
+  std::vector<std::vector<uint32_t>> rims(views.size());
+  ParallelRanges(views.size(), AllCores(), /*min_per_thread=*/1, [&](size_t first, size_t last) {
+    for (size_t v = first; v < last; ++v) {
+      const CalibratedView& view = views[v];
+      const Rendering drawn = RenderMesh(shape, view);
+      // Distance (pixels) from each object pixel to the nearest background pixel.
+      cv::Mat to_background;
+      if (on_rim != nullptr && !view.mask.empty() && voxel_size > 0.0) {
+        cv::distanceTransform(view.mask, to_background, cv::DIST_L2, 3);
       }
-      const double facing = mesh.normals[i].cast<double>().dot((view.centre - world).normalized());
-      if (!(facing > 0.0)) continue;
-      if (view.valid.at<uint8_t>(row, col) == 0) continue;
-      if (!view.mask.empty() && view.mask.at<uint8_t>(row, col) == 0) continue;
-      sightings[i].push_back({static_cast<uint32_t>(v), static_cast<float>(facing)});
+      const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
+      for (size_t i = 0; i < n; ++i) {
+        const Eigen::Vector3d world = mesh.vertices[i].cast<double>();
+        const double depth = view.Depth(world);
+        if (!(depth > 0.0)) continue;
+        const Eigen::Vector2d pixel = view.Project(world);
+        const int col = static_cast<int>(std::floor(pixel.x()));
+        const int row = static_cast<int>(std::floor(pixel.y()));
+        if (col < 0 || row < 0 || col >= view.width || row >= view.height) continue;
+        if (depth > drawn.depth.at<float>(row, col) + depth_tolerance) continue;
+        if (!to_background.empty() && view.mask.at<uint8_t>(row, col) != 0 &&
+            to_background.at<float>(row, col) <= rim_voxels * focal * voxel_size / depth) {
+          rims[v].push_back(static_cast<uint32_t>(i));
+        }
+        const double facing = mesh.normals[i].cast<double>().dot((view.centre - world).normalized());
+        if (!(facing > 0.0)) continue;
+        if (view.valid.at<uint8_t>(row, col) == 0) continue;
+        if (!view.mask.empty() && view.mask.at<uint8_t>(row, col) == 0) continue;
+        per_view[v].emplace_back(static_cast<uint32_t>(i), static_cast<float>(facing));
+      }
+    }
+  });
+  for (size_t v = 0; v < views.size(); ++v) {
+    for (const auto& [i, facing] : per_view[v]) sightings[i].push_back({static_cast<uint32_t>(v), facing});
+    if (on_rim != nullptr) {
+      for (uint32_t i : rims[v]) (*on_rim)[i] = 1;
     }
   }
   return sightings;

@@ -1,12 +1,15 @@
 #include "export/mesh_refinement.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <thread>
 
 #include <glog/logging.h>
 
 #include "export/mesh_colouring.h"
+#include "export/parallel_ranges.h"
 
 namespace raycarve {
 namespace exporter {
@@ -34,8 +37,8 @@ bool MeshRefinementOptions::IsValid(std::string* reason) const {
     *reason = "mesh refinement needs a search range, patch radius and depth tolerance > 0";
     return false;
   }
-  if (steps_per_side < 1 || min_views < 2 || smoothing_passes < 0) {
-    *reason = "mesh refinement needs steps_per_side >= 1, min_views >= 2, smoothing_passes >= 0";
+  if (steps_per_side < 1 || min_views < 2 || smoothing_passes < 0 || max_views < min_views) {
+    *reason = "mesh refinement needs steps_per_side >= 1, min_views >= 2, smoothing_passes >= 0, max_views >= min_views";
     return false;
   }
   if (!(min_gain > 0.0 && min_gain <= 1.0)) {
@@ -80,12 +83,23 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
     const std::vector<std::vector<VertexSighting>> sightings = FindVertexSightings(
         views, *mesh, options.depth_tolerance, &on_rim, options.voxel_size, 1.0);
     std::vector<float> offsets(n, 0.0f);
-    summary.judged = summary.moved = 0;
+    std::vector<uint8_t> judged(n, 0), moved(n, 0);
+    const int threads = options.num_threads > 0 ? options.num_threads : AllCores();
+    ParallelRanges(n, threads, /*min_per_thread=*/1024, [&](size_t begin, size_t end) {
     std::vector<Eigen::Vector3f> patch(static_cast<size_t>(kPatchSamples) * views.size());
-    for (size_t i = 0; i < n; ++i) {
-      const std::vector<VertexSighting>& seen = sightings[i];
+    std::vector<VertexSighting> seen;
+    for (size_t i = begin; i < end; ++i) {
+      seen = sightings[i];
       if (static_cast<int>(seen.size()) < options.min_views) continue;
-      ++summary.judged;
+      // The best-facing photos judge: grazing views add blur and misregistration, and time.
+      if (static_cast<int>(seen.size()) > options.max_views) {
+        std::partial_sort(seen.begin(), seen.begin() + options.max_views, seen.end(),
+                          [](const VertexSighting& a, const VertexSighting& b) {
+                            return a.facing > b.facing;
+                          });
+        seen.resize(options.max_views);
+      }
+      judged[i] = 1;
       const Eigen::Vector3d centre = mesh->vertices[i].cast<double>();
       const Eigen::Vector3d normal = mesh->normals[i].cast<double>();
       Eigen::Vector3d u, w;
@@ -153,13 +167,16 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
       if (best != options.steps_per_side && std::isfinite(stay_cost) &&
           best_cost < options.min_gain * stay_cost) {
         offsets[i] = static_cast<float>((best - options.steps_per_side) * step);
-        ++summary.moved;
+        moved[i] = 1;
       } else if (!std::isfinite(stay_cost) && std::isfinite(best_cost)) {
         // Staying puts the vertex off the object in a photo that sees it: take the best.
         offsets[i] = static_cast<float>((best - options.steps_per_side) * step);
-        ++summary.moved;
+        moved[i] = 1;
       }
     }
+    });
+    summary.judged = std::count(judged.begin(), judged.end(), 1);
+    summary.moved = std::count(moved.begin(), moved.end(), 1);
     for (int s = 0; s < options.smoothing_passes; ++s) {
       std::vector<float> smoothed(n);
       for (size_t i = 0; i < n; ++i) {

@@ -31,6 +31,8 @@ struct MeshRefinementOptions {
   int min_views = 2;                // photos needed to judge a vertex
   double min_gain = 0.8;            // an offset must cost below this share of staying
   int smoothing_passes = 3;         // neighbour averaging of the offsets
+  int max_views = 16;               // at most this many photos judge a vertex: the best-facing
+  int num_threads = 0;              // 0: every core (the result does not depend on it)
 
   bool IsValid(std::string* reason) const;
 };

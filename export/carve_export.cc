@@ -129,6 +129,10 @@ bool ModelMeshOptions::IsValid(std::string* reason) const {
     *reason = "mesh colouring needs min_views >= 1";
     return false;
   }
+  if (min_component_vertices < 0) {
+    *reason = "mesh minimum component size must be >= 0";
+    return false;
+  }
   if (refine_passes < 0) {
     *reason = "mesh refinement passes must be >= 0";
     return false;
@@ -151,6 +155,8 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   }
   ModelMesh model;
   model.mesh = MeshSolidVoxels(result.volume, geometry, &model.geometry);
+  model.small_components_removed =
+      RemoveSmallComponents(options.min_component_vertices, &model.mesh);
   if (model.mesh.empty()) return model;
   MeshRefinementOptions refinement;
   refinement.passes = options.refine_passes;

@@ -46,11 +46,17 @@ struct ModelMeshOptions {
   // Passes of RefineMeshFromPhotos (search +-1 voxel along the normals, patches half a voxel
   // across) before colouring; 0: the smoothed iso-surface as it is.
   int refine_passes = 2;
+  // Pieces of the iso-surface with fewer vertices than this go before refinement: specks, and
+  // the parts of specks that flying edges splits where voxels touch only along an edge or at a
+  // corner. 24 is the iso-surface of a 2x2x2 block, the smallest speck the carve's default
+  // --min_component_voxels 8 keeps; 0 keeps everything.
+  int64_t min_component_vertices = 24;
   bool IsValid(std::string* reason) const;
 };
 struct ModelMesh {
   TriangleMesh mesh;
   SurfaceMeshSummary geometry;
+  int64_t small_components_removed = 0;
   MeshRefinementSummary refinement;
   MeshColouringSummary colouring;
   std::vector<std::vector<uint32_t>> seen_by;  // per vertex, the views (indices) that see it

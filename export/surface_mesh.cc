@@ -246,6 +246,41 @@ void ComputeVertexNormals(TriangleMesh* mesh) {
   }
 }
 
+int64_t RemoveSmallComponents(int64_t min_vertices, TriangleMesh* mesh) {
+  const int n = static_cast<int>(mesh->vertices.size());
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&parent](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const Eigen::Vector3i& t : mesh->triangles) {
+    parent[find(t[1])] = find(t[0]);
+    parent[find(t[2])] = find(t[0]);
+  }
+  std::vector<int64_t> size(n, 0);
+  for (int v = 0; v < n; ++v) ++size[find(v)];
+  std::vector<int> remap(n, -1);
+  TriangleMesh kept;
+  int64_t removed = 0;
+  for (int v = 0; v < n; ++v) {
+    const int root = find(v);
+    if (root == v && size[v] < min_vertices) ++removed;
+    if (size[root] < min_vertices) continue;
+    remap[v] = static_cast<int>(kept.vertices.size());
+    kept.vertices.push_back(mesh->vertices[v]);
+    if (mesh->normals.size() == mesh->vertices.size()) kept.normals.push_back(mesh->normals[v]);
+    if (mesh->colours.size() == mesh->vertices.size()) kept.colours.push_back(mesh->colours[v]);
+  }
+  if (removed == 0) return 0;
+  for (const Eigen::Vector3i& t : mesh->triangles) {
+    if (remap[t[0]] < 0) continue;
+    kept.triangles.emplace_back(remap[t[0]], remap[t[1]], remap[t[2]]);
+  }
+  *mesh = std::move(kept);
+  return removed;
+}
+
 MeshTopology AnalyseTopology(const TriangleMesh& mesh) {
   MeshTopology topology;
   const int num_vertices = static_cast<int>(mesh.vertices.size());

@@ -60,6 +60,11 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
 // side), normalised; a vertex in no triangle of non-zero area keeps a zero normal.
 void ComputeVertexNormals(TriangleMesh* mesh);
 
+// Removes every connected component (through shared vertices) with fewer than `min_vertices`
+// vertices, and the vertices only they used (normals and colours follow). Returns the components
+// removed.
+int64_t RemoveSmallComponents(int64_t min_vertices, TriangleMesh* mesh);
+
 // The mesh's topology, counted from its triangles.
 struct MeshTopology {
   int64_t edges = 0;

@@ -138,6 +138,7 @@ CarveRun CarveProject(const CarveRequest& request) {
     run.num_mesh_vertices = model.mesh.vertices.size();
     run.mesh_colouring = model.colouring;
     run.mesh_refinement = model.refinement;
+    run.mesh_small_components_removed = model.small_components_removed;
     // The cloud: the mesh's vertices that two or more photos see, and which ones, in COLMAP's
     // visibility format (image indices: positions among the model's images in id order).
     std::vector<std::vector<uint32_t>> visibility;
@@ -352,6 +353,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
     json.Key("mesh").BeginObject()
         .Key("closed_manifold").Value(t.IsClosedManifold())
         .Key("components").Value(static_cast<int64_t>(t.components))
+        .Key("small_components_removed").Value(run.mesh_small_components_removed)
         .Key("boundary_edges").Value(static_cast<int64_t>(t.boundary_edges))
         .Key("non_manifold_edges").Value(static_cast<int64_t>(t.non_manifold_edges))
         .Key("non_manifold_vertices").Value(static_cast<int64_t>(t.non_manifold_vertices))
@@ -537,6 +539,10 @@ void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
   }
   request->mesh.max_triangles = static_cast<int64_t>(request->mesh_max_faces);
   request->mesh.min_views = request->options.min_views;
+  // The mesh drops what is smaller than the iso-surface of the smallest speck the carve keeps
+  // (a cube of min_component_voxels voxels: 6 faces of n^(2/3) vertices).
+  request->mesh.min_component_vertices = static_cast<int64_t>(
+      std::ceil(6.0 * std::pow(static_cast<double>(std::max<int64_t>(request->options.min_component_voxels, 0)), 2.0 / 3.0)));
   if (!request->mesh.IsValid(&reason)) throw InputError("--mesh_*: " + reason);
 }
 

@@ -155,6 +155,7 @@ struct CarveRun {
   exporter::MeshTopology mesh_topology;
   exporter::MeshColouringSummary mesh_colouring;  // the smooth mesh's (vertices 0 otherwise)
   exporter::MeshRefinementSummary mesh_refinement;
+  int64_t mesh_small_components_removed = 0;
   // The model's sparse points inside the grid against the cloud (accuracy: their 90% distance).
   bool has_sparse = false;
   exporter::CloudComparison sparse;

@@ -107,6 +107,26 @@ TEST(SurfaceMesh, SeparateSolidsAreSeparateComponentsAndTheGridBorderClosesTheMe
   EXPECT_GT(at_border, 0);
 }
 
+TEST(SurfaceMesh, ComponentsSmallerThanAGivenSizeAreRemoved) {
+  // A ball and a lone voxel (its iso-surface: an octahedron of 6 vertices).
+  const Volume volume = MakeVolume(20, [](const Eigen::Vector3d& p) {
+    return (p - Eigen::Vector3d(-0.4, 0, 0)).norm() < 0.4 ||
+           (p - Eigen::Vector3d(0.75, 0.75, 0.75)).norm() < 0.05;
+  });
+  TriangleMesh mesh = MeshSolidVoxels(volume, SurfaceMeshOptions());
+  ASSERT_EQ(AnalyseTopology(mesh).components, 2);
+  const size_t before = mesh.vertices.size();
+  EXPECT_EQ(RemoveSmallComponents(6, &mesh), 0);
+  EXPECT_EQ(mesh.vertices.size(), before);
+  EXPECT_EQ(RemoveSmallComponents(24, &mesh), 1);
+  EXPECT_EQ(mesh.vertices.size(), before - 6);
+  EXPECT_EQ(mesh.normals.size(), mesh.vertices.size());
+  const MeshTopology topology = AnalyseTopology(mesh);
+  EXPECT_EQ(topology.components, 1);
+  EXPECT_TRUE(topology.IsClosedManifold());
+  for (const Eigen::Vector3f& v : mesh.vertices) EXPECT_LT(v.x(), 0.5f);
+}
+
 TEST(SurfaceMesh, TheTopologyCheckFindsOpenAndNonManifoldMeshes) {
   TriangleMesh open;
   open.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};

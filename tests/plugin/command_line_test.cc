@@ -379,6 +379,25 @@ TEST_F(CommandLine, HoldoutScoresRendersOfLeftOutViews) {
   EXPECT_GT(JsonNumber(report, "mean_psnr_db"), 5.0);
   EXPECT_TRUE(fs::is_regular_file(out + "/holdout/view001.png"));
   EXPECT_TRUE(fs::is_regular_file(out + "/holdout/view005.png"));
+  // The mesh is scored beside the voxel volume of the same carve, and written out.
+  EXPECT_GT(JsonNumber(report, "mean_volume_psnr_db"), 5.0);
+  EXPECT_GT(JsonNumber(report, "mean_volume_silhouette_iou"), 0.5);
+  ASSERT_TRUE(fs::is_regular_file(out + "/holdout/mesh.ply"));
+  // --model scores a given PLY on the same held-out views: the mesh it wrote scores as it did.
+  const std::string again = project + "/out_model";
+  ASSERT_EQ(Run("holdout --workspace_path " + project + " --output_path " + again +
+                    " --resolution 48 --every 4 --mask_path " + project + "/masks --model " + out +
+                    "/holdout/mesh.ply",
+                &output),
+            0)
+      << output;
+  const std::string scored = testing::ReadFileBytes(again + "/holdout/holdout.json");
+  EXPECT_NEAR(JsonNumber(scored, "mean_psnr_db"), JsonNumber(report, "mean_psnr_db"), 0.01);
+  EXPECT_NEAR(JsonNumber(scored, "mean_silhouette_iou"), JsonNumber(report, "mean_silhouette_iou"),
+              0.001);
+  ExpectUserError("holdout --workspace_path " + project + " --output_path " + again +
+                      " --model " + project + "/missing.ply",
+                  {"missing.ply", "not found"});
   ExpectUserError("holdout --workspace_path " + project + " --output_path " + out + " --every 1",
                   {"--every must be at least 2"});
 }

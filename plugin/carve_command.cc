@@ -573,6 +573,10 @@ int RunCarve(int argc, char** argv) {
                       : "");
     sparse_line = text;
   }
+  size_t judged_voxels = 0;
+  for (const ColouredVoxel& voxel : run.result->surface) {
+    judged_voxels += voxel.num_views >= request.options.min_views;
+  }
   std::string level_line;
   for (const LevelStatistics& level : s.levels) {
     char text[96];
@@ -593,7 +597,7 @@ int RunCarve(int argc, char** argv) {
       " %lld evaluations\n"
       "  levels          %zu (%s)\n"
       "  convergence     %.2f s (+ %.2f s set-up), peak memory %.1f MiB\n"
-      "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more (cloud.ply)\n"
+      "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more\n"
       "  sparse points   %s\n"
       "  outputs         %s/cloud.ply (%zu points), mesh.ply (%zu triangles),\n"
       "                  report.json, convergence.csv\n"
@@ -604,7 +608,7 @@ int RunCarve(int argc, char** argv) {
       static_cast<long long>(s.component_carved), static_cast<long long>(s.evaluated),
       s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds,
       s.peak_memory_bytes / (1024.0 * 1024.0), static_cast<long long>(s.final_surface),
-      static_cast<long long>(s.visible_surface), run.num_cloud_points, request.options.min_views,
+      static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,
       sparse_line.c_str(), run.output_path.c_str(), run.num_cloud_points,
       run.num_mesh_triangles, run.output_path.c_str());
   if (s.final_solid == 0 || s.visible_surface == 0) {

@@ -72,8 +72,10 @@ class BinaryReader {
 
   void ExpectEnd() {
     if (stream_.peek() != std::char_traits<char>::eof()) {
+      // kind_ is unset when the count is 0 and no record was read.
       throw InputError(source_ + ": trailing data after the " + std::to_string(count_) + " " +
-                       kind_ + " records that the count field announces (wrong count?)");
+                       (kind_ != nullptr ? std::string(kind_) + " " : std::string()) +
+                       "records that the count field announces (wrong count?)");
     }
   }
 

@@ -140,6 +140,14 @@ std::vector<Eigen::Vector3f> ReadComparablePoints(const std::string& path, int m
   pcl::PointCloud<pcl::PointXYZ> vertices;
   pcl::fromPCLPointCloud2(mesh.cloud, vertices);
   std::vector<Eigen::Vector3f> points;
+  // PCL's k-d tree aborts on a non-finite point: such a file is refused by name.
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    const pcl::PointXYZ& p = vertices[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      throw InputError(path + ": vertex " + std::to_string(i) +
+                       " has a non-finite coordinate (NaN or infinity)");
+    }
+  }
   if (mesh.polygons.empty()) {
     for (const pcl::PointXYZ& p : vertices) points.emplace_back(p.x, p.y, p.z);
   } else {

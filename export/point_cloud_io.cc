@@ -1,5 +1,6 @@
 #include "export/point_cloud_io.h"
 
+#include <cmath>
 #include <fstream>
 
 #include <filesystem>
@@ -109,6 +110,10 @@ std::vector<ColouredPoint> ReadPointCloudPly(const std::string& path) {
   std::vector<ColouredPoint> points;
   points.reserve(cloud.size());
   for (const pcl::PointXYZRGBNormal& p : cloud) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      throw InputError(path + ": vertex " + std::to_string(points.size()) +
+                       " has a non-finite coordinate (NaN or infinity)");
+    }
     ColouredPoint point;
     point.xyz = Eigen::Vector3f(p.x, p.y, p.z);
     point.normal = Eigen::Vector3f(p.normal_x, p.normal_y, p.normal_z);

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -105,6 +107,36 @@ TEST_F(CommandLine, CorruptedCountAndUnknownCameraModelAreNamed) {
   testing::WriteFile(model + "/cameras.bin", bytes);
   ExpectUserError("model_info --input_path " + model,
                   {model + "/cameras.bin", "camera 1", "model_id", "EUCM"});
+
+  // A count of 0 followed by any byte (found by fuzzing: it crashed before any record was read).
+  for (const char* file : {"cameras.bin", "images.bin", "points3D.bin"}) {
+    model = CopyModel(std::string("zero_count_") + file);
+    testing::WriteFile(model + "/" + file, std::string(8, '\0') + "x");
+    ExpectUserError("model_info --input_path " + model,
+                    {model + "/" + file, "trailing data after the 0 records"});
+  }
+}
+
+TEST_F(CommandLine, APointCloudWithANonFiniteCoordinateIsNamedNotAborted) {
+  // Found by fuzzing: PCL's k-d tree aborted the process on a NaN.
+  const std::string folder = *root_ + "/nan_cloud";
+  fs::create_directories(folder);
+  // Binary little-endian, so that the NaN and the infinity are exact.
+  auto write_cloud = [](const std::string& path, std::vector<float> xyz) {
+    std::string bytes =
+        "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(xyz.size() / 3) +
+        "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    bytes.append(reinterpret_cast<const char*>(xyz.data()), xyz.size() * sizeof(float));
+    testing::WriteFile(path, bytes);
+  };
+  const float nan = std::nanf(""), inf = std::numeric_limits<float>::infinity();
+  write_cloud(folder + "/good.ply", {0, 0, 0, 1, 0, 0, 0, 1, 0});
+  write_cloud(folder + "/nan.ply", {0, 0, 0, nan, 0, 0, 0, 1, 0});
+  write_cloud(folder + "/inf.ply", {0, 0, 0, 1, 0, 0, 0, inf, 0});
+  ExpectUserError("compare --reference " + folder + "/good.ply --input " + folder + "/nan.ply",
+                  {folder + "/nan.ply", "vertex 1", "non-finite"});
+  ExpectUserError("compare --reference " + folder + "/inf.ply --input " + folder + "/good.ply",
+                  {folder + "/inf.ply", "vertex 2", "non-finite"});
 }
 
 TEST_F(CommandLine, NaNPoseIsNamed) {

@@ -18,6 +18,10 @@ namespace raycarve {
 // (fx = k11, fy = k22, principal point (k13, k23) + principal_point_offset) with
 // cam_from_world = (R, t); images with identical intrinsics and size share a camera. The model
 // has no 3D points.
+// How far (largest entry of |R R^T - I|) a rotation read from a file may be from orthonormal:
+// the files print it to about 7 significant digits.
+constexpr double kRotationTolerance = 1e-4;
+
 struct MiddleburyImportOptions {
   // Added to (k13, k23) to reach COLMAP's convention. 0.5 reads the file as indexing pixel
   // centres at integers (the usual convention for such K); 0 copies K literally.

@@ -62,11 +62,29 @@ TEST(Middlebury, BadFilesNameTheLineAndField) {
   ExpectError("1\na.png 1500 0 300 0 1510 250 0 0 1 1 0 0 0 1 0 0 0 1 0.1 x 0.6\n", {"line 2", "'t2'", "'x'"});
   ExpectError("1\na.png 1500 2 300 0 1510 250 0 0 1 1 0 0 0 1 0 0 0 1 0.1 0.2 0.6\n", {"line 2", "skew"});
   ExpectError("1\na.png 1500 0 300 0 1510 250 0 0 1 1 0 0 0 2 0 0 0 1 0.1 0.2 0.6\n", {"line 2", "not a rotation"});
+  // Off by 1e-3 is not a rotation printed to 7 digits.
+  ExpectError("1\na.png 1500 0 300 0 1510 250 0 0 1 1 0.001 0 0 1 0 0 0 1 0.1 0.2 0.6\n", {"not a rotation"});
   // A reflection is orthonormal but not a rotation.
   ExpectError("1\na.png 1500 0 300 0 1510 250 0 0 1 -1 0 0 0 1 0 0 0 1 0.1 0.2 0.6\n", {"not a rotation"});
   ExpectError("1\na.png 1500 0 300 0 1510 250 0 0 1 1 0 0 0 1 0 0 0 1 0.1 nan 0.6\n", {"'t2'"});
   ExpectError("2\na.png 1 0 3 0 1 2 0 0 1 1 0 0 0 1 0 0 0 1 0 0 1\na.png 1 0 3 0 1 2 0 0 1 1 0 0 0 1 0 0 0 1 0 0 1\n",
               {"duplicate", "a.png"});
+}
+
+TEST(Middlebury, RotationsPrintedToSevenDigitsAreTakenAndOrthonormalised) {
+  // A rotation about z by 0.3 rad, printed to 7 significant digits (|R R^T - I| about 1e-7) and
+  // then nudged by 2e-6, as the shipped dinoR_par.txt is.
+  const double c = std::cos(0.3), s = std::sin(0.3);
+  char line[512];
+  std::snprintf(line, sizeof(line),
+                "1\na.png 1500 0 300 0 1510 250 0 0 1 %.7g %.7g 0 %.7g %.7g 0 0 0 1.000002 0.1 0.2 0.6\n",
+                c, -s, s, c);
+  std::istringstream stream(line);
+  const Reconstruction model = ReadMiddleburyParameters(stream, "x_par.txt", Vga, MiddleburyImportOptions());
+  const Eigen::Matrix3d R = model.images.begin()->second.cam_from_world.rotation.toRotationMatrix();
+  EXPECT_LT((R * R.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(R(0, 0), c, 1e-5);
+  EXPECT_NEAR(R(1, 0), s, 1e-5);
 }
 
 TEST(Middlebury, MissingPhotoIsNamed) {
@@ -78,6 +96,20 @@ TEST(Middlebury, MissingPhotoIsNamed) {
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find(empty + "/templeSR0001.png"), std::string::npos)
         << error.what();
+  }
+}
+
+// Every shipped calibration imports (dinoR and dinoSR print rotations orthonormal to 1.6e-6).
+TEST(Middlebury, EveryShippedCalibrationImports) {
+  RAYCARVE_REQUIRE_DATA("middlebury");
+  const std::pair<const char*, size_t> sets[] = {
+      {"templeSparseRing/templeSR_par.txt", 16}, {"dinoSparseRing/dinoSR_par.txt", 16},
+      {"dinoRing/dinoR_par.txt", 48}};
+  for (const auto& [file, images] : sets) {
+    const std::string path = data_path + "/" + file;
+    const std::string folder = path.substr(0, path.rfind('/'));
+    const Reconstruction model = ImportMiddlebury(path, folder, MiddleburyImportOptions());
+    EXPECT_EQ(model.images.size(), images) << file;
   }
 }
 

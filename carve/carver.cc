@@ -212,6 +212,7 @@ bool CarveOptions::IsValid(std::string* reason) const {
     *reason = "threshold must be a finite number";
     return false;
   }
+
   if (!std::isfinite(adaptive_threshold) || adaptive_threshold < 0.0) {
     *reason = "adaptive_threshold must be a finite number >= 0";
     return false;

@@ -515,8 +515,10 @@ void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
   } else {
     char* end = nullptr;
     const double value = std::strtod(text.threshold.c_str(), &end);
-    if (text.threshold.empty() || end == nullptr || *end != '\0' || !std::isfinite(value)) {
-      throw InputError("--threshold: threshold must be a finite number or auto, got '" + text.threshold + "'");
+    if (text.threshold.empty() || end == nullptr || *end != '\0' || !std::isfinite(value) ||
+        value < 0.0) {
+      throw InputError("--threshold: threshold must be a finite number >= 0 (0: no voxel is "
+                       "consistent) or auto, got '" + text.threshold + "'");
     }
     request->options.auto_threshold = false;
     request->options.threshold = value;
@@ -532,6 +534,11 @@ void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
   std::string reason;
   if (!request->view_options.background.IsValid(&reason)) throw InputError(reason);
   if (!request->options.IsValid(&reason)) throw InputError(reason);
+  if (request->options.num_threads != -1 &&
+      (request->options.num_threads < 1 || request->options.num_threads > 1024)) {
+    throw InputError("--num_threads: must be -1 (every core) or 1 to 1024, got " +
+                     std::to_string(request->options.num_threads));
+  }
   if (request->mesh_max_faces > static_cast<uint64_t>(std::numeric_limits<int32_t>::max())) {
     throw InputError("--mesh_max_faces: at most " +
                      std::to_string(std::numeric_limits<int32_t>::max()) + ", got " +

@@ -44,6 +44,13 @@ void ValidateCamera(const Camera& camera, const std::string& context) {
     throw InputError(prefix.str() + ": width/height must be positive, found " +
                      std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
+  // OpenCV decodes no photo of more than 2^30 pixels (CV_IO_MAX_IMAGE_PIXELS); a camera larger
+  // than any photo it could have taken is a broken file, refused before anything is allocated.
+  if (static_cast<uint64_t>(camera.width) * camera.height > kMaxCameraPixels) {
+    throw InputError(prefix.str() + ": width/height " + std::to_string(camera.width) + "x" +
+                     std::to_string(camera.height) + " is more than " +
+                     std::to_string(kMaxCameraPixels) + " pixels, larger than any photo can be read");
+  }
   if (!(camera.FocalLengthX() > 0.0) || !(camera.FocalLengthY() > 0.0)) {
     throw InputError(prefix.str() + ": focal length must be positive");
   }

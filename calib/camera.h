@@ -31,5 +31,7 @@ struct Camera {
 // Throws InputError, prefixed with `context` (file and camera), when the camera cannot be used:
 // wrong number of parameters, a non-finite parameter, a non-positive focal length or image size.
 void ValidateCamera(const Camera& camera, const std::string& context);
+// The most pixels a camera may have (ValidateCamera): OpenCV's default CV_IO_MAX_IMAGE_PIXELS.
+constexpr uint64_t kMaxCameraPixels = uint64_t{1} << 30;
 
 }  // namespace raycarve

@@ -12,6 +12,7 @@
 #include <glog/logging.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "calib/image_reader.h"
 #include "calib/input_error.h"
 
 namespace raycarve {
@@ -158,7 +159,7 @@ Reconstruction ImportMiddlebury(const std::string& par_path,
     if (!std::filesystem::is_regular_file(path)) {
       throw InputError(path + ": photo named in " + par_path + " not found");
     }
-    const cv::Mat photo = cv::imread(path, cv::IMREAD_UNCHANGED);
+    const cv::Mat photo = ReadImage(path, cv::IMREAD_UNCHANGED);
     if (photo.empty()) throw InputError(path + ": cannot be decoded as an image");
     return Eigen::Vector2i(photo.cols, photo.rows);
   };

@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/image_reader.h"
 #include "calib/input_error.h"
 
 namespace raycarve {
@@ -47,7 +48,7 @@ std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruc
       throw InputError(path + ": photo of image " + std::to_string(image_id) + " ('" +
                        image.name + "') not found");
     }
-    const cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);
+    const cv::Mat bgr = ReadImage(path, cv::IMREAD_COLOR);
     if (bgr.empty()) {
       throw InputError(path + ": photo of image " + std::to_string(image_id) +
                        " cannot be decoded as an image");
@@ -65,7 +66,7 @@ std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruc
         throw InputError(colmap_style + ": mask of image " + std::to_string(image_id) +
                          " not found (nor " + same_name + ")");
       }
-      mask = cv::imread(mask_file, cv::IMREAD_GRAYSCALE);
+      mask = ReadImage(mask_file, cv::IMREAD_GRAYSCALE);
       if (mask.empty()) throw InputError(mask_file + ": mask cannot be decoded as an image");
       ++summary->masks_from_files;
     } else if (options.background.mode != BackgroundOptions::Mode::kNone) {

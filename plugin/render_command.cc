@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/image_reader.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
 #include "export/point_cloud_io.h"
@@ -54,7 +55,7 @@ int RunRender(int argc, char** argv) {
     std::string source = "(no photo)";
     if (!image_path.empty()) {
       source = image_path + "/" + image.name;
-      const cv::Mat bgr = cv::imread(source, cv::IMREAD_COLOR);
+      const cv::Mat bgr = ReadImage(source, cv::IMREAD_COLOR);
       if (bgr.empty()) throw InputError(source + ": cannot read the photo of image " + image.name);
       cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
     }

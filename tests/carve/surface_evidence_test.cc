@@ -44,7 +44,7 @@ TEST(GatherVoxelPixels, CountsExactlyThePixelsWhoseRayMeetsTheCube) {
   const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(3, 80, 60));
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
   const VoxelGrid grid(scene.object_box, 12);
-  for (const Eigen::Vector3i voxel : {Eigen::Vector3i(2, 3, 1), Eigen::Vector3i(6, 6, 2)}) {
+  for (const Eigen::Vector3i& voxel : {Eigen::Vector3i(2, 3, 1), Eigen::Vector3i(6, 6, 2)}) {
     for (const CalibratedView& view : views) {
       ViewColourStats stats;
       GatherVoxelPixels(view, grid, voxel, &stats);

@@ -117,6 +117,37 @@ TEST_F(CommandLine, CorruptedCountAndUnknownCameraModelAreNamed) {
   }
 }
 
+TEST_F(CommandLine, SizesAFileAnnouncesAreCheckedBeforeAnythingIsAllocated) {
+  // A camera of 200000 x 200000 pixels (found by fuzzing: render allocated a 120 GB image).
+  const std::string model = CopyModel("huge_camera");
+  std::string bytes = testing::ReadFileBytes(model + "/cameras.bin");
+  const uint64_t side = 200000;
+  bytes.replace(8 + 4 + 4, 8, reinterpret_cast<const char*>(&side), 8);
+  bytes.replace(8 + 4 + 4 + 8, 8, reinterpret_cast<const char*>(&side), 8);
+  testing::WriteFile(model + "/cameras.bin", bytes);
+  ExpectUserError("model_info --input_path " + model,
+                  {model, "camera 1", "200000x200000", "larger than any photo"});
+
+  // A PNG whose header claims 60000 x 60000 pixels: OpenCV refuses it, and the photo is named.
+  const std::string project = *root_ + "/huge_png";
+  fs::remove_all(project);
+  fs::copy(Project(), project, fs::copy_options::recursive);
+  const std::string huge(
+      "\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x00\xea\x60\x00"
+      "\x00\xea\x60\x08\x02\x00\x00\x00\x0f\xb0\xe2\x15\x00\x00\x00\x0b\x49\x44\x41\x54\x78"
+      "\x9c\x63\x60\x40\x05\x00\x00\x10\x00\x01\x39\xbd\x8f\x65\x00\x00\x00\x00\x49\x45\x4e"
+      "\x44\xae\x42\x60\x82",
+      68);
+  std::string first_photo;
+  for (const auto& entry : fs::directory_iterator(project + "/images")) {
+    if (first_photo.empty() || entry.path().string() < first_photo) first_photo = entry.path().string();
+  }
+  ASSERT_FALSE(first_photo.empty());
+  testing::WriteFile(first_photo, huge);
+  ExpectUserError("carve --workspace_path " + project + " --output_path " + project + "/out",
+                  {first_photo, "OpenCV refuses to decode it"});
+}
+
 TEST_F(CommandLine, APointCloudWithANonFiniteCoordinateIsNamedNotAborted) {
   // Found by fuzzing: PCL's k-d tree aborted the process on a NaN.
   const std::string folder = *root_ + "/nan_cloud";

@@ -189,9 +189,18 @@ int RunCalibrate(int argc, char** argv) {
   if (write_undistorted) {
     // COLMAP's conventions: photos keep their names (and format), masks are <name>.png.
     const std::filesystem::path root(output_path);
+    std::vector<std::pair<std::string, std::string>> inputs = {
+        {project.model_path, "input model"}, {project.image_path, "photo folder"}};
+    if (!view_options.mask_path.empty()) inputs.emplace_back(view_options.mask_path, "mask folder");
+    // Every name checked before the first file is written.
     for (const CalibratedView& view : views) {
-      const std::filesystem::path photo = root / "undistorted" / view.name;
-      const std::filesystem::path mask = root / "masks" / (view.name + ".png");
+      OutputFileInside((root / "undistorted").string(), view.name, inputs);
+      OutputFileInside((root / "masks").string(), view.name + ".png", inputs);
+    }
+    for (const CalibratedView& view : views) {
+      const std::filesystem::path photo = OutputFileInside((root / "undistorted").string(), view.name, inputs);
+      const std::filesystem::path mask =
+          OutputFileInside((root / "masks").string(), view.name + ".png", inputs);
       std::filesystem::create_directories(photo.parent_path(), error);
       std::filesystem::create_directories(mask.parent_path(), error);
       if (error) throw InputError(mask.parent_path().string() + ": cannot create: " + error.message());

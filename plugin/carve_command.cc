@@ -56,6 +56,19 @@ CarveRun CarveProject(const CarveRequest& request) {
   if (!CheckCarveFits(views, run.bounds.box, request.options, &reason)) {
     throw InputError("raycarve carve: " + reason);
   }
+  // What the outputs must never land in, checked before the work starts: the masks written
+  // under <output>/masks must not replace the user's.
+  std::vector<std::pair<std::string, std::string>> inputs = {
+      {project.model_path, "input model"}, {project.image_path, "photo folder"}};
+  if (!request.view_options.mask_path.empty()) {
+    inputs.emplace_back(request.view_options.mask_path, "mask folder");
+  }
+  for (const CalibratedView& view : views) {
+    if (!view.mask.empty()) {
+      OutputFileInside((std::filesystem::path(run.output_path) / "masks").string(),
+                       view.name + ".png", inputs);
+    }
+  }
   stage = Clock::now();
   const VoxelGrid grid(run.bounds.box, request.options.resolution);
   const ViewReaderSummary& masks = project.view_summary;
@@ -181,7 +194,8 @@ CarveRun CarveProject(const CarveRequest& request) {
   // The masks used, so that a user can check them: undistorted, as the carving saw them.
   for (const CalibratedView& view : views) {
     if (view.mask.empty()) continue;
-    const std::filesystem::path mask_path = out / "masks" / (view.name + ".png");
+    const std::filesystem::path mask_path =
+        OutputFileInside((out / "masks").string(), view.name + ".png", inputs);
     std::filesystem::create_directories(mask_path.parent_path(), error);
     if (error) throw InputError(mask_path.parent_path().string() + ": cannot create: " + error.message());
     WriteImageAtomically(mask_path.string(), view.mask);

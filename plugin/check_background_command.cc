@@ -34,6 +34,14 @@ int RunCheckBackground(int argc, char** argv) {
     throw InputError("raycarve check_background: needs masks: --mask_path, or --background_colour auto|R,G,B");
   }
   const WorkspacePaths paths = ResolveWorkspace(workspace_path, input_path, image_path);
+  if (!output_path.empty()) {
+    CheckOutputFileOutside(output_path, cloud, "input cloud");
+    CheckOutputFileOutside(output_path, paths.model_path, "input model");
+    CheckOutputFileOutside(output_path, paths.image_path, "photo folder");
+    if (!view_options.mask_path.empty()) {
+      CheckOutputFileOutside(output_path, view_options.mask_path, "mask folder");
+    }
+  }
   const std::vector<CalibratedView> views =
       ReadCalibratedViews(ReadModel(paths.model_path), paths.image_path, view_options, nullptr);
   std::vector<Eigen::Vector3f> points;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <filesystem>
 #include <string>
 
 #include <memory>
@@ -186,5 +187,16 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run);
 void CheckOutputDoesNotOverwrite(const std::string& output_path,
                                  const std::string& input_path,
                                  const std::string& what);
+// Throws InputError when the output file or folder `output_file` is `input_path` or lies inside
+// it (a folder), after resolving links, dots and trailing slashes.
+void CheckOutputFileOutside(const std::string& output_file,
+                            const std::string& input_path,
+                            const std::string& what);
+// The path of an output named after an image (`relative_name`, e.g. "<name>.png") under
+// `folder`. Throws InputError when the name is absolute or escapes `folder` through "..", or
+// when the path lies inside one of `inputs` (path, what it is).
+std::filesystem::path OutputFileInside(const std::string& folder,
+                                       const std::string& relative_name,
+                                       const std::vector<std::pair<std::string, std::string>>& inputs);
 
 }  // namespace raycarve

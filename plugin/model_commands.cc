@@ -96,6 +96,39 @@ void CheckOutputDoesNotOverwrite(const std::string& output_path,
   }
 }
 
+void CheckOutputFileOutside(const std::string& output_file,
+                            const std::string& input_path,
+                            const std::string& what) {
+  if (output_file.empty() || input_path.empty()) return;
+  namespace fs = std::filesystem;
+  const fs::path output = fs::weakly_canonical(output_file);
+  const fs::path input = fs::weakly_canonical(input_path);
+  // The output is the input, or lies inside it (a folder), through links, dots and slashes.
+  const auto [input_end, output_at] = std::mismatch(input.begin(), input.end(), output.begin(), output.end());
+  if (input_end == input.end()) {
+    throw InputError(output_file + ": the output " +
+                     (output == input ? std::string("is the ") : std::string("lies inside the ")) +
+                     what + " (" + input_path +
+                     "); raycarve never overwrites its input, choose another --output_path");
+  }
+}
+
+std::filesystem::path OutputFileInside(const std::string& folder,
+                                       const std::string& relative_name,
+                                       const std::vector<std::pair<std::string, std::string>>& inputs) {
+  namespace fs = std::filesystem;
+  const fs::path name(relative_name);
+  const fs::path root = fs::weakly_canonical(folder);
+  const fs::path path = fs::weakly_canonical(root / name);
+  const auto [root_end, path_at] = std::mismatch(root.begin(), root.end(), path.begin(), path.end());
+  if (name.is_absolute() || root_end != root.end() || path == root) {
+    throw InputError(folder + ": the image name '" + relative_name +
+                     "' would write outside this output folder; raycarve refuses it");
+  }
+  for (const auto& [input, what] : inputs) CheckOutputFileOutside(path.string(), input, what);
+  return path;
+}
+
 std::string DescribeModelText(const Reconstruction& reconstruction,
                               const std::string& model_path,
                               const Bounds& bounds) {
@@ -202,7 +235,7 @@ int RunModelInfo(int argc, char** argv) {
   const std::string json = DescribeModelJson(reconstruction, input_path, bounds);
   std::cout << (format == "json" ? json : DescribeModelText(reconstruction, input_path, bounds));
   if (!output_path.empty()) {
-    CheckOutputDoesNotOverwrite(output_path, input_path, "input model");
+    CheckOutputFileOutside(output_path, input_path, "input model");
     WriteTextFileAtomically(output_path, json);
   }
   return 0;

@@ -148,6 +148,59 @@ TEST_F(CommandLine, SizesAFileAnnouncesAreCheckedBeforeAnythingIsAllocated) {
                   {first_photo, "OpenCV refuses to decode it"});
 }
 
+TEST_F(CommandLine, NoOutputLandsInAnInputOrOutsideItsFolder) {
+  // model_info's JSON inside the model it describes (it replaced images.bin).
+  const std::string model = CopyModel("write_into_model");
+  const std::string images_bin = testing::ReadFileBytes(model + "/images.bin");
+  ExpectUserError("model_info --input_path " + model + " --output_path " + model + "/images.bin",
+                  {model + "/images.bin", "lies inside the input model", "never overwrites"});
+  ExpectUserError("model_info --input_path " + model + " --output_path " + model + "/../" +
+                      fs::path(model).filename().string() + "/info.json",
+                  {"lies inside the input model"});
+  EXPECT_EQ(testing::ReadFileBytes(model + "/images.bin"), images_bin);
+
+  // A carve's masks over the user's masks: refused before the carve starts.
+  const std::string project = *root_ + "/masks_project";
+  fs::remove_all(project);
+  fs::copy(Project(), project, fs::copy_options::recursive);
+  ASSERT_TRUE(fs::is_directory(project + "/masks"));
+  ExpectUserError("carve --workspace_path " + project + " --output_path " + project +
+                      " --mask_path " + project + "/masks --resolution 16",
+                  {"lies inside the mask folder", project + "/masks"});
+
+  // check_background's JSON over the cloud it checks.
+  std::string output;
+  ASSERT_EQ(Run("carve --workspace_path " + project + " --output_path " + project +
+                    "/carved --resolution 16",
+                &output),
+            0)
+      << output;
+  const std::string cloud = project + "/carved/cloud.ply";
+  ExpectUserError("check_background --input " + cloud + " --workspace_path " + project +
+                      " --mask_path " + project + "/masks --output_path " + cloud,
+                  {"is the input cloud"});
+
+  // calibrate writing undistorted photos into the photo folder they come from.
+  fs::copy(project + "/images", project + "/undistorted", fs::copy_options::recursive);
+  ExpectUserError("calibrate --input_path " + project + "/sparse/0 --image_path " + project +
+                      "/undistorted --output_path " + project + " --skip_missing_images 1",
+                  {"lies inside the photo folder"});
+
+  // An image name that climbs out of the folder its outputs go to.
+  const std::string escape = CopyModel("escaping_name", "TXT");
+  std::string text = testing::ReadFileBytes(escape + "/images.txt");
+  const size_t at = text.find("view001.png");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 11, "../escaped.png");
+  testing::WriteFile(escape + "/images.txt", text);
+  fs::copy_file(project + "/images/view001.png", project + "/escaped.png",
+                fs::copy_options::overwrite_existing);
+  ExpectUserError("calibrate --input_path " + escape + " --image_path " + project +
+                      "/images --output_path " + *root_ + "/escaping_out",
+                  {"'../escaped.png'", "would write outside"});
+  EXPECT_FALSE(fs::exists(*root_ + "/escaping_out/escaped.png"));
+}
+
 TEST_F(CommandLine, APointCloudWithANonFiniteCoordinateIsNamedNotAborted) {
   // Found by fuzzing: PCL's k-d tree aborted the process on a NaN.
   const std::string folder = *root_ + "/nan_cloud";

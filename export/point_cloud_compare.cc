@@ -15,6 +15,7 @@
 #include <pcl/point_types.h>
 
 #include "calib/input_error.h"
+#include "export/point_cloud_io.h"
 
 namespace raycarve {
 namespace exporter {
@@ -133,6 +134,7 @@ double MedianNeighbourSpacing(const std::vector<Eigen::Vector3f>& points) {
 
 std::vector<Eigen::Vector3f> ReadComparablePoints(const std::string& path, int mesh_samples) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": file not found");
+  if (CheckPlyHeader(path) == 0) throw InputError(path + ": no points to compare");
   pcl::PolygonMesh mesh;
   if (pcl::io::loadPLYFile(path, mesh) != 0) {
     throw InputError(path + ": PCL could not read it as a PLY point cloud or mesh");

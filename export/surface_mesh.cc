@@ -31,6 +31,7 @@
 
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
+#include "export/point_cloud_io.h"
 
 // A mesh vertex as the PLY holds it: position, normal, colour (PCL packs red, green and blue into
 // one float field named rgb and writes them as three uchar properties).
@@ -359,6 +360,7 @@ MeshTopology AnalyseTopology(const TriangleMesh& mesh) {
 
 TriangleMesh ReadMeshOrCloudPly(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": file not found");
+  if (CheckPlyHeader(path) == 0) throw InputError(path + ": no vertices to draw");
   pcl::PolygonMesh polygon_mesh;
   const pcl::console::VERBOSITY_LEVEL verbosity = pcl::console::getVerbosityLevel();
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);

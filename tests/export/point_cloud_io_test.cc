@@ -77,3 +77,87 @@ TEST(PointCloudIo, MissingOrBrokenFilesAreNamed) {
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+// Expects CheckPlyHeader (and the reader) to refuse `bytes` with a message holding `part`.
+void ExpectHeaderRefused(const std::string& bytes, const std::string& part) {
+  const std::string folder = testing::MakeTemporaryDirectory("ply_header");
+  const std::string path = folder + "/cloud.ply";
+  testing::WriteFile(path, bytes);
+  for (int reader = 0; reader < 2; ++reader) {
+    try {
+      if (reader == 0) {
+        CheckPlyHeader(path);
+      } else {
+        ReadPointCloudPly(path);
+      }
+      ADD_FAILURE() << "accepted: " << bytes.substr(0, 200);
+    } catch (const InputError& error) {
+      const std::string message = error.what();
+      EXPECT_NE(message.find(path), std::string::npos) << message;
+      EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+    }
+  }
+  std::filesystem::remove_all(folder);
+}
+
+const char kXyz[] = "property float x\nproperty float y\nproperty float z\n";
+
+TEST(PlyHeader, CountsTheFileCannotHoldAreRefusedBeforeAnyAllocation) {
+  // Found by fuzzing: 333333333 vertices announced in a 120-byte file made PCL take 4 GB.
+  ExpectHeaderRefused(std::string("ply\nformat binary_little_endian 1.0\nelement vertex 333333333\n") +
+                          kXyz + "end_header\n" + std::string(24, '\0'),
+                      "announces 333333333 records");
+  ExpectHeaderRefused(std::string("ply\nformat ascii 1.0\nelement vertex 1000\n") + kXyz +
+                          "end_header\n0 0 0\n",
+                      "announces 1000 records");
+  // And a face element whose lists cannot fit either.
+  ExpectHeaderRefused(std::string("ply\nformat binary_little_endian 1.0\nelement vertex 1\n") + kXyz +
+                          "element face 99999999\nproperty list uchar int vertex_indices\nend_header\n" +
+                          std::string(12, '\0'),
+                      "'face' announces 99999999");
+  // Found by fuzzing: an obj_info grid of 10000 x 10000 made render draw 100000000 points.
+  ExpectHeaderRefused(std::string("ply\nformat binary_little_endian 1.0\nobj_info num_cols 10000\n"
+                                  "obj_info num_rows 10000\nelement vertex 1\n") +
+                          kXyz + "end_header\n" + std::string(12, '\0'),
+                      "num_cols x num_rows");
+}
+
+TEST(PlyHeader, BrokenHeadersAndMissingCoordinatesAreNamed) {
+  ExpectHeaderRefused("plx\n", "not a PLY file");
+  ExpectHeaderRefused(std::string("ply\nformat binary_little_endian 1.0\nelement vertex 1\n") + kXyz,
+                      "no end_header");
+  ExpectHeaderRefused(std::string("ply\nformat binary_middle_endian 1.0\nelement vertex 1\n") + kXyz +
+                          "end_header\n",
+                      "format 'binary_middle_endian'");
+  ExpectHeaderRefused(std::string("ply\nformat ascii 1.0\nelement vertex 2\nproperty float a\n"
+                                  "property float b\nend_header\n1 2\n3 4\n"),
+                      "no x, y and z");
+  ExpectHeaderRefused(std::string("ply\nformat ascii 1.0\nelement vertex -3\n") + kXyz + "end_header\n",
+                      "no valid count");
+  ExpectHeaderRefused(std::string("ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\n"
+                                  "end_header\n0\n"),
+                      "'float128'");
+}
+
+TEST(PlyHeader, WellFormedFilesPassWithTheirVertexCount) {
+  const std::string folder = testing::MakeTemporaryDirectory("ply_header_ok");
+  std::vector<ColouredPoint> points(5);
+  for (int i = 0; i < 5; ++i) points[i].xyz = Eigen::Vector3f(i, 0, 0);
+  WritePointCloudPly(points, folder + "/cloud.ply");
+  EXPECT_EQ(CheckPlyHeader(folder + "/cloud.ply"), 5u);
+  testing::WriteFile(folder + "/ascii.ply", std::string("ply\r\nformat ascii 1.0\r\ncomment hi\r\n"
+                                                        "element vertex 2\r\n") +
+                                                "property double x\r\nproperty double y\r\n"
+                                                "property double z\r\nend_header\r\n1 2 3\r\n4 5 6\r\n");
+  EXPECT_EQ(CheckPlyHeader(folder + "/ascii.ply"), 2u);
+  EXPECT_EQ(ReadPointCloudPly(folder + "/ascii.ply").size(), 2u);
+  std::filesystem::remove_all(folder);
+}
+
+}  // namespace
+}  // namespace exporter
+}  // namespace raycarve

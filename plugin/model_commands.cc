@@ -152,9 +152,13 @@ std::string DescribeModelText(const Reconstruction& reconstruction,
         image.points2D.begin(), image.points2D.end(),
         [](const Point2D& p) { return p.point3D_id != kInvalidPoint3DId; });
     const Eigen::Vector3d centre = image.ProjectionCenter();
-    std::snprintf(line, sizeof(line), "  %6u  %-28s %6u %9zu  (%.4g, %.4g, %.4g)\n", id,
-                  image.name.c_str(), image.camera_id, observed, centre.x(), centre.y(),
-                  centre.z());
+    // The name apart: it may be longer than any fixed buffer.
+    std::string name = image.name;
+    if (name.size() < 28) name.append(28 - name.size(), ' ');
+    std::snprintf(line, sizeof(line), "  %6u  ", id);
+    text << line << name;
+    std::snprintf(line, sizeof(line), " %6u %9zu  (%.4g, %.4g, %.4g)\n", image.camera_id, observed,
+                  centre.x(), centre.y(), centre.z());
     text << line;
   }
   text << "points3D: " << reconstruction.points3D.size() << ", mean track length "

@@ -201,6 +201,19 @@ TEST_F(CommandLine, NoOutputLandsInAnInputOrOutsideItsFolder) {
   EXPECT_FALSE(fs::exists(*root_ + "/escaping_out/escaped.png"));
 }
 
+TEST_F(CommandLine, ModelInfoListsImageNamesOfAnyLength) {
+  const std::string model = CopyModel("long_name", "TXT");
+  std::string text = testing::ReadFileBytes(model + "/images.txt");
+  const size_t at = text.find("view001.png");
+  ASSERT_NE(at, std::string::npos);
+  const std::string name = std::string(300, 'n') + ".png";
+  text.replace(at, 11, name);
+  testing::WriteFile(model + "/images.txt", text);
+  std::string output;
+  ASSERT_EQ(Run("model_info --input_path " + model, &output), 0) << output;
+  EXPECT_NE(output.find(name + " "), std::string::npos) << output;
+}
+
 TEST_F(CommandLine, APointCloudWithANonFiniteCoordinateIsNamedNotAborted) {
   // Found by fuzzing: PCL's k-d tree aborted the process on a NaN.
   const std::string folder = *root_ + "/nan_cloud";

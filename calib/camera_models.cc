@@ -190,8 +190,9 @@ CameraModelId CameraModelIdFromInt(int model_id, const std::string& context) {
   }
   std::ostringstream message;
   message << context << ": camera model id " << model_id;
-  const int newer = model_id - kFirstNewerModelId;
-  if (newer >= 0 && newer < static_cast<int>(sizeof(kNewerModels) / sizeof(kNewerModels[0]))) {
+  // In 64 bits: ids near INT_MIN must not overflow (found by fuzzing).
+  const int64_t newer = static_cast<int64_t>(model_id) - kFirstNewerModelId;
+  if (newer >= 0 && newer < static_cast<int64_t>(sizeof(kNewerModels) / sizeof(kNewerModels[0]))) {
     message << " (" << kNewerModels[newer] << ", from a COLMAP newer than 3.8)";
   }
   message << " is not supported; raycarve reads COLMAP 3.8's models 0-10 "

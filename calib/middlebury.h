@@ -33,7 +33,7 @@ struct MiddleburyImportOptions {
 // `image_size(name)` returns (width, height) of the named photo. Throws InputError naming
 // `source`, the line and the field on: a bad or missing count, a short line, a malformed number,
 // non-zero skew or k31/k32, k33 != 1, non-positive focal lengths, R not a rotation (orthonormal
-// with determinant +1 within 1e-6), fewer or more lines than the count, duplicate names.
+// with determinant +1 within kRotationTolerance; R is then replaced by the nearest rotation), fewer or more lines than the count, duplicate names.
 Reconstruction ReadMiddleburyParameters(
     std::istream& stream,
     const std::string& source,

@@ -21,14 +21,14 @@ namespace {
 
 // COLMAP's fused.ply vertex: x y z nx ny nz red green blue, in that order. PCL's PLY writer names
 // normal_x "nx" and splits the packed rgb into red, green and blue.
-struct FusedPoint {
+struct EIGEN_ALIGN16 FusedPoint {
   PCL_ADD_POINT4D;
   float normal_x;
   float normal_y;
   float normal_z;
   PCL_ADD_RGB;
   PCL_MAKE_ALIGNED_OPERATOR_NEW
-} EIGEN_ALIGN16;
+};
 
 }  // namespace
 }  // namespace exporter
@@ -155,6 +155,10 @@ uint64_t CheckPlyHeader(const std::string& path) {
       if (type == "list") {
         std::string count_type, item_type;
         words >> count_type >> item_type >> name;
+        if (element.name == "vertex") {
+          throw InputError(path + ": PLY element 'vertex' has a list property ('" + name +
+                           "'), which no reader here takes");
+        }
         element.min_bytes += type_bytes(count_type);
         type_bytes(item_type);
       } else {
@@ -171,6 +175,11 @@ uint64_t CheckPlyHeader(const std::string& path) {
       words >> key >> value;
       if (key == "num_cols") grid_cols = value;
       if (key == "num_rows") grid_rows = value;
+    } else if (keyword != "comment" && !keyword.empty()) {
+      // Found by fuzzing: PCL skips an unknown line and files the properties after it under the
+      // element before, where a list property trips an assertion.
+      throw InputError(path + ": PLY header line '" + line.substr(0, 80) +
+                       "' is not one PLY has (format, element, property, comment, obj_info)");
     }
   }
   if (!ended) throw InputError(path + ": PLY header has no end_header");

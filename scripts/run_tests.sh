@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # README command 2: set-up, build everything, and run every test (CTest, 2 at a time); then the
-# tests that feed raycarve bad input again under AddressSanitizer + UndefinedBehaviorSanitizer.
+# tests that feed raycarve bad input, and the fuzz targets' corpora, again under AddressSanitizer +
+# UndefinedBehaviorSanitizer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -14,6 +15,6 @@ if [ ! -f build-asan/CMakeCache.txt ]; then
 fi
 cmake --build build-asan -j"$jobs" --target raycarve calib_model_reader_test calib_middlebury_test \
   calib_colmap_program_test export_point_cloud_io_test plugin_option_parser_test \
-  plugin_command_line_test >&2
+  plugin_command_line_test fuzz_model_reader fuzz_middlebury fuzz_ply fuzz_option_parser >&2
 (cd build-asan && ctest --output-on-failure --timeout 900 -j"$jobs" \
-  -R 'calib/(model_reader|middlebury|colmap_program)_test|export/point_cloud_io_test|plugin/(option_parser|command_line)_test')
+  -R 'calib/(model_reader|middlebury|colmap_program)_test|export/point_cloud_io_test|plugin/(option_parser|command_line)_test|fuzz/')

@@ -1,6 +1,7 @@
 #include "calib/camera_models.h"
 
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -127,6 +128,10 @@ TEST(CameraModels, NewerModelIdsAreRefusedByName) {
   }
   EXPECT_THROW(CameraModelIdFromInt(99, "x"), InputError);
   EXPECT_THROW(CameraModelIdFromInt(-1, "x"), InputError);
+  // Ids near INT_MIN (found by fuzzing: a signed overflow under UBSan).
+  EXPECT_THROW(CameraModelIdFromInt(std::numeric_limits<int>::min() + 1, "x"), InputError);
+  EXPECT_THROW(CameraModelIdFromInt(std::numeric_limits<int>::min(), "x"), InputError);
+  EXPECT_THROW(CameraModelIdFromInt(std::numeric_limits<int>::max(), "x"), InputError);
   try {
     CameraModelIdFromName("EUCM", "cameras.txt: line 4");
     FAIL() << "EUCM accepted";

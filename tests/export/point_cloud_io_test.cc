@@ -141,6 +141,14 @@ TEST(PlyHeader, BrokenHeadersAndMissingCoordinatesAreNamed) {
   ExpectHeaderRefused(std::string("ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\n"
                                   "end_header\n0\n"),
                       "'float128'");
+  // Found by fuzzing: an unknown line before a face's list made PCL's reader assert.
+  ExpectHeaderRefused(std::string("ply\nformat ascii 1.0\nelement vertex 1\n") + kXyz +
+                          "elementdface 1\nproperty list uchar int vertex_indices\nend_header\n"
+                          "0 0 0\n3 0 0 0\n",
+                      "'elementdface 1' is not one PLY has");
+  ExpectHeaderRefused(std::string("ply\nformat ascii 1.0\nelement vertex 1\n") + kXyz +
+                          "property list uchar int vertex_indices\nend_header\n0 0 0 0\n",
+                      "'vertex' has a list property");
 }
 
 TEST(PlyHeader, WellFormedFilesPassWithTheirVertexCount) {

@@ -26,14 +26,6 @@ namespace {
 
 bool Solid(const Volume& volume, const Eigen::Vector3i& voxel) { return volume.IsSolid(voxel); }
 
-Eigen::Matrix<uint8_t, 3, 1> ToRgb(const Eigen::Vector3f& colour) {
-  Eigen::Matrix<uint8_t, 3, 1> rgb;
-  for (int k = 0; k < 3; ++k) {
-    rgb[k] = static_cast<uint8_t>(std::clamp(std::lround(colour[k]), 0L, 255L));
-  }
-  return rgb;
-}
-
 }  // namespace
 
 std::vector<ColouredPoint> SurfacePoints(const CarveResult& result, int min_views) {

@@ -10,6 +10,7 @@
 
 #include "export/mesh_renderer.h"
 #include "export/parallel_ranges.h"
+#include "export/point_cloud_io.h"
 
 namespace raycarve {
 namespace exporter {
@@ -75,14 +76,6 @@ Eigen::Vector3f RobustColour(const std::vector<Sample>& samples, double outlier_
     weight += samples[i].weight;
   }
   return weight > 0.0f ? Eigen::Vector3f(sum / weight) : median;
-}
-
-Eigen::Matrix<uint8_t, 3, 1> ToRgb(const Eigen::Vector3f& colour) {
-  Eigen::Matrix<uint8_t, 3, 1> rgb;
-  for (int k = 0; k < 3; ++k) {
-    rgb[k] = static_cast<uint8_t>(std::clamp(std::lround(colour[k]), 0L, 255L));
-  }
-  return rgb;
 }
 
 }  // namespace

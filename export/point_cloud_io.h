@@ -1,5 +1,7 @@
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -15,6 +17,15 @@ struct ColouredPoint {
   Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // zero when unknown
   Eigen::Matrix<uint8_t, 3, 1> rgb = Eigen::Matrix<uint8_t, 3, 1>::Zero();
 };
+
+// An RGB colour (0-255, any real values) rounded and clamped to bytes.
+inline Eigen::Matrix<uint8_t, 3, 1> ToRgb(const Eigen::Vector3f& colour) {
+  Eigen::Matrix<uint8_t, 3, 1> rgb;
+  for (int k = 0; k < 3; ++k) {
+    rgb[k] = static_cast<uint8_t>(std::clamp(std::lround(colour[k]), 0L, 255L));
+  }
+  return rgb;
+}
 
 // Writes a binary little-endian PLY through PCL, with per-vertex x y z, nx ny nz and
 // red green blue (uchar), so that COLMAP, MeshLab, CloudCompare and Open3D open it. Written to a

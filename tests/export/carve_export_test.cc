@@ -75,6 +75,33 @@ TEST(CarveExport, FilesOpenWithPCLAndHaveTheExpectedFields) {
   for (const pcl::PointXYZRGB& vertex : vertices) {
     ASSERT_TRUE(box.contains(Eigen::Vector3d(vertex.x, vertex.y, vertex.z)));
   }
+
+  // The smooth mesh, as carve writes it: PCL reads its triangles, normals and colours back.
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(6, 160, 120));
+  const ModelMesh model = MeshCarvedModel(result, testing::SceneViews(scene), ModelMeshOptions());
+  ASSERT_FALSE(model.mesh.empty());
+  WriteMeshPly(model.mesh, folder + "/smooth.ply");
+  pcl::PolygonMesh smooth;
+  ASSERT_EQ(pcl::io::loadPLYFile(folder + "/smooth.ply", smooth), 0);
+  EXPECT_EQ(smooth.polygons.size(), model.mesh.triangles.size());
+  EXPECT_EQ(smooth.cloud.width * smooth.cloud.height, model.mesh.vertices.size());
+  std::vector<std::string> mesh_fields;
+  for (const pcl::PCLPointField& field : smooth.cloud.fields) mesh_fields.push_back(field.name);
+  for (const char* name : {"x", "y", "z", "normal_x", "normal_y", "normal_z", "rgb"}) {
+    EXPECT_NE(std::find(mesh_fields.begin(), mesh_fields.end(), name), mesh_fields.end()) << name;
+  }
+  pcl::PointCloud<pcl::PointXYZRGBNormal> smooth_vertices;
+  pcl::fromPCLPointCloud2(smooth.cloud, smooth_vertices);
+  for (size_t i = 0; i < smooth_vertices.size(); ++i) {
+    const pcl::PointXYZRGBNormal& v = smooth_vertices[i];
+    ASSERT_NEAR(v.x, model.mesh.vertices[i].x(), 1e-6f);
+    ASSERT_NEAR(Eigen::Vector3f(v.normal_x, v.normal_y, v.normal_z).norm(), 1.0f, 1e-4f);
+    ASSERT_EQ(v.r, model.mesh.colours[i][0]);
+  }
+  for (size_t t = 0; t < smooth.polygons.size(); ++t) {
+    ASSERT_EQ(smooth.polygons[t].vertices.size(), 3u);
+    ASSERT_EQ(static_cast<int>(smooth.polygons[t].vertices[1]), model.mesh.triangles[t][1]);
+  }
   std::filesystem::remove_all(folder);
 }
 

@@ -109,14 +109,11 @@ bool ModelMeshOptions::IsValid(std::string* reason) const {
     *reason = "mesh edge length in pixels must be >= 0";
     return false;
   }
-  if (smoothing_iterations < 0) {
-    *reason = "mesh smoothing iterations must be >= 0";
-    return false;
-  }
-  if (max_triangles < 0 || (max_triangles > 0 && max_triangles < 4)) {
-    *reason = "mesh face budget must be 0 (none) or at least 4";
-    return false;
-  }
+  // The geometry's own options say what is wrong with the smoothing and the face budget.
+  SurfaceMeshOptions geometry;
+  geometry.smoothing_iterations = smoothing_iterations;
+  geometry.max_triangles = max_triangles;
+  if (!geometry.IsValid(reason)) return false;
   if (min_views < 1) {
     *reason = "mesh colouring needs min_views >= 1";
     return false;

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "export/mesh_renderer.h"
+#include "carve/view_workers.h"
 #include "export/parallel_ranges.h"
 #include "export/point_cloud_io.h"
 
@@ -105,7 +106,7 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
   // Each view on its own (in parallel): the vertices it sees, and which lie on its mask's rim.
   std::vector<std::vector<std::pair<uint32_t, float>>> per_view(views.size());
   std::vector<std::vector<uint32_t>> rims(views.size());
-  ParallelRanges(views.size(), AllCores(), /*min_per_thread=*/1, [&](size_t first, size_t last) {
+  ParallelRanges(views.size(), ResolveNumThreads(-1), /*min_per_thread=*/1, [&](size_t first, size_t last) {
     for (size_t v = first; v < last; ++v) {
       const CalibratedView& view = views[v];
       const Rendering drawn = RenderMesh(shape, view);

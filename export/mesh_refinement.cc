@@ -4,11 +4,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <thread>
 
 #include <glog/logging.h>
 
 #include "export/mesh_colouring.h"
+#include "carve/view_workers.h"
 #include "export/parallel_ranges.h"
 
 namespace raycarve {
@@ -84,7 +84,7 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
         views, *mesh, options.depth_tolerance, &on_rim, options.voxel_size, 1.0);
     std::vector<float> offsets(n, 0.0f);
     std::vector<uint8_t> judged(n, 0), moved(n, 0);
-    const int threads = options.num_threads > 0 ? options.num_threads : AllCores();
+    const int threads = options.num_threads > 0 ? options.num_threads : ResolveNumThreads(-1);
     ParallelRanges(n, threads, /*min_per_thread=*/1024, [&](size_t begin, size_t end) {
     std::vector<Eigen::Vector3f> patch(static_cast<size_t>(kPatchSamples) * views.size());
     std::vector<VertexSighting> seen;

@@ -27,8 +27,5 @@ void ParallelRanges(size_t n, int threads, size_t min_per_thread, const Body& bo
   for (std::thread& worker : workers) worker.join();
 }
 
-// Every core the machine reports (at least one).
-inline int AllCores() { return std::max(1, static_cast<int>(std::thread::hardware_concurrency())); }
-
 }  // namespace exporter
 }  // namespace raycarve

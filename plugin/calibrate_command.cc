@@ -193,14 +193,16 @@ int RunCalibrate(int argc, char** argv) {
         {project.model_path, "input model"}, {project.image_path, "photo folder"}};
     if (!view_options.mask_path.empty()) inputs.emplace_back(view_options.mask_path, "mask folder");
     // Every name checked before the first file is written.
+    std::vector<std::pair<std::filesystem::path, std::filesystem::path>> targets;
     for (const CalibratedView& view : views) {
-      OutputFileInside((root / "undistorted").string(), view.name, inputs);
-      OutputFileInside((root / "masks").string(), view.name + ".png", inputs);
+      // In this order: the photo's name is the one a user gave.
+      std::filesystem::path photo = OutputFileInside((root / "undistorted").string(), view.name, inputs);
+      std::filesystem::path mask = OutputFileInside((root / "masks").string(), view.name + ".png", inputs);
+      targets.emplace_back(std::move(photo), std::move(mask));
     }
-    for (const CalibratedView& view : views) {
-      const std::filesystem::path photo = OutputFileInside((root / "undistorted").string(), view.name, inputs);
-      const std::filesystem::path mask =
-          OutputFileInside((root / "masks").string(), view.name + ".png", inputs);
+    for (size_t v = 0; v < views.size(); ++v) {
+      const CalibratedView& view = views[v];
+      const auto& [photo, mask] = targets[v];
       std::filesystem::create_directories(photo.parent_path(), error);
       std::filesystem::create_directories(mask.parent_path(), error);
       if (error) throw InputError(mask.parent_path().string() + ": cannot create: " + error.message());

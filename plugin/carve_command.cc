@@ -63,11 +63,11 @@ CarveRun CarveProject(const CarveRequest& request) {
   if (!request.view_options.mask_path.empty()) {
     inputs.emplace_back(request.view_options.mask_path, "mask folder");
   }
-  for (const CalibratedView& view : views) {
-    if (!view.mask.empty()) {
-      OutputFileInside((std::filesystem::path(run.output_path) / "masks").string(),
-                       view.name + ".png", inputs);
-    }
+  std::vector<std::filesystem::path> mask_targets(views.size());
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (views[v].mask.empty()) continue;
+    mask_targets[v] = OutputFileInside((std::filesystem::path(run.output_path) / "masks").string(),
+                                       views[v].name + ".png", inputs);
   }
   stage = Clock::now();
   const VoxelGrid grid(run.bounds.box, request.options.resolution);
@@ -192,10 +192,10 @@ CarveRun CarveProject(const CarveRequest& request) {
   }
 
   // The masks used, so that a user can check them: undistorted, as the carving saw them.
-  for (const CalibratedView& view : views) {
+  for (size_t v = 0; v < views.size(); ++v) {
+    const CalibratedView& view = views[v];
     if (view.mask.empty()) continue;
-    const std::filesystem::path mask_path =
-        OutputFileInside((out / "masks").string(), view.name + ".png", inputs);
+    const std::filesystem::path& mask_path = mask_targets[v];  // checked before carving
     std::filesystem::create_directories(mask_path.parent_path(), error);
     if (error) throw InputError(mask_path.parent_path().string() + ": cannot create: " + error.message());
     WriteImageAtomically(mask_path.string(), view.mask);

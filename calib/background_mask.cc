@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <vector>
 
 #include <glog/logging.h>
+#include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "calib/input_error.h"
@@ -86,6 +88,290 @@ cv::Mat ObjectMaskFromBackdrop(const cv::Mat& rgb, const Eigen::Vector3d& backdr
   }
   cv::morphologyEx(mask, mask, cv::MORPH_OPEN, cv::Mat::ones(3, 3, CV_8U));
   cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, cv::Mat::ones(5, 5, CV_8U));
+  return mask;
+}
+
+}  // namespace raycarve
+
+namespace raycarve {
+namespace {
+
+// The pixels of line `d` from one side: 0 top, 1 bottom, 2 left, 3 right.
+std::vector<cv::Vec3b> LinePixels(const cv::Mat& rgb, int side, int d) {
+  std::vector<cv::Vec3b> line;
+  if (side < 2) {
+    const int row = side == 0 ? d : rgb.rows - 1 - d;
+    for (int col = 0; col < rgb.cols; ++col) line.push_back(rgb.at<cv::Vec3b>(row, col));
+  } else {
+    const int col = side == 2 ? d : rgb.cols - 1 - d;
+    for (int row = 0; row < rgb.rows; ++row) line.push_back(rgb.at<cv::Vec3b>(row, col));
+  }
+  return line;
+}
+
+Eigen::Vector3d MedianColour(const std::vector<cv::Vec3b>& pixels) {
+  Eigen::Vector3d median = Eigen::Vector3d::Zero();
+  if (pixels.empty()) return median;
+  std::vector<int> channel(pixels.size());
+  for (int k = 0; k < 3; ++k) {
+    for (size_t i = 0; i < pixels.size(); ++i) channel[i] = pixels[i][k];
+    std::nth_element(channel.begin(), channel.begin() + channel.size() / 2, channel.end());
+    median[k] = channel[channel.size() / 2];
+  }
+  return median;
+}
+
+Eigen::Vector3d ToVector(const cv::Vec3b& p) { return Eigen::Vector3d(p[0], p[1], p[2]); }
+
+double ShareWithin(const std::vector<cv::Vec3b>& pixels, const Eigen::Vector3d& colour,
+                   double tolerance) {
+  size_t close = 0;
+  for (const cv::Vec3b& p : pixels) close += (ToVector(p) - colour).norm() <= tolerance;
+  return pixels.empty() ? 0.0 : static_cast<double>(close) / pixels.size();
+}
+
+// Width of the frame on one side: the outermost lines that are each uniform (90% of their
+// pixels within tolerance of their median) and differ from the line just inside the widest
+// frame allowed.
+int FrameWidth(const cv::Mat& rgb, int side, double tolerance) {
+  const int extent = side < 2 ? rgb.rows : rgb.cols;
+  const int widest = static_cast<int>(extent * 0.025);
+  if (widest < 1 || 2 * widest + 4 > extent) return 0;
+  const Eigen::Vector3d inside = MedianColour(LinePixels(rgb, side, widest + 1));
+  int width = 0;
+  for (int d = 0; d < widest; ++d) {
+    const std::vector<cv::Vec3b> line = LinePixels(rgb, side, d);
+    const Eigen::Vector3d median = MedianColour(line);
+    if (ShareWithin(line, median, tolerance) < 0.9 || (median - inside).norm() <= tolerance) break;
+    width = d + 1;
+  }
+  return width;
+}
+
+// The band of 2% of rows and columns inside the frame, as `border` (pixels, at most ~40,000
+// by a regular stride) and as a test of whether a pixel lies in it.
+struct BorderBand {
+  int top, bottom, left, right;  // first row/col inside the band's inner edge, per side
+  int frame[4];
+  bool InFrame(int row, int col, int rows, int cols) const {
+    return row < frame[0] || row >= rows - frame[1] || col < frame[2] || col >= cols - frame[3];
+  }
+  bool InBand(int row, int col, int rows, int cols) const {
+    return !InFrame(row, col, rows, cols) &&
+           (row < top || row >= rows - bottom || col < left || col >= cols - right);
+  }
+};
+
+BorderBand MakeBand(const cv::Mat& rgb, const int frame[4]) {
+  BorderBand band;
+  for (int k = 0; k < 4; ++k) band.frame[k] = frame[k];
+  const int band_rows = std::max(1, rgb.rows / 50), band_cols = std::max(1, rgb.cols / 50);
+  band.top = frame[0] + band_rows;
+  band.bottom = frame[1] + band_rows;
+  band.left = frame[2] + band_cols;
+  band.right = frame[3] + band_cols;
+  return band;
+}
+
+}  // namespace
+
+std::string BackdropModel::Summary() const {
+  std::ostringstream text;
+  if (!found) {
+    text << "no plain backdrop (the border needs more than " << kMaxBackdropColours
+         << " colours; " << std::lround(100.0 * explained) << "% explained)";
+    return text.str();
+  }
+  text << colours.size() << (colours.size() == 1 ? " colour (" : " colours (");
+  for (size_t i = 0; i < colours.size(); ++i) {
+    text << (i > 0 ? "; " : "") << std::lround(colours[i][0]) << "," << std::lround(colours[i][1])
+         << "," << std::lround(colours[i][2]) << " " << std::lround(100.0 * shares[i]) << "%";
+  }
+  text << ")";
+  const int widest = std::max({frame[0], frame[1], frame[2], frame[3]});
+  if (widest > 0) {
+    text << ", frame " << frame[0] << "/" << frame[1] << "/" << frame[2] << "/" << frame[3]
+         << " px";
+  }
+  return text.str();
+}
+
+BackdropModel EstimateBackdropModel(const cv::Mat& rgb, double tolerance) {
+  CHECK_EQ(rgb.type(), CV_8UC3);
+  BackdropModel model;
+  for (int side = 0; side < 4; ++side) model.frame[side] = FrameWidth(rgb, side, tolerance);
+  const BorderBand band = MakeBand(rgb, model.frame);
+  std::vector<cv::Vec3b> border;
+  const int64_t band_pixels = 2LL * (band.top - model.frame[0]) * rgb.cols +
+                              2LL * (band.left - model.frame[2]) * rgb.rows;
+  const int stride = static_cast<int>(std::max<int64_t>(1, band_pixels / 40000));
+  int64_t index = 0;
+  for (int row = 0; row < rgb.rows; ++row) {
+    for (int col = 0; col < rgb.cols; ++col) {
+      if (band.InBand(row, col, rgb.rows, rgb.cols) && index++ % stride == 0) {
+        border.push_back(rgb.at<cv::Vec3b>(row, col));
+      }
+    }
+  }
+  if (border.size() < 16) return model;
+
+  // One colour: the median, as EstimateBackdropColour.
+  const Eigen::Vector3d median = MedianColour(border);
+  model.explained = ShareWithin(border, median, tolerance);
+  if (model.explained >= 0.8) {
+    model.found = true;
+    model.colours = {median};
+    model.shares = {model.explained};
+    return model;
+  }
+  cv::Mat samples(static_cast<int>(border.size()), 3, CV_32F);
+  for (size_t i = 0; i < border.size(); ++i) {
+    for (int k = 0; k < 3; ++k) samples.at<float>(static_cast<int>(i), k) = border[i][k];
+  }
+  cv::RNG& rng = cv::theRNG();
+  const uint64 saved_state = rng.state;
+  for (int count = 2; count <= kMaxBackdropColours; ++count) {
+    rng.state = 0x9e3779b97f4a7c15ULL;  // the same clusters on every run
+    cv::Mat labels, centres;
+    cv::kmeans(samples, count, labels,
+               cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 0.5), 2,
+               cv::KMEANS_PP_CENTERS, centres);
+    std::vector<std::vector<cv::Vec3b>> members(count);
+    for (size_t i = 0; i < border.size(); ++i) {
+      members[labels.at<int>(static_cast<int>(i))].push_back(border[i]);
+    }
+    std::vector<Eigen::Vector3d> colours;
+    for (const auto& cluster : members) {
+      // A cluster of under 3% of the border is the object touching it, or noise.
+      if (cluster.size() >= 0.03 * border.size()) colours.push_back(MedianColour(cluster));
+    }
+    size_t close = 0;
+    std::vector<size_t> nearest_count(colours.size(), 0);
+    for (const cv::Vec3b& p : border) {
+      double best = std::numeric_limits<double>::infinity();
+      size_t which = 0;
+      for (size_t c = 0; c < colours.size(); ++c) {
+        const double d = (ToVector(p) - colours[c]).norm();
+        if (d < best) best = d, which = c;
+      }
+      if (best <= tolerance) ++close, ++nearest_count[which];
+    }
+    model.explained = static_cast<double>(close) / border.size();
+    if (model.explained >= 0.8) {
+      model.found = true;
+      model.colours = colours;
+      for (size_t c = 0; c < colours.size(); ++c) {
+        model.shares.push_back(static_cast<double>(nearest_count[c]) / border.size());
+      }
+      break;
+    }
+  }
+  rng.state = saved_state;
+  return model;
+}
+
+double BackdropDistance(const Eigen::Vector3d& rgb, const BackdropModel& model, double darkest,
+                        double brightest) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& colour : model.colours) {
+    const double norm2 = colour.squaredNorm();
+    const double scale =
+        norm2 < 1e-9 ? 1.0 : std::clamp(rgb.dot(colour) / norm2, darkest, brightest);
+    best = std::min(best, (rgb - scale * colour).norm());
+  }
+  return best;
+}
+
+cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
+                            const BackdropModel& model,
+                            double tolerance,
+                            bool refine,
+                            const std::vector<Eigen::Vector2d>& object_seeds,
+                            const std::vector<cv::Point>& box_hull,
+                            ObjectMaskReport* report) {
+  CHECK_EQ(rgb.type(), CV_8UC3);
+  CHECK(model.found);
+  ObjectMaskReport local;
+  if (report == nullptr) report = &local;
+  *report = ObjectMaskReport();
+  // GrabCut works on at most 800 pixels a side; the result is scaled back.
+  const double scale = std::min(1.0, 800.0 / std::max(rgb.rows, rgb.cols));
+  cv::Mat work = rgb;
+  if (scale < 1.0) cv::resize(rgb, work, cv::Size(), scale, scale, cv::INTER_AREA);
+  int frame[4];
+  for (int k = 0; k < 4; ++k) frame[k] = static_cast<int>(std::ceil(model.frame[k] * scale));
+  const BorderBand band = MakeBand(work, frame);
+
+  cv::Mat inside_box(work.size(), CV_8UC1, cv::Scalar(255));
+  if (box_hull.size() >= 3) {
+    std::vector<cv::Point> scaled, hull;
+    for (const cv::Point& p : box_hull) {
+      scaled.emplace_back(static_cast<int>(std::lround(p.x * scale)),
+                          static_cast<int>(std::lround(p.y * scale)));
+    }
+    cv::convexHull(scaled, hull);
+    inside_box.setTo(0);
+    cv::fillConvexPoly(inside_box, hull, cv::Scalar(255));
+    // A margin for the camera's distortion between the sampled outline's points.
+    const int margin = 2 + work.cols / 100;
+    cv::dilate(inside_box, inside_box, cv::Mat::ones(2 * margin + 1, 2 * margin + 1, CV_8U));
+    report->cut_to_box = true;
+  }
+
+  cv::Mat labels(work.size(), CV_8UC1);
+  cv::Mat colour_rule(work.size(), CV_8UC1);
+  int object_like = 0, backdrop_like = 0;
+  for (int row = 0; row < work.rows; ++row) {
+    const cv::Vec3b* pixels = work.ptr<cv::Vec3b>(row);
+    uint8_t* label = labels.ptr<uint8_t>(row);
+    uint8_t* rule = colour_rule.ptr<uint8_t>(row);
+    const uint8_t* in_box = inside_box.ptr<uint8_t>(row);
+    for (int col = 0; col < work.cols; ++col) {
+      const Eigen::Vector3d p = ToVector(pixels[col]);
+      rule[col] = 0;
+      if (band.InFrame(row, col, work.rows, work.cols) || in_box[col] == 0) {
+        label[col] = cv::GC_BGD;
+      } else if (BackdropDistance(p, model, 1.0, 1.0) <= tolerance) {
+        label[col] = band.InBand(row, col, work.rows, work.cols) ? cv::GC_BGD : cv::GC_PR_BGD;
+      } else {
+        rule[col] = 255;
+        label[col] = BackdropDistance(p, model, kShadowGain, kLightGain) <= tolerance ? cv::GC_PR_BGD : cv::GC_PR_FGD;
+      }
+      const bool object = label[col] == cv::GC_PR_FGD;
+      object_like += object;
+      backdrop_like += !object;
+    }
+  }
+  for (const Eigen::Vector2d& seed : object_seeds) {
+    const cv::Point at(static_cast<int>(std::floor(seed.x() * scale)),
+                       static_cast<int>(std::floor(seed.y() * scale)));
+    if (at.x < 0 || at.y < 0 || at.x >= work.cols || at.y >= work.rows) continue;
+    if (labels.at<uint8_t>(at) == cv::GC_BGD) continue;  // frame, border or outside the volume
+    labels.at<uint8_t>(at) = cv::GC_FGD;
+    ++report->seeds;
+    ++object_like;
+  }
+
+  cv::Mat mask;
+  if (refine && object_like >= 64 && backdrop_like >= 64) {
+    try {
+      cv::Mat background_model, object_model;
+      cv::grabCut(work, labels, cv::Rect(), background_model, object_model, 3,
+                  cv::GC_INIT_WITH_MASK);
+      mask = (labels & 1) * 255;  // GC_FGD and GC_PR_FGD are odd
+      report->refined = true;
+    } catch (const cv::Exception& error) {
+      LOG(WARNING) << "GrabCut failed (" << error.what() << "); the colour rule's mask is used";
+    }
+  }
+  if (mask.empty()) mask = colour_rule & inside_box;
+  cv::morphologyEx(mask, mask, cv::MORPH_OPEN, cv::Mat::ones(3, 3, CV_8U));
+  cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, cv::Mat::ones(5, 5, CV_8U));
+  if (scale < 1.0) {
+    cv::resize(mask, mask, rgb.size(), 0, 0, cv::INTER_LINEAR);
+    cv::threshold(mask, mask, 127, 255, cv::THRESH_BINARY);
+  }
+  report->object_share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
   return mask;
 }
 

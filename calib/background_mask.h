@@ -1,8 +1,10 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
 namespace raycarve {
@@ -19,6 +21,9 @@ struct BackgroundOptions {
   Eigen::Vector3d colour = Eigen::Vector3d::Zero();  // RGB 0-255, for kColour
   // A pixel farther than this from the backdrop colour (Euclidean RGB distance) is object.
   double tolerance = 30.0;
+  // kAuto: refine each mask by a graph cut over colour models of object and backdrop (OpenCV's
+  // GrabCut), seeded with the photo's sparse points; off, masks are the colour rule alone.
+  bool refine = true;
 
   bool IsValid(std::string* reason) const;
 };
@@ -35,5 +40,60 @@ bool EstimateBackdropColour(const cv::Mat& rgb, double tolerance, Eigen::Vector3
 // farther than `tolerance` from it, cleaned of specks (opening, 3x3) and of pinholes (closing,
 // 5x5). Holes larger than that stay background, since objects can have real openings.
 cv::Mat ObjectMaskFromBackdrop(const cv::Mat& rgb, const Eigen::Vector3d& backdrop, double tolerance);
+
+// What a photo's border says about its backdrop, for photos on one or several plain colours
+// (a wall and a table, a gradient sweep, a vignetted cloth), behind an optional uniform frame.
+struct BackdropModel {
+  bool found = false;                  // the border is explained by a few plain colours
+  std::vector<Eigen::Vector3d> colours;  // RGB, the per-channel median of each colour's pixels
+  std::vector<double> shares;          // of the border's pixels, per colour
+  double explained = 0.0;              // share of the border's pixels within tolerance of one
+  int frame[4] = {0, 0, 0, 0};         // uniform frame lines at the top, bottom, left, right
+  std::string Summary() const;         // "2 colours (85,100,160 60%; ...), frame 3 px"
+};
+
+// At most this many colours make a backdrop; a border that needs more is a natural scene.
+constexpr int kMaxBackdropColours = 5;
+
+// The backdrop of a photo (CV_8UC3 RGB) from its border: a frame of uniform lines at any side
+// (up to 2.5% of the photo) that differ from what lies inside them is set aside; the next band
+// (2% of rows and columns) is described by the fewest colours (1 to kMaxBackdropColours, by
+// k-means, deterministic) that bring 80% of its pixels within `tolerance`. With one colour this
+// is EstimateBackdropColour. `found` is false when no such set exists.
+BackdropModel EstimateBackdropModel(const cv::Mat& rgb, double tolerance);
+
+// How far a pixel's colour is from the backdrop: the least RGB distance to one of the model's
+// colours scaled by a brightness gain in [darkest, brightest] (shadows darken a backdrop, and
+// vignetting darkens the border from which the colours come, without changing their hue).
+double BackdropDistance(const Eigen::Vector3d& rgb, const BackdropModel& model, double darkest,
+                        double brightest);
+// The gains a pixel may differ by from a backdrop colour and still be probable backdrop.
+constexpr double kShadowGain = 0.4;
+constexpr double kLightGain = 1.8;
+
+struct ObjectMaskReport {
+  double object_share = 0.0;  // of the photo's pixels
+  int seeds = 0;              // sparse points used as sure object
+  bool refined = false;       // GrabCut ran (it needs both some object and some backdrop)
+  bool cut_to_box = false;    // pixels whose rays miss the volume were set to backdrop
+};
+
+// The object mask (CV_8UC1, 255 = object) of a photo whose backdrop is `model`:
+//  - the frame, and pixels within `tolerance` of a backdrop colour, are backdrop;
+//  - with `refine`, GrabCut (OpenCV) then decides over colour models of both, from: frame and
+//    border pixels of the backdrop's colours as sure backdrop, the other backdrop-coloured
+//    pixels and those that are only a darker shade of it (shadows, vignetting) as probable
+//    backdrop, the rest as probable object, and `object_seeds` (pixels of sparse points inside
+//    the volume) as sure object;
+//  - `box_hull` (the volume's outline in the photo, possibly empty): pixels outside it are sure
+//    backdrop, since no carving can use them;
+//  - then cleaned of specks (opening 3x3) and pinholes (closing 5x5).
+cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
+                            const BackdropModel& model,
+                            double tolerance,
+                            bool refine,
+                            const std::vector<Eigen::Vector2d>& object_seeds,
+                            const std::vector<cv::Point>& box_hull,
+                            ObjectMaskReport* report);
 
 }  // namespace raycarve

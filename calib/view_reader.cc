@@ -25,6 +25,51 @@ std::string ViewReaderSummary::Summary() const {
   return text.str();
 }
 
+namespace {
+
+// The pixels of the image's sparse points that lie inside `volume` (all, when it is empty).
+std::vector<Eigen::Vector2d> SeedPixels(const Reconstruction& reconstruction, const Image& image,
+                                        const Eigen::AlignedBox3d& volume) {
+  std::vector<Eigen::Vector2d> seeds;
+  for (const Point2D& point2D : image.points2D) {
+    const auto found = reconstruction.points3D.find(point2D.point3D_id);
+    if (found == reconstruction.points3D.end()) continue;
+    if (!volume.isEmpty() && !volume.contains(found->second.xyz)) continue;
+    seeds.push_back(point2D.xy);
+  }
+  return seeds;
+}
+
+// Points along the outline of `volume` in the photo (its twelve edges, sampled so that the
+// camera's distortion bends them as it bends the photo); empty when the volume is unknown or
+// reaches behind the camera, where no outline bounds what the photo shows of it.
+std::vector<cv::Point> VolumeOutline(const Camera& camera, const Image& image,
+                                     const Eigen::AlignedBox3d& volume) {
+  std::vector<cv::Point> outline;
+  if (volume.isEmpty()) return outline;
+  const int steps = 16;
+  for (int corner = 0; corner < 8; ++corner) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (corner & (1 << axis)) continue;  // each edge once, from its lower end
+      const Eigen::Vector3d start = volume.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+      Eigen::Vector3d end = start;
+      end[axis] = volume.max()[axis];
+      for (int i = 0; i <= steps; ++i) {
+        const Eigen::Vector3d world = start + (end - start) * (static_cast<double>(i) / steps);
+        const Eigen::Vector3d local = image.cam_from_world * world;
+        if (!(local.z() > 1e-9)) return {};
+        const Eigen::Vector2d pixel = camera.ImgFromCam(local.head<2>() / local.z());
+        if (!pixel.allFinite() || pixel.cwiseAbs().maxCoeff() > 1e7) return {};
+        outline.emplace_back(static_cast<int>(std::lround(pixel.x())),
+                             static_cast<int>(std::lround(pixel.y())));
+      }
+    }
+  }
+  return outline;
+}
+
+}  // namespace
+
 std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruction,
                                                 const std::string& image_path,
                                                 const ViewReaderOptions& options,
@@ -69,20 +114,42 @@ std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruc
       mask = ReadImage(mask_file, cv::IMREAD_GRAYSCALE);
       if (mask.empty()) throw InputError(mask_file + ": mask cannot be decoded as an image");
       ++summary->masks_from_files;
-    } else if (options.background.mode != BackgroundOptions::Mode::kNone) {
-      Eigen::Vector3d backdrop = options.background.colour;
-      if (options.background.mode == BackgroundOptions::Mode::kAuto &&
-          !EstimateBackdropColour(rgb, options.background.tolerance, &backdrop)) {
-        LOG(WARNING) << path << ": the photo's border is not one colour; no backdrop mask";
-        ++summary->no_plain_backdrop;
-      } else {
-        mask = ObjectMaskFromBackdrop(rgb, backdrop, options.background.tolerance);
-        mask_file = path + " (backdrop mask)";
-        summary->mean_backdrop += backdrop;
-        ++summary->masks_from_backdrop;
-      }
     }
     const Camera& camera = reconstruction.cameras.at(image.camera_id);
+    PhotoMaskInfo info;
+    info.name = image.name;
+    info.source = mask.empty() ? "none" : "file";
+    if (options.mask_path.empty() && options.background.mode == BackgroundOptions::Mode::kColour) {
+      const Eigen::Vector3d& backdrop = options.background.colour;
+      mask = ObjectMaskFromBackdrop(rgb, backdrop, options.background.tolerance);
+      mask_file = path + " (backdrop mask)";
+      summary->mean_backdrop += backdrop;
+      ++summary->masks_from_backdrop;
+      info.source = "colour";
+    } else if (options.mask_path.empty() &&
+               options.background.mode == BackgroundOptions::Mode::kAuto) {
+      info.backdrop = EstimateBackdropModel(rgb, options.background.tolerance);
+      if (!info.backdrop.found) {
+        LOG(WARNING) << path << ": " << info.backdrop.Summary() << "; no backdrop mask";
+        ++summary->no_plain_backdrop;
+      } else {
+        mask = ObjectMaskFromModel(rgb, info.backdrop, options.background.tolerance,
+                                   options.background.refine,
+                                   SeedPixels(reconstruction, image, options.volume),
+                                   VolumeOutline(camera, image, options.volume), &info.mask);
+        mask_file = path + " (backdrop mask)";
+        summary->mean_backdrop += info.backdrop.colours[0];
+        ++summary->masks_from_backdrop;
+        info.source = "backdrop";
+        VLOG(1) << path << ": backdrop " << info.backdrop.Summary() << ", object "
+                << std::lround(100.0 * info.mask.object_share) << "% of the photo, "
+                << info.mask.seeds << " sparse points as seeds";
+      }
+    }
+    if (!mask.empty()) {
+      info.object_share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
+    }
+    summary->photos.push_back(info);
     views.push_back(MakeCalibratedView(camera, image, rgb, path, mask, mask_file));
     VLOG(1) << path << ": view built";
   }

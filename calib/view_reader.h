@@ -17,6 +17,18 @@ struct ViewReaderOptions {
   std::string mask_path;
   // Without mask files: masks computed from a plain backdrop (see background_mask.h).
   BackgroundOptions background;
+  // The volume to carve, when known: automatic masks take the sparse points inside it as sure
+  // object and the pixels whose rays miss it as backdrop. Empty: every sparse point, no cut.
+  Eigen::AlignedBox3d volume;
+};
+
+// What was found for one photo's mask.
+struct PhotoMaskInfo {
+  std::string name;    // the image's name in the model
+  std::string source;  // "file", "backdrop", "colour" (the given backdrop colour) or "none"
+  BackdropModel backdrop;   // for "backdrop" and for "none" under kAuto (found = false)
+  ObjectMaskReport mask;    // for "backdrop"
+  double object_share = 0.0;  // of the photo's pixels, for any source with a mask
 };
 
 struct ViewReaderSummary {
@@ -27,6 +39,7 @@ struct ViewReaderSummary {
   int no_plain_backdrop = 0;  // kAuto found no one-coloured border: that view has no mask
   Eigen::Vector3d mean_backdrop = Eigen::Vector3d::Zero();  // over masks_from_backdrop views
   std::vector<std::string> missing;  // photo paths not found (only with skip_missing_images)
+  std::vector<PhotoMaskInfo> photos;  // per loaded view, in view order
   std::string Summary() const;
 };
 

@@ -267,6 +267,39 @@ std::string CarveStatistics::Summary() const {
   return text.str();
 }
 
+BoxCoverage MeasureBoxCoverage(const std::vector<CalibratedView>& views,
+                               const Eigen::AlignedBox3d& box,
+                               int min_views) {
+  BoxCoverage coverage;
+  coverage.view_share.assign(views.size(), 0.0);
+  constexpr int kSteps = 17;
+  std::vector<int> seen_by(kSteps * kSteps * kSteps, 0);
+  for (size_t v = 0; v < views.size(); ++v) {
+    const CalibratedView& view = views[v];
+    int seen = 0;
+    for (int i = 0; i < kSteps * kSteps * kSteps; ++i) {
+      const Eigen::Vector3d t((i % kSteps + 0.5) / kSteps, ((i / kSteps) % kSteps + 0.5) / kSteps,
+                              (i / (kSteps * kSteps) + 0.5) / kSteps);
+      const Eigen::Vector3d point = box.min() + box.sizes().cwiseProduct(t);
+      if (!(view.Depth(point) > 0.0)) continue;
+      const Eigen::Vector2d pixel = view.Project(point);
+      if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < view.width &&
+            pixel.y() < view.height)) {
+        continue;
+      }
+      const int col = static_cast<int>(pixel.x()), row = static_cast<int>(pixel.y());
+      if (!view.valid.empty() && view.valid.at<uint8_t>(row, col) == 0) continue;
+      ++seen;
+      ++seen_by[i];
+    }
+    coverage.view_share[v] = static_cast<double>(seen) / seen_by.size();
+  }
+  int seen_enough = 0;
+  for (int count : seen_by) seen_enough += count >= min_views;
+  coverage.seen_share = static_cast<double>(seen_enough) / seen_by.size();
+  return coverage;
+}
+
 bool CheckCarveFits(const std::vector<CalibratedView>& views,
                     const Eigen::AlignedBox3d& box,
                     const CarveOptions& options,

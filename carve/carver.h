@@ -390,6 +390,17 @@ bool CheckCarveFits(const std::vector<CalibratedView>& views,
                     const CarveOptions& options,
                     std::string* reason);
 
+// How much of a box the views see, from a lattice of 17^3 points over it: per view the share of
+// the points in front of its camera and on a valid pixel of its photo, and the share of the
+// points that at least `min_views` views see.
+struct BoxCoverage {
+  std::vector<double> view_share;  // per view, in view order
+  double seen_share = 0.0;         // by min_views views or more
+};
+BoxCoverage MeasureBoxCoverage(const std::vector<CalibratedView>& views,
+                               const Eigen::AlignedBox3d& box,
+                               int min_views);
+
 // Carves the volume over `box` seen by `views` until no voxel whose visibility changed is
 // inconsistent. `progress` (optional) is called about every `progress_interval_seconds` of
 // carving. Options must pass CheckCarveFits (CHECKed).

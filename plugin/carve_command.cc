@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include <glog/logging.h>
@@ -49,6 +50,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   run.num_missing_images = static_cast<int>(project.view_summary.missing.size());
   run.masks_from_files = project.view_summary.masks_from_files;
   run.masks_from_backdrop = project.view_summary.masks_from_backdrop;
+  run.mask_photos = project.view_summary.photos;
   run.colour = project.colour;
   run.stage_seconds.emplace_back("load_project", SecondsSince(stage));
   const std::vector<CalibratedView>& views = project.views;
@@ -56,6 +58,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   if (!CheckCarveFits(views, run.bounds.box, request.options, &reason)) {
     throw InputError("raycarve carve: " + reason);
   }
+  CheckVolumeSeen("carve", project, views, request.options.min_views, request.bounds);
   // What the outputs must never land in, checked before the work starts: the masks written
   // under <output>/masks must not replace the user's.
   std::vector<std::pair<std::string, std::string>> inputs = {
@@ -251,6 +254,33 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("background_tolerance").Value(request.view_options.background.tolerance)
       .Key("visual_hull").Value(request.options.visual_hull)
       .EndObject();
+  json.Key("masks").BeginArray();
+  for (const PhotoMaskInfo& photo : run.mask_photos) {
+    json.BeginObject()
+        .Key("name").Value(photo.name)
+        .Key("source").Value(photo.source)
+        .Key("object_share").Value(photo.object_share);
+    if (request.background == "auto" && request.view_options.mask_path.empty()) {
+      json.Key("backdrop_found").Value(photo.backdrop.found)
+          .Key("border_explained").Value(photo.backdrop.explained);
+      json.Key("backdrop_colours").BeginArray();
+      for (size_t c = 0; c < photo.backdrop.colours.size(); ++c) {
+        json.BeginObject()
+            .Key("rgb").Value(JsonArray(photo.backdrop.colours[c]))
+            .Key("border_share").Value(photo.backdrop.shares[c])
+            .EndObject();
+      }
+      json.EndArray();
+      json.Key("frame_px").Value(std::vector<double>{
+          static_cast<double>(photo.backdrop.frame[0]), static_cast<double>(photo.backdrop.frame[1]),
+          static_cast<double>(photo.backdrop.frame[2]), static_cast<double>(photo.backdrop.frame[3])});
+      json.Key("sparse_point_seeds").Value(photo.mask.seeds)
+          .Key("graph_cut").Value(photo.mask.refined)
+          .Key("cut_to_volume").Value(photo.mask.cut_to_box);
+    }
+    json.EndObject();
+  }
+  json.EndArray();
   if (request.colour_calibration) {
     json.Key("colour_calibration").BeginObject()
         .Key("points_used").Value(run.colour.points_used)
@@ -567,6 +597,45 @@ void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
   if (!request->mesh.IsValid(&reason)) throw InputError("--mesh_*: " + reason);
 }
 
+// One line on where the masks came from: per source the count, and for backdrop masks the
+// colours found (those of the first such photo), frames and the median object share.
+std::string MaskSummary(const std::vector<PhotoMaskInfo>& photos) {
+  std::map<std::string, int> count;
+  std::vector<double> shares;
+  const PhotoMaskInfo* first_backdrop = nullptr;
+  int framed = 0, no_backdrop = 0;
+  for (const PhotoMaskInfo& photo : photos) {
+    ++count[photo.source];
+    if (photo.source != "none") shares.push_back(photo.object_share);
+    if (photo.source == "backdrop") {
+      if (first_backdrop == nullptr) first_backdrop = &photo;
+      framed += std::max({photo.backdrop.frame[0], photo.backdrop.frame[1],
+                          photo.backdrop.frame[2], photo.backdrop.frame[3]}) > 0;
+    }
+    no_backdrop += photo.source == "none" && photo.backdrop.explained > 0.0;
+  }
+  std::ostringstream text;
+  const char* separator = "";
+  for (const auto& [source, n] : count) {
+    text << separator << n << (source == "file"       ? " from mask files"
+                               : source == "backdrop" ? " from the backdrop"
+                               : source == "colour"   ? " from the given backdrop colour"
+                                                      : " without a mask");
+    separator = ", ";
+  }
+  if (first_backdrop != nullptr) {
+    text << "; backdrop of the first: " << first_backdrop->backdrop.Summary();
+    if (framed > 0) text << "; " << framed << " photos with a frame";
+  }
+  if (no_backdrop > 0) text << "; " << no_backdrop << " photos show no plain backdrop (natural scene?)";
+  if (!shares.empty()) {
+    std::nth_element(shares.begin(), shares.begin() + shares.size() / 2, shares.end());
+    text << "; object " << std::lround(100.0 * shares[shares.size() / 2])
+         << "% of a photo (median)";
+  }
+  return text.str();
+}
+
 int RunCarve(int argc, char** argv) {
   CarveRequest request;
   CarveFlagText text;
@@ -594,6 +663,7 @@ int RunCarve(int argc, char** argv) {
                       : "");
     sparse_line = text;
   }
+  const std::string mask_line = MaskSummary(run.mask_photos);
   size_t judged_voxels = 0;
   for (const ColouredVoxel& voxel : run.result->surface) {
     judged_voxels += voxel.num_views >= request.options.min_views;
@@ -620,6 +690,7 @@ int RunCarve(int argc, char** argv) {
       "  convergence     %.2f s (+ %.2f s set-up), peak memory %.1f MiB\n"
       "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more\n"
       "  sparse points   %s\n"
+      "  masks           %s\n"
       "  outputs         %s/cloud.ply (%zu points), mesh.ply (%zu triangles),\n"
       "                  report.json, convergence.csv\n"
       "  open with       meshlab %s/mesh.ply   (or CloudCompare, Open3D, colmap gui)\n",
@@ -630,7 +701,7 @@ int RunCarve(int argc, char** argv) {
       s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds,
       s.peak_memory_bytes / (1024.0 * 1024.0), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,
-      sparse_line.c_str(), run.output_path.c_str(), run.num_cloud_points,
+      sparse_line.c_str(), mask_line.c_str(), run.output_path.c_str(), run.num_cloud_points,
       run.num_mesh_triangles, run.output_path.c_str());
   if (s.final_solid == 0 || s.visible_surface == 0) {
     std::printf(

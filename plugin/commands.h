@@ -104,6 +104,16 @@ LoadedProject LoadProject(const std::string& command,
                           bool colour_calibration = false,
                           int hold_out_every = 0);
 
+// Throws InputError when no part of the project's volume is seen by `min_views` of `views`
+// (a --bbox in another frame or unit, bounds from points far from every camera's view): the
+// message names the box, how much of it each photo sees and, for a --bbox, the sparse points'
+// own box.
+void CheckVolumeSeen(const std::string& command,
+                     const LoadedProject& project,
+                     const std::vector<CalibratedView>& views,
+                     int min_views,
+                     const BoundsFlags& bounds_flags);
+
 // carve: everything `raycarve carve` takes, and what it produced.
 // --threshold auto's threshold where too few sparse points can be judged.
 constexpr double kFallbackThreshold = 30.0;
@@ -147,6 +157,7 @@ struct CarveRun {
   int num_missing_images = 0;
   int masks_from_files = 0;
   int masks_from_backdrop = 0;
+  std::vector<PhotoMaskInfo> mask_photos;  // per view: where its mask came from, what was found
   ColourCalibration colour;
   std::unique_ptr<CarveResult> result;
   std::vector<std::pair<std::string, double>> stage_seconds;

@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <set>
 
@@ -27,6 +28,7 @@ int RunHoldout(int argc, char** argv) {
   int every = 4;
   std::string render = "mesh";
   std::string other_path;
+  std::string score_mask_path;
   double splat_size = 0.0;
   OptionParser parser(
       "holdout",
@@ -47,6 +49,10 @@ int RunHoldout(int argc, char** argv) {
   parser.AddDefault("point_size", &splat_size,
                     "splat side (world units) for a cloud given by --model (0: 1.5 x the cloud's "
                     "median neighbour spacing)");
+  parser.AddDefault("score_mask_path", &score_mask_path,
+                    "score the held-out views against these masks (<photo name>.png, as "
+                    "--mask_path) instead of the masks the carve uses: to compare automatic "
+                    "masks with exact ones on the same footing");
   if (!parser.Parse(argc, argv)) return 0;
   ApplyCarveFlags(text, &request);
   if (every < 2) throw InputError("raycarve holdout: --every must be at least 2");
@@ -64,6 +70,22 @@ int RunHoldout(int argc, char** argv) {
   }
   std::sort(held_out.begin(), held_out.end(),
             [](const CalibratedView& a, const CalibratedView& b) { return a.name < b.name; });
+  if (!score_mask_path.empty()) {
+    // The held-out views again, with the scoring masks, undistorted as the carve's are.
+    Reconstruction held_out_model = project.reconstruction;
+    held_out_model.images.clear();
+    for (const auto& [id, image] : project.reconstruction.images) {
+      if (held_out_names.count(image.name) > 0) held_out_model.images.emplace(id, image);
+    }
+    ViewReaderOptions score_options = request.view_options;
+    score_options.mask_path = score_mask_path;
+    std::vector<CalibratedView> scored =
+        ReadCalibratedViews(held_out_model, project.image_path, score_options, nullptr);
+    std::map<std::string, cv::Mat> mask_of;
+    for (CalibratedView& view : scored) mask_of[view.name] = view.mask;
+    for (CalibratedView& view : held_out) view.mask = mask_of.at(view.name);
+    LOG(INFO) << "held-out views scored against the masks in " << score_mask_path;
+  }
   if (training.size() < 2) {
     throw InputError("raycarve holdout: only " + std::to_string(training.size()) +
                      " views left to carve with; raise --every");
@@ -104,6 +126,7 @@ int RunHoldout(int argc, char** argv) {
     if (!CheckCarveFits(training, project.bounds.box, request.options, &reason)) {
       throw InputError("raycarve holdout: " + reason);
     }
+    CheckVolumeSeen("holdout", project, training, request.options.min_views, request.bounds);
     LOG(INFO) << "carving with " << training.size() << " views, holding out " << held_out.size();
     options.surface_points = SurfacePointsOf(project.reconstruction, training, project.bounds.box);
     result = std::make_unique<CarveResult>(CarveVolume(training, project.bounds.box, options));
@@ -139,6 +162,7 @@ int RunHoldout(int argc, char** argv) {
   json.BeginObject()
       .Key("model_path").Value(project.model_path)
       .Key("every").Value(every)
+      .Key("score_mask_path").Value(score_mask_path)
       .Key("training_views").Value(static_cast<uint64_t>(training.size()))
       .Key("cloud_points").Value(static_cast<uint64_t>(points.size()))
       .Key("render").Value(render)

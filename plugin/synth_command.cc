@@ -36,9 +36,10 @@ int RunSynth(int argc, char** argv) {
                     "../shared/data, then teapot/teapot_bezier.txt)");
   std::string backdrop = "patchwork";
   parser.AddDefault("backdrop", &backdrop,
-                    "behind the scene: a patchwork sky, or a uniform dark backdrop (a studio set-up "
-                    "that needs masks)",
-                    {"patchwork", "uniform"});
+                    "behind the scene: a patchwork sky (a natural scene), or a studio backdrop "
+                    "that needs masks: uniform (dark), two_tone (wall and table, with a dark "
+                    "frame), gradient, vignetted, shadowed_table",
+                    BackdropNames());
   std::string texture = "plain";
   parser.AddDefault("texture", &texture,
                     "the surfaces' texture: plain checks and stripes, or with a non-repeating "
@@ -51,7 +52,7 @@ int RunSynth(int argc, char** argv) {
                     "camera model of the photos (with a typical distortion)", models);
   if (!parser.Parse(argc, argv)) return 0;
   options.camera_model = CameraModelIdFromName(camera_model, "--camera_model");
-  options.uniform_backdrop = backdrop == "uniform";
+  BackdropFromString(backdrop, &options.backdrop);
   options.detail_texture = texture == "detailed";
   SceneKindFromString(scene_kind, &options.scene);
   std::string reason;

@@ -1,16 +1,19 @@
 #include "plugin/workspace.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include <glog/logging.h>
 
 #include "calib/colour_calibration.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
+#include "carve/carver.h"
 #include "plugin/commands.h"
 
 namespace raycarve {
@@ -166,7 +169,9 @@ LoadedProject LoadProject(const std::string& command,
   project.bounds = ResolveBounds(project.reconstruction, bounds_flags, paths.model_path);
   LOG(INFO) << project.bounds.Summary();
   LOG(INFO) << "loading and undistorting " << registered << " photos from " << paths.image_path;
-  project.views = ReadCalibratedViews(project.reconstruction, paths.image_path, view_options,
+  ViewReaderOptions reader_options = view_options;
+  reader_options.volume = project.bounds.box;
+  project.views = ReadCalibratedViews(project.reconstruction, paths.image_path, reader_options,
                                       &project.view_summary);
   LOG(INFO) << project.view_summary.Summary();
   if (static_cast<int>(project.views.size()) < min_images) {
@@ -187,6 +192,53 @@ LoadedProject LoadProject(const std::string& command,
   project.surface_points =
       SurfacePointsOf(project.reconstruction, project.views, project.bounds.box);
   return project;
+}
+
+void CheckVolumeSeen(const std::string& command,
+                     const LoadedProject& project,
+                     const std::vector<CalibratedView>& views,
+                     int min_views,
+                     const BoundsFlags& bounds_flags) {
+  const Eigen::AlignedBox3d& box = project.bounds.box;
+  const BoxCoverage coverage = MeasureBoxCoverage(views, box, min_views);
+  if (coverage.seen_share > 0.0) {
+    if (coverage.seen_share < 0.5) {
+      LOG(WARNING) << "only " << std::lround(100.0 * coverage.seen_share) << "% of the volume is "
+                   << "seen by " << min_views << " or more photos; the rest cannot be carved";
+    }
+    return;
+  }
+  const auto format = [](const Eigen::AlignedBox3d& b) {
+    std::ostringstream text;
+    text << "(" << b.min().x() << ", " << b.min().y() << ", " << b.min().z() << ") - ("
+         << b.max().x() << ", " << b.max().y() << ", " << b.max().z() << ")";
+    return text.str();
+  };
+  std::ostringstream text;
+  text << "raycarve " << command << ": the volume " << format(box)
+       << (project.bounds.is_explicit ? " (--bbox)" : " (from the sparse points)")
+       << " is seen by fewer than " << min_views << " photos (--min_views) everywhere: nothing "
+       << "in it can be carved. Share of it each photo sees:";
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (v == 12) {
+      text << " ... (" << views.size() - v << " more)";
+      break;
+    }
+    text << (v > 0 ? "," : "") << " " << views[v].name << " "
+         << std::lround(100.0 * coverage.view_share[v]) << "%";
+  }
+  if (project.bounds.is_explicit) {
+    BoundsFlags from_points = bounds_flags;
+    from_points.bbox.clear();
+    try {
+      const Bounds own = ResolveBounds(project.reconstruction, from_points, project.model_path);
+      text << ". The sparse points' own box is " << format(own.box)
+           << ": is the --bbox in the model's frame and units?";
+    } catch (const InputError&) {
+      text << ". (The sparse points cannot bound a volume of their own.)";
+    }
+  }
+  throw InputError(text.str());
 }
 
 std::vector<SurfacePoint> SurfacePointsOf(const Reconstruction& reconstruction,

@@ -143,6 +143,42 @@ Eigen::Vector3d SkyColour(const Eigen::Vector3d& direction) {
   return Eigen::Vector3d(40 + (hash & 0x7f), 40 + ((hash >> 8) & 0x7f), 60 + ((hash >> 16) & 0x7f));
 }
 
+// What a ray that meets no part of the scene shows, for each backdrop. The table is the plane
+// z = 0 around the ground square (out to a radius of 14), the wall everything beyond it.
+Eigen::Vector3d BackdropColour(Backdrop backdrop, const Eigen::Vector3d& origin,
+                               const Eigen::Vector3d& direction) {
+  const bool meets_table = direction.z() < 0.0;
+  const Eigen::Vector3d on_table = meets_table
+                                       ? Eigen::Vector3d(origin - direction * (origin.z() /
+                                                                               direction.z()))
+                                       : Eigen::Vector3d::Zero();
+  const bool table = meets_table && on_table.head<2>().norm() < 14.0;
+  switch (backdrop) {
+    case Backdrop::kPatchwork:
+      return SkyColour(direction);
+    case Backdrop::kUniform:
+      return kBackdropColour;
+    case Backdrop::kTwoTone:
+      return table ? Eigen::Vector3d(150, 160, 205) : Eigen::Vector3d(85, 100, 160);
+    case Backdrop::kGradient: {
+      const double elevation = std::asin(std::clamp(direction.z(), -1.0, 1.0));
+      const double t = std::clamp((elevation + 0.85) / 0.85, 0.0, 1.0);
+      const double w = t * t * (3.0 - 2.0 * t);
+      return (1.0 - w) * Eigen::Vector3d(150, 110, 80) + w * Eigen::Vector3d(235, 200, 170);
+    }
+    case Backdrop::kVignetted:
+      return Eigen::Vector3d(140, 90, 150);
+    case Backdrop::kShadowedTable: {
+      if (!table) return Eigen::Vector3d(225, 225, 230);
+      // A soft shadow cast away from the light (see SurfaceColour), darkest near the objects.
+      const double r = (on_table.head<2>() - Eigen::Vector2d(-0.2, -0.3)).norm();
+      const double shade = 1.0 - 0.55 * std::exp(-(r / 1.9) * (r / 1.9));
+      return shade * Eigen::Vector3d(190, 160, 120);
+    }
+  }
+  return SkyColour(direction);
+}
+
 // Value noise in [0, 1] at a point: random values on a lattice of spacing `scale` (hashed from
 // the lattice coordinates and `channel`), interpolated smoothly. Not periodic.
 double ValueNoise(const Eigen::Vector3d& point, double scale, uint32_t channel) {
@@ -243,7 +279,7 @@ cv::Mat Render(const SceneGeometry& geometry,
                const Camera& camera,
                const Rigid3d& cam_from_world,
                int supersampling,
-               bool uniform_backdrop,
+               Backdrop backdrop,
                bool detail,
                cv::Mat* mask) {
   const Rigid3d world_from_cam = cam_from_world.Inverse();
@@ -263,9 +299,9 @@ cv::Mat Render(const SceneGeometry& geometry,
               (world_from_cam.rotation * normalized.homogeneous()).normalized();
           const Hit hit = Trace(geometry, world_from_cam.translation, direction);
           hits += hit.surface != Surface::kNone;
-          sum += hit.surface != Surface::kNone ? SurfaceColour(hit, detail)
-                 : uniform_backdrop            ? kBackdropColour
-                                               : SkyColour(direction);
+          sum += hit.surface != Surface::kNone
+                     ? SurfaceColour(hit, detail)
+                     : BackdropColour(backdrop, world_from_cam.translation, direction);
         }
       }
       const Eigen::Vector3d rgb = sum / (supersampling * supersampling);
@@ -273,6 +309,31 @@ cv::Mat Render(const SceneGeometry& geometry,
       photo.at<cv::Vec3b>(row, col) = cv::Vec3b(static_cast<uint8_t>(std::lround(rgb[0])),
                                                 static_cast<uint8_t>(std::lround(rgb[1])),
                                                 static_cast<uint8_t>(std::lround(rgb[2])));
+    }
+  }
+  if (backdrop == Backdrop::kVignetted) {
+    // Natural vignetting: the photo darkens with the squared distance from its centre.
+    const Eigen::Vector2d centre(0.5 * photo.cols, 0.5 * photo.rows);
+    const double corner2 = centre.squaredNorm();
+    for (int row = 0; row < photo.rows; ++row) {
+      for (int col = 0; col < photo.cols; ++col) {
+        const double r2 = (Eigen::Vector2d(col + 0.5, row + 0.5) - centre).squaredNorm();
+        const double gain = 1.0 - 0.45 * r2 / corner2;
+        cv::Vec3b& p = photo.at<cv::Vec3b>(row, col);
+        for (int k = 0; k < 3; ++k) p[k] = static_cast<uint8_t>(std::lround(p[k] * gain));
+      }
+    }
+  }
+  if (backdrop == Backdrop::kTwoTone) {
+    // A near-black frame of 3 pixels, as a lens hood or a scanner leaves.
+    const int frame = 3;
+    for (int row = 0; row < photo.rows; ++row) {
+      for (int col = 0; col < photo.cols; ++col) {
+        if (row < frame || col < frame || row >= photo.rows - frame || col >= photo.cols - frame) {
+          photo.at<cv::Vec3b>(row, col) = cv::Vec3b(18, 16, 14);
+          mask->at<uint8_t>(row, col) = 0;
+        }
+      }
     }
   }
   return photo;
@@ -449,6 +510,25 @@ bool SceneKindFromString(const std::string& text, SceneKind* kind) {
   return false;
 }
 
+std::vector<std::string> BackdropNames() {
+  return {"patchwork", "uniform", "two_tone", "gradient", "vignetted", "shadowed_table"};
+}
+
+std::string BackdropToString(Backdrop backdrop) {
+  return BackdropNames()[static_cast<int>(backdrop)];
+}
+
+bool BackdropFromString(const std::string& text, Backdrop* backdrop) {
+  const std::vector<std::string> names = BackdropNames();
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (text == names[i]) {
+      *backdrop = static_cast<Backdrop>(i);
+      return true;
+    }
+  }
+  return false;
+}
+
 std::string DefaultTeapotPath() {
   const std::string relative = "teapot/teapot_bezier.txt";
   const char* data = std::getenv("RAYCARVE_DATA_DIR");
@@ -538,7 +618,7 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
     cv::Mat mask;
     scene.photos.emplace(image.image_id,
                          Render(geometry, camera, image.cam_from_world, options.supersampling,
-                                options.uniform_backdrop, options.detail_texture, &mask));
+                                options.backdrop, options.detail_texture, &mask));
     scene.masks.emplace(image.image_id, mask);
     reconstruction.images.emplace(image.image_id, std::move(image));
   }

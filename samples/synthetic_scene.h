@@ -26,6 +26,21 @@ enum class SceneKind { kSimple, kPaper };
 std::string SceneKindToString(SceneKind kind);
 bool SceneKindFromString(const std::string& text, SceneKind* kind);
 
+// What the photos show around the scene. The scene (objects and the checkered ground square) is
+// the object in the exact masks; everything a backdrop adds is background.
+enum class Backdrop {
+  kPatchwork,  // a sky of many coloured patches: a natural scene, no backdrop to mask
+  kUniform,    // one dark colour (kBackdropColour), as a studio backdrop
+  kTwoTone,    // a blue wall and a paler table plane (z = 0 around the ground square), and a
+               // 3-pixel near-black frame at the photo's edge
+  kGradient,   // a studio sweep: the colour goes from dark slate below to pale grey above
+  kVignetted,  // a uniform grey backdrop, the whole photo darkened towards its corners
+  kShadowedTable,  // a pale table plane with a soft shadow of the objects on it, a pale wall
+};
+std::string BackdropToString(Backdrop backdrop);
+bool BackdropFromString(const std::string& text, Backdrop* backdrop);
+std::vector<std::string> BackdropNames();
+
 // Where the paper's scene reads the teapot's Bezier patches: teapot/teapot_bezier.txt in
 // $RAYCARVE_DATA_DIR, else in the first ../shared/data found beside the working folder or beside
 // a folder holding the program.
@@ -46,9 +61,9 @@ struct SyntheticSceneOptions {
   int num_surface_samples = 3000;  // candidate sparse points before the visibility filter
   double pixel_noise = 0.0;        // std. dev. of Gaussian noise on the 2D observations (px)
   int supersampling = 2;           // rays per pixel along each axis when rendering
-  // Behind the scene: a patchwork sky (empty space is photo-inconsistent) or a uniform backdrop
-  // (kBackdropColour, as a studio backdrop: empty space is consistent unless masks are used).
-  bool uniform_backdrop = false;
+  // Behind the scene: a patchwork sky (empty space is photo-inconsistent) or one of the studio
+  // backdrops (empty space is consistent unless masks are used).
+  Backdrop backdrop = Backdrop::kPatchwork;
   // A non-repeating noise texture over every surface, on top of the checks and stripes, so that
   // structure-from-motion (SIFT matching) can tell places apart; off, the photos are plain.
   bool detail_texture = false;

@@ -25,7 +25,7 @@ inline SyntheticSceneOptions SceneOptions(int views,
   options.width = width;
   options.height = height;
   options.num_surface_samples = surface_samples;
-  options.uniform_backdrop = uniform_backdrop;
+  options.backdrop = uniform_backdrop ? Backdrop::kUniform : Backdrop::kPatchwork;
   return options;
 }
 

@@ -294,8 +294,10 @@ cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
   ObjectMaskReport local;
   if (report == nullptr) report = &local;
   *report = ObjectMaskReport();
-  // GrabCut works on at most 800 pixels a side; the result is scaled back.
-  const double scale = std::min(1.0, 800.0 / std::max(rgb.rows, rgb.cols));
+  // GrabCut works on at most kWorkSide pixels a side; the result is scaled back, and its
+  // outline re-decided by the colour rule at full resolution.
+  constexpr double kWorkSide = 320.0;
+  const double scale = std::min(1.0, kWorkSide / std::max(rgb.rows, rgb.cols));
   cv::Mat work = rgb;
   if (scale < 1.0) cv::resize(rgb, work, cv::Size(), scale, scale, cv::INTER_AREA);
   int frame[4];
@@ -354,12 +356,26 @@ cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
 
   cv::Mat mask;
   if (refine && object_like >= 64 && backdrop_like >= 64) {
+    // Only the volume's outline (and a margin) can hold object: the cut runs there.
+    cv::Rect region(0, 0, work.cols, work.rows);
+    if (report->cut_to_box) {
+      std::vector<cv::Point> inside;
+      cv::findNonZero(inside_box, inside);
+      region = inside.empty() ? cv::Rect() : cv::boundingRect(inside);
+    }
     try {
-      cv::Mat background_model, object_model;
-      cv::grabCut(work, labels, cv::Rect(), background_model, object_model, 3,
-                  cv::GC_INIT_WITH_MASK);
-      mask = (labels & 1) * 255;  // GC_FGD and GC_PR_FGD are odd
-      report->refined = true;
+      cv::Mat region_labels = labels(region).clone();
+      const cv::Mat under = region_labels != cv::GC_BGD;
+      const cv::Mat object = (region_labels & 1) != 0;
+      if (cv::countNonZero(object) >= 64 && cv::countNonZero(~object) >= 64 &&
+          cv::countNonZero(under) > 0) {
+        cv::Mat background_model, object_model;
+        cv::grabCut(work(region), region_labels, cv::Rect(), background_model, object_model, 2,
+                    cv::GC_INIT_WITH_MASK);
+        mask = cv::Mat::zeros(work.size(), CV_8UC1);
+        mask(region).setTo(255, (region_labels & 1) != 0);  // GC_FGD and GC_PR_FGD are odd
+        report->refined = true;
+      }
     } catch (const cv::Exception& error) {
       LOG(WARNING) << "GrabCut failed (" << error.what() << "); the colour rule's mask is used";
     }
@@ -370,6 +386,35 @@ cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
   if (scale < 1.0) {
     cv::resize(mask, mask, rgb.size(), 0, 0, cv::INTER_LINEAR);
     cv::threshold(mask, mask, 127, 255, cv::THRESH_BINARY);
+    // Along the outline, within the blur of the scaling, the colour rule decides per pixel.
+    const int reach = static_cast<int>(std::ceil(1.0 / scale)) + 1;
+    const cv::Mat kernel = cv::Mat::ones(2 * reach + 1, 2 * reach + 1, CV_8U);
+    cv::Mat grown, shrunk, full_box;
+    cv::dilate(mask, grown, kernel);
+    cv::erode(mask, shrunk, kernel);
+    cv::resize(inside_box, full_box, rgb.size(), 0, 0, cv::INTER_NEAREST);
+    const int full_frame[4] = {model.frame[0], model.frame[1], model.frame[2], model.frame[3]};
+    const BorderBand full_band = MakeBand(rgb, full_frame);
+    for (int row = 0; row < rgb.rows; ++row) {
+      const uint8_t* g = grown.ptr<uint8_t>(row);
+      const uint8_t* e = shrunk.ptr<uint8_t>(row);
+      const uint8_t* b = full_box.ptr<uint8_t>(row);
+      uint8_t* out = mask.ptr<uint8_t>(row);
+      const cv::Vec3b* pixels = rgb.ptr<cv::Vec3b>(row);
+      for (int col = 0; col < rgb.cols; ++col) {
+        if (g[col] == e[col]) continue;  // not near the outline
+        const bool object = b[col] != 0 && !full_band.InFrame(row, col, rgb.rows, rgb.cols) &&
+                            BackdropDistance(ToVector(pixels[col]), model, 1.0, 1.0) > tolerance;
+        // Near the outline a pixel stays object only when its colour is not the backdrop's,
+        // and becomes object only when it is neither backdrop nor a shade of it.
+        out[col] = out[col] != 0 ? (object ? 255 : 0)
+                                 : (object && BackdropDistance(ToVector(pixels[col]), model,
+                                                               kShadowGain, kLightGain) >
+                                                  tolerance
+                                        ? 255
+                                        : 0);
+      }
+    }
   }
   report->object_share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
   return mask;

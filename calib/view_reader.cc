@@ -1,6 +1,11 @@
 #include "calib/view_reader.h"
 
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
 #include <filesystem>
+#include <thread>
 #include <sstream>
 
 #include <glog/logging.h>
@@ -70,6 +75,84 @@ std::vector<cv::Point> VolumeOutline(const Camera& camera, const Image& image,
 
 }  // namespace
 
+namespace {
+
+// What loading one registered image gave.
+struct LoadedView {
+  bool missing = false;  // photo not found, skipped
+  std::string path;
+  CalibratedView view;
+  PhotoMaskInfo info;
+  std::exception_ptr error;
+};
+
+LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, const Image& image,
+                    const std::string& image_path, const ViewReaderOptions& options) {
+  LoadedView loaded;
+  const std::string path = (std::filesystem::path(image_path) / image.name).string();
+  loaded.path = path;
+  if (!std::filesystem::is_regular_file(path)) {
+    if (options.skip_missing_images) {
+      LOG(WARNING) << path << ": photo of image " << image_id << " not found; skipped";
+      loaded.missing = true;
+      return loaded;
+    }
+    throw InputError(path + ": photo of image " + std::to_string(image_id) + " ('" + image.name +
+                     "') not found");
+  }
+  const cv::Mat bgr = ReadImage(path, cv::IMREAD_COLOR);
+  if (bgr.empty()) {
+    throw InputError(path + ": photo of image " + std::to_string(image_id) +
+                     " cannot be decoded as an image");
+  }
+  cv::Mat rgb;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  cv::Mat mask;
+  std::string mask_file;
+  PhotoMaskInfo& info = loaded.info;
+  info.name = image.name;
+  info.source = "none";
+  const Camera& camera = reconstruction.cameras.at(image.camera_id);
+  if (!options.mask_path.empty()) {
+    const std::filesystem::path folder(options.mask_path);
+    const std::string colmap_style = (folder / (image.name + ".png")).string();
+    const std::string same_name = (folder / image.name).string();
+    mask_file = std::filesystem::is_regular_file(colmap_style) ? colmap_style : same_name;
+    if (!std::filesystem::is_regular_file(mask_file)) {
+      throw InputError(colmap_style + ": mask of image " + std::to_string(image_id) +
+                       " not found (nor " + same_name + ")");
+    }
+    mask = ReadImage(mask_file, cv::IMREAD_GRAYSCALE);
+    if (mask.empty()) throw InputError(mask_file + ": mask cannot be decoded as an image");
+    info.source = "file";
+  } else if (options.background.mode == BackgroundOptions::Mode::kColour) {
+    mask = ObjectMaskFromBackdrop(rgb, options.background.colour, options.background.tolerance);
+    mask_file = path + " (backdrop mask)";
+    info.source = "colour";
+  } else if (options.background.mode == BackgroundOptions::Mode::kAuto) {
+    info.backdrop = EstimateBackdropModel(rgb, options.background.tolerance);
+    if (!info.backdrop.found) {
+      LOG(WARNING) << path << ": " << info.backdrop.Summary() << "; no backdrop mask";
+    } else {
+      mask = ObjectMaskFromModel(rgb, info.backdrop, options.background.tolerance,
+                                 options.background.refine,
+                                 SeedPixels(reconstruction, image, options.volume),
+                                 VolumeOutline(camera, image, options.volume), &info.mask);
+      mask_file = path + " (backdrop mask)";
+      info.source = "backdrop";
+      VLOG(1) << path << ": backdrop " << info.backdrop.Summary() << ", object "
+              << std::lround(100.0 * info.mask.object_share) << "% of the photo, "
+              << info.mask.seeds << " sparse points as seeds";
+    }
+  }
+  if (!mask.empty()) info.object_share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
+  loaded.view = MakeCalibratedView(camera, image, rgb, path, mask, mask_file);
+  VLOG(1) << path << ": view built";
+  return loaded;
+}
+
+}  // namespace
+
 std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruction,
                                                 const std::string& image_path,
                                                 const ViewReaderOptions& options,
@@ -81,77 +164,53 @@ std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruc
   if (!std::filesystem::is_directory(image_path)) {
     throw InputError(image_path + ": image folder does not exist or is not a folder");
   }
+  // Photos are decoded, masked and undistorted on several threads; the views, the summary and
+  // the first error (in image-id order) are the same for any thread count.
+  std::vector<std::pair<image_t, const Image*>> images;
+  for (const auto& [image_id, image] : reconstruction.images) images.emplace_back(image_id, &image);
+  std::vector<LoadedView> loaded(images.size());
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const int num_threads = static_cast<int>(std::min<size_t>(
+      images.size(), options.num_threads > 0 ? options.num_threads : cores));
+  std::atomic<size_t> next{0};
+  const auto work = [&] {
+    for (size_t i = next++; i < images.size(); i = next++) {
+      try {
+        loaded[i] = LoadView(reconstruction, images[i].first, *images[i].second, image_path,
+                             options);
+      } catch (...) {
+        loaded[i].error = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < num_threads; ++t) threads.emplace_back(work);
+  work();
+  for (std::thread& thread : threads) thread.join();
+
   std::vector<CalibratedView> views;
-  for (const auto& [image_id, image] : reconstruction.images) {
-    const std::string path = (std::filesystem::path(image_path) / image.name).string();
-    if (!std::filesystem::is_regular_file(path)) {
-      if (options.skip_missing_images) {
-        LOG(WARNING) << path << ": photo of image " << image_id << " not found; skipped";
-        summary->missing.push_back(path);
-        continue;
-      }
-      throw InputError(path + ": photo of image " + std::to_string(image_id) + " ('" +
-                       image.name + "') not found");
+  for (LoadedView& result : loaded) {
+    if (result.error) std::rethrow_exception(result.error);
+    if (result.missing) {
+      summary->missing.push_back(result.path);
+      continue;
     }
-    const cv::Mat bgr = ReadImage(path, cv::IMREAD_COLOR);
-    if (bgr.empty()) {
-      throw InputError(path + ": photo of image " + std::to_string(image_id) +
-                       " cannot be decoded as an image");
-    }
-    cv::Mat rgb;
-    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-    cv::Mat mask;
-    std::string mask_file;
-    if (!options.mask_path.empty()) {
-      const std::filesystem::path folder(options.mask_path);
-      const std::string colmap_style = (folder / (image.name + ".png")).string();
-      const std::string same_name = (folder / image.name).string();
-      mask_file = std::filesystem::is_regular_file(colmap_style) ? colmap_style : same_name;
-      if (!std::filesystem::is_regular_file(mask_file)) {
-        throw InputError(colmap_style + ": mask of image " + std::to_string(image_id) +
-                         " not found (nor " + same_name + ")");
-      }
-      mask = ReadImage(mask_file, cv::IMREAD_GRAYSCALE);
-      if (mask.empty()) throw InputError(mask_file + ": mask cannot be decoded as an image");
-      ++summary->masks_from_files;
-    }
-    const Camera& camera = reconstruction.cameras.at(image.camera_id);
-    PhotoMaskInfo info;
-    info.name = image.name;
-    info.source = mask.empty() ? "none" : "file";
-    if (options.mask_path.empty() && options.background.mode == BackgroundOptions::Mode::kColour) {
-      const Eigen::Vector3d& backdrop = options.background.colour;
-      mask = ObjectMaskFromBackdrop(rgb, backdrop, options.background.tolerance);
-      mask_file = path + " (backdrop mask)";
-      summary->mean_backdrop += backdrop;
+    const PhotoMaskInfo& info = result.info;
+    if (info.source == "file") ++summary->masks_from_files;
+    if (info.source == "colour") {
+      summary->mean_backdrop += options.background.colour;
       ++summary->masks_from_backdrop;
-      info.source = "colour";
-    } else if (options.mask_path.empty() &&
-               options.background.mode == BackgroundOptions::Mode::kAuto) {
-      info.backdrop = EstimateBackdropModel(rgb, options.background.tolerance);
-      if (!info.backdrop.found) {
-        LOG(WARNING) << path << ": " << info.backdrop.Summary() << "; no backdrop mask";
-        ++summary->no_plain_backdrop;
-      } else {
-        mask = ObjectMaskFromModel(rgb, info.backdrop, options.background.tolerance,
-                                   options.background.refine,
-                                   SeedPixels(reconstruction, image, options.volume),
-                                   VolumeOutline(camera, image, options.volume), &info.mask);
-        mask_file = path + " (backdrop mask)";
-        summary->mean_backdrop += info.backdrop.colours[0];
-        ++summary->masks_from_backdrop;
-        info.source = "backdrop";
-        VLOG(1) << path << ": backdrop " << info.backdrop.Summary() << ", object "
-                << std::lround(100.0 * info.mask.object_share) << "% of the photo, "
-                << info.mask.seeds << " sparse points as seeds";
-      }
     }
-    if (!mask.empty()) {
-      info.object_share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
+    if (info.source == "backdrop") {
+      summary->mean_backdrop += info.backdrop.colours[0];
+      ++summary->masks_from_backdrop;
+    }
+    if (options.mask_path.empty() && options.background.mode == BackgroundOptions::Mode::kAuto &&
+        !info.backdrop.found) {
+      ++summary->no_plain_backdrop;
     }
     summary->photos.push_back(info);
-    views.push_back(MakeCalibratedView(camera, image, rgb, path, mask, mask_file));
-    VLOG(1) << path << ": view built";
+    views.push_back(std::move(result.view));
   }
   summary->num_loaded = static_cast<int>(views.size());
   if (summary->masks_from_backdrop > 0) summary->mean_backdrop /= summary->masks_from_backdrop;

@@ -20,6 +20,8 @@ struct ViewReaderOptions {
   // The volume to carve, when known: automatic masks take the sparse points inside it as sure
   // object and the pixels whose rays miss it as backdrop. Empty: every sparse point, no cut.
   Eigen::AlignedBox3d volume;
+  // Threads decoding and masking photos (0: one per core); the result is the same for any.
+  int num_threads = 0;
 };
 
 // What was found for one photo's mask.

@@ -252,6 +252,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("masks_from_files").Value(run.masks_from_files)
       .Key("masks_from_backdrop").Value(run.masks_from_backdrop)
       .Key("background_tolerance").Value(request.view_options.background.tolerance)
+      .Key("mask_graph_cut").Value(request.view_options.background.refine)
       .Key("visual_hull").Value(request.options.visual_hull)
       .EndObject();
   json.Key("masks").BeginArray();
@@ -515,10 +516,13 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "pixels are left out, and the silhouettes pre-carve the volume");
   parser->AddDefault("background_colour", &text->background,
                      "without --mask_path, masks from a plain backdrop: auto (a photo whose border "
-                     "is one colour gets a mask; natural scenes are left as they are), none, or "
-                     "R,G,B");
+                     "is one to five plain colours, behind an optional frame, gets a mask; natural "
+                     "scenes are left as they are), none, or R,G,B");
   parser->AddDefault("background_tolerance", &request->view_options.background.tolerance,
                      "RGB distance from the backdrop colour beyond which a pixel is object");
+  parser->AddDefault("mask_graph_cut", &request->view_options.background.refine,
+                     "auto masks: refine the colour rule by a graph cut (GrabCut) seeded with the "
+                     "sparse points; 0: the colour rule alone");
   parser->AddDefault("visual_hull", &request->options.visual_hull,
                      "with masks, carve the silhouettes' visual hull before colouring");
   parser->AddDefault("mesh", &request->mesh_kind,

@@ -320,24 +320,64 @@ cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
     report->cut_to_box = true;
   }
 
+  // Each pixel's colour class: the backdrop's colours, a shade of them (darker or lighter by a
+  // gain), or neither. A shade is probable backdrop only where it is reached from the backdrop's
+  // colours through neighbours that differ by at most half the tolerance (a soft shadow, a
+  // vignette, a gradient): a dark part of the object that happens to share a backdrop colour's
+  // hue is not, since its edge against the backdrop is sharp.
+  enum : uint8_t { kPlain = 0, kShade = 1, kObject = 2, kFrame = 3 };
+  cv::Mat colour_class(work.size(), CV_8UC1);
+  std::vector<cv::Point> frontier;
+  for (int row = 0; row < work.rows; ++row) {
+    const cv::Vec3b* pixels = work.ptr<cv::Vec3b>(row);
+    uint8_t* klass = colour_class.ptr<uint8_t>(row);
+    for (int col = 0; col < work.cols; ++col) {
+      const Eigen::Vector3d p = ToVector(pixels[col]);
+      if (band.InFrame(row, col, work.rows, work.cols)) {
+        klass[col] = kFrame;
+      } else if (BackdropDistance(p, model, 1.0, 1.0) <= tolerance) {
+        klass[col] = kPlain;
+        frontier.emplace_back(col, row);
+      } else {
+        klass[col] = BackdropDistance(p, model, kShadowGain, kLightGain) <= tolerance ? kShade
+                                                                                      : kObject;
+      }
+    }
+  }
+  cv::Mat reached(work.size(), CV_8UC1, cv::Scalar(0));
+  for (const cv::Point& p : frontier) reached.at<uint8_t>(p) = 1;
+  const double step2 = 0.25 * tolerance * tolerance;
+  while (!frontier.empty()) {
+    const cv::Point p = frontier.back();
+    frontier.pop_back();
+    const Eigen::Vector3d colour = ToVector(work.at<cv::Vec3b>(p));
+    const cv::Point neighbours[4] = {{p.x + 1, p.y}, {p.x - 1, p.y}, {p.x, p.y + 1}, {p.x, p.y - 1}};
+    for (const cv::Point& q : neighbours) {
+      if (q.x < 0 || q.y < 0 || q.x >= work.cols || q.y >= work.rows) continue;
+      if (reached.at<uint8_t>(q) || colour_class.at<uint8_t>(q) != kShade) continue;
+      if ((ToVector(work.at<cv::Vec3b>(q)) - colour).squaredNorm() > step2) continue;
+      reached.at<uint8_t>(q) = 1;
+      frontier.push_back(q);
+    }
+  }
+
   cv::Mat labels(work.size(), CV_8UC1);
   cv::Mat colour_rule(work.size(), CV_8UC1);
   int object_like = 0, backdrop_like = 0;
   for (int row = 0; row < work.rows; ++row) {
-    const cv::Vec3b* pixels = work.ptr<cv::Vec3b>(row);
     uint8_t* label = labels.ptr<uint8_t>(row);
     uint8_t* rule = colour_rule.ptr<uint8_t>(row);
     const uint8_t* in_box = inside_box.ptr<uint8_t>(row);
+    const uint8_t* klass = colour_class.ptr<uint8_t>(row);
+    const uint8_t* shade_reached = reached.ptr<uint8_t>(row);
     for (int col = 0; col < work.cols; ++col) {
-      const Eigen::Vector3d p = ToVector(pixels[col]);
-      rule[col] = 0;
-      if (band.InFrame(row, col, work.rows, work.cols) || in_box[col] == 0) {
+      rule[col] = klass[col] == kShade || klass[col] == kObject ? 255 : 0;
+      if (klass[col] == kFrame || in_box[col] == 0) {
         label[col] = cv::GC_BGD;
-      } else if (BackdropDistance(p, model, 1.0, 1.0) <= tolerance) {
+      } else if (klass[col] == kPlain) {
         label[col] = band.InBand(row, col, work.rows, work.cols) ? cv::GC_BGD : cv::GC_PR_BGD;
       } else {
-        rule[col] = 255;
-        label[col] = BackdropDistance(p, model, kShadowGain, kLightGain) <= tolerance ? cv::GC_PR_BGD : cv::GC_PR_FGD;
+        label[col] = klass[col] == kShade && shade_reached[col] ? cv::GC_PR_BGD : cv::GC_PR_FGD;
       }
       const bool object = label[col] == cv::GC_PR_FGD;
       object_like += object;
@@ -370,8 +410,13 @@ cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
       if (cv::countNonZero(object) >= 64 && cv::countNonZero(~object) >= 64 &&
           cv::countNonZero(under) > 0) {
         cv::Mat background_model, object_model;
+        // GrabCut seeds its colour models by k-means on OpenCV's per-thread generator: a fixed
+        // state gives the same mask on any thread.
+        const uint64 saved_state = cv::theRNG().state;
+        cv::theRNG().state = 0x9e3779b97f4a7c15ULL;
         cv::grabCut(work(region), region_labels, cv::Rect(), background_model, object_model, 2,
                     cv::GC_INIT_WITH_MASK);
+        cv::theRNG().state = saved_state;
         mask = cv::Mat::zeros(work.size(), CV_8UC1);
         mask(region).setTo(255, (region_labels & 1) != 0);  // GC_FGD and GC_PR_FGD are odd
         report->refined = true;

@@ -82,9 +82,10 @@ struct ObjectMaskReport {
 //  - the frame, and pixels within `tolerance` of a backdrop colour, are backdrop;
 //  - with `refine`, GrabCut (OpenCV) then decides over colour models of both, from: frame and
 //    border pixels of the backdrop's colours as sure backdrop, the other backdrop-coloured
-//    pixels and those that are only a darker shade of it (shadows, vignetting) as probable
-//    backdrop, the rest as probable object, and `object_seeds` (pixels of sparse points inside
-//    the volume) as sure object;
+//    pixels and those that are only a shade of them (shadows, vignetting, gradients: a gain in
+//    [kShadowGain, kLightGain], reached from the backdrop's colours through neighbours that
+//    differ by at most half the tolerance) as probable backdrop, the rest as probable object,
+//    and `object_seeds` (pixels of sparse points inside the volume) as sure object;
 //  - `box_hull` (the volume's outline in the photo, possibly empty): pixels outside it are sure
 //    backdrop, since no carving can use them;
 //  - then cleaned of specks (opening 3x3) and pinholes (closing 5x5).

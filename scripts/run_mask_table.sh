@@ -50,8 +50,8 @@ for backdrop in two_tone gradient vignetted shadowed_table uniform patchwork; do
   echo "| $backdrop | $made of 12 | $iou | $iou_no_cut | $auto | $exact ${label} | $ratio |"
 done
 echo
-echo "| Middlebury set (given model) | masks | held-out PSNR / IoU (own masks) | carve s |"
-echo "|---|---|---:|---:|"
+echo "| Middlebury set (given model) | masks | held-out PSNR / IoU, own masks | photos and masks s | carve s |"
+echo "|---|---|---:|---:|---:|"
 for set in templeSparseRing dinoSparseRing dinoRing; do
   args="--input_path $data/middlebury/$set/colmap/given --image_path $data/middlebury/$set"
   dir="$out/$set"
@@ -60,6 +60,6 @@ for set in templeSparseRing dinoSparseRing dinoRing; do
   # shellcheck disable=SC2086
   $rc holdout $args --output_path "$dir/holdout" > "$dir.holdout.log" 2>&1
   masks=$(grep -m1 "^  masks " "$dir.carve.log" | sed 's/^  masks *//')
-  seconds=$(python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); print("%.1f" % sum(s["seconds"] for s in r["stages"]))' "$dir/carve/report.json" 2>/dev/null || echo "?")
-  echo "| $set | $masks | $(holdout_figures "$dir/holdout/holdout.json") | $seconds |"
+  seconds=$(python3 -c 'import json,sys; s=json.load(open(sys.argv[1]))["stage_seconds"]; print("%.2f | %.2f" % (s["load_project"], s["carve_setup"] + s["carve"]))' "$dir/carve/report.json")
+  echo "| $set | $masks | $(holdout_figures "$dir/holdout/holdout/holdout.json") | $seconds |"
 done

@@ -1,12 +1,17 @@
 #include "calib/background_mask.h"
 
+#include <filesystem>
+#include <map>
+
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "calib/input_error.h"
+#include "calib/view_reader.h"
 #include "samples/synthetic_scene.h"
 #include "tests/carve/carve_fixture.h"
+#include "tests/test_support.h"
 
 namespace raycarve {
 namespace {
@@ -75,6 +80,130 @@ TEST(BackgroundMask, ParsesTheFlag) {
   std::string reason;
   options.tolerance = 0;
   EXPECT_FALSE(options.IsValid(&reason));
+}
+
+// A generated scene of `views` photos on `backdrop`, written as a project, and the masks that
+// the view reader makes for it without mask files (the volume: the scene's box with a margin,
+// as the sparse points would bound it), by image name.
+struct AutoMasks {
+  SyntheticScene scene;
+  ViewReaderSummary summary;
+  std::map<std::string, cv::Mat> masks;
+  std::map<std::string, cv::Mat> truth;
+};
+
+AutoMasks MakeAutoMasks(Backdrop backdrop, int views, int width, int height, bool refine = true,
+                        int num_threads = 0) {
+  AutoMasks result;
+  SyntheticSceneOptions options = testing::SceneOptions(views, width, height, false, 600);
+  options.backdrop = backdrop;
+  result.scene = GenerateSyntheticScene(options);
+  const std::string folder =
+      testing::MakeTemporaryDirectory("auto_masks_" + BackdropToString(backdrop));
+  WriteSyntheticProject(result.scene, folder);
+  ViewReaderOptions reader;
+  reader.background.mode = BackgroundOptions::Mode::kAuto;
+  reader.background.refine = refine;
+  reader.num_threads = num_threads;
+  reader.volume = result.scene.object_box;
+  const Eigen::Vector3d margin = Eigen::Vector3d::Constant(0.1 * result.scene.object_box.sizes().maxCoeff());
+  reader.volume.min() -= margin;
+  reader.volume.max() += margin;
+  const std::vector<CalibratedView> read =
+      ReadCalibratedViews(result.scene.reconstruction, folder + "/images", reader, &result.summary);
+  for (const CalibratedView& view : read) result.masks[view.name] = view.mask;
+  for (const auto& [id, image] : result.scene.reconstruction.images) {
+    result.truth[image.name] = result.scene.masks.at(id);
+  }
+  std::filesystem::remove_all(folder);
+  return result;
+}
+
+TEST(BackdropModel, FindsTheWallAndTheTableAndSetsTheFrameAside) {
+  SyntheticSceneOptions options = testing::SceneOptions(2, 240, 180);
+  options.backdrop = Backdrop::kTwoTone;
+  const SyntheticScene scene = GenerateSyntheticScene(options);
+  for (const auto& [id, photo] : scene.photos) {
+    const BackdropModel model = EstimateBackdropModel(photo, 30.0);
+    ASSERT_TRUE(model.found) << model.Summary();
+    ASSERT_EQ(model.colours.size(), 2u) << model.Summary();
+    for (int side = 0; side < 4; ++side) EXPECT_EQ(model.frame[side], 3) << model.Summary();
+    // The two colours the scene paints (wall and table), to the rounding of their medians.
+    std::vector<Eigen::Vector3d> expected = {{150, 160, 205}, {85, 100, 160}};
+    for (const Eigen::Vector3d& colour : expected) {
+      const double nearest = std::min((model.colours[0] - colour).norm(),
+                                      (model.colours[1] - colour).norm());
+      EXPECT_LT(nearest, 2.0) << model.Summary();
+    }
+  }
+}
+
+TEST(BackdropModel, ANaturalSceneHasNoBackdrop) {
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(3, 240, 180));
+  for (const auto& [id, photo] : scene.photos) {
+    const BackdropModel model = EstimateBackdropModel(photo, 30.0);
+    EXPECT_FALSE(model.found) << "view " << id << ": " << model.Summary();
+  }
+}
+
+TEST(BackdropModel, AShadowIsADarkerShadeOfTheBackdrop) {
+  BackdropModel model;
+  model.found = true;
+  model.colours = {Eigen::Vector3d(190, 160, 120)};
+  EXPECT_NEAR(BackdropDistance(Eigen::Vector3d(95, 80, 60), model, 0.4, 1.0), 0.0, 1e-9);
+  EXPECT_GT(BackdropDistance(Eigen::Vector3d(95, 80, 60), model, 1.0, 1.0), 100.0);
+  // A colour of another hue is far at any brightness.
+  EXPECT_GT(BackdropDistance(Eigen::Vector3d(60, 70, 90), model, 0.4, 1.8), 40.0);
+}
+
+// Masks made without mask files agree with the exact silhouettes on every studio backdrop.
+class AutomaticMasks : public ::testing::TestWithParam<Backdrop> {};
+
+TEST_P(AutomaticMasks, AgreeWithTheExactSilhouettes) {
+  const AutoMasks made = MakeAutoMasks(GetParam(), 4, 320, 240);
+  ASSERT_EQ(made.summary.masks_from_backdrop, 4);
+  for (const PhotoMaskInfo& photo : made.summary.photos) {
+    EXPECT_EQ(photo.source, "backdrop");
+    EXPECT_TRUE(photo.mask.refined) << photo.name;
+    EXPECT_GT(photo.mask.seeds, 50) << photo.name;
+    EXPECT_TRUE(photo.mask.cut_to_box) << photo.name;
+    // Measured 0.993-0.998 over the five backdrops and four views (anti-aliased outlines differ).
+    EXPECT_GT(Iou(made.masks.at(photo.name), made.truth.at(photo.name)), 0.95)
+        << BackdropToString(GetParam()) << " " << photo.name << ": " << photo.backdrop.Summary();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(StudioBackdrops, AutomaticMasks,
+                         ::testing::Values(Backdrop::kTwoTone, Backdrop::kGradient,
+                                           Backdrop::kVignetted, Backdrop::kShadowedTable,
+                                           Backdrop::kUniform),
+                         [](const ::testing::TestParamInfo<Backdrop>& info) {
+                           return BackdropToString(info.param);
+                         });
+
+TEST(AutomaticMasks, TheGraphCutIsWhatTakesShadowsOut) {
+  // The colour rule alone keeps the table's shadow as object; GrabCut, seeded with the sparse
+  // points, leaves it out (measured: IoU a mean of 0.69 without and 0.99 with over 12 views of 320x240).
+  const AutoMasks without = MakeAutoMasks(Backdrop::kShadowedTable, 2, 320, 240, false);
+  const AutoMasks with = MakeAutoMasks(Backdrop::kShadowedTable, 2, 320, 240, true);
+  for (const auto& [name, truth] : with.truth) {
+    EXPECT_GT(Iou(with.masks.at(name), truth), Iou(without.masks.at(name), truth) + 0.1) << name;
+  }
+}
+
+TEST(AutomaticMasks, AreTheSameForAnyThreadCount) {
+  const AutoMasks one = MakeAutoMasks(Backdrop::kGradient, 3, 200, 150, true, 1);
+  const AutoMasks two = MakeAutoMasks(Backdrop::kGradient, 3, 200, 150, true, 3);
+  for (const auto& [name, mask] : one.masks) {
+    EXPECT_EQ(cv::countNonZero(mask != two.masks.at(name)), 0) << name;
+  }
+}
+
+TEST(AutomaticMasks, ANaturalSceneGetsNone) {
+  const AutoMasks made = MakeAutoMasks(Backdrop::kPatchwork, 3, 240, 180);
+  EXPECT_EQ(made.summary.masks_from_backdrop, 0);
+  EXPECT_EQ(made.summary.no_plain_backdrop, 3);
+  for (const auto& [name, mask] : made.masks) EXPECT_TRUE(mask.empty()) << name;
 }
 
 }  // namespace

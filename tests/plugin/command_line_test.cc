@@ -485,6 +485,42 @@ TEST_F(CommandLine, ByDefaultAPlainBackdropGivesMasksAndANaturalSceneNone) {
                   {"--background_colour 'black'"});
 }
 
+TEST_F(CommandLine, ABackdropOfTwoColoursBehindAFrameGivesMasksAndSaysWhatItFound) {
+  const std::string studio = *root_ + "/two_tone";
+  std::string output;
+  ASSERT_EQ(Run("synth --output_path " + studio +
+                    " --views 4 --width 160 --height 120 --points 300 --backdrop two_tone",
+                &output),
+            0)
+      << output;
+  ASSERT_EQ(Run("carve --workspace_path " + studio + " --output_path " + studio +
+                    "/out --resolution 32",
+                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("4 from the backdrop; backdrop of the first: 2 colours"), std::string::npos)
+      << output;
+  EXPECT_NE(output.find("4 photos with a frame"), std::string::npos) << output;
+  const std::string report = testing::ReadFileBytes(studio + "/out/report.json");
+  EXPECT_EQ(JsonNumber(report, "masks_from_backdrop"), 4);
+  EXPECT_NE(report.find("\"source\": \"backdrop\""), std::string::npos) << report;
+  EXPECT_NE(report.find("\"frame_px\": [3, 3, 3, 3]"), std::string::npos) << report;
+  EXPECT_GT(JsonNumber(report, "visual_hull_carved"), 0);
+}
+
+TEST_F(CommandLine, AVolumeNoPhotoSeesIsRefusedWithWhatEachPhotoSees) {
+  // A --bbox far from where the cameras look (as in another frame or unit).
+  ExpectUserError("carve --workspace_path " + Project() + " --output_path " + *root_ +
+                      "/unseen --resolution 16 --bbox 100,100,100,101,101,101",
+                  {"the volume (100, 100, 100) - (101, 101, 101) (--bbox)",
+                   "seen by fewer than 2 photos", "view001.png 0%", "view004.png 0%",
+                   "The sparse points' own box is"});
+  EXPECT_FALSE(fs::exists(*root_ + "/unseen/report.json"));
+  ExpectUserError("holdout --workspace_path " + Project() + " --output_path " + *root_ +
+                      "/unseen --resolution 16 --every 4 --bbox 100,100,100,101,101,101",
+                  {"seen by fewer than 2 photos"});
+}
+
 TEST_F(CommandLine, HoldoutScoresRendersOfLeftOutViews) {
   // Its own project: held-out scoring needs enough training views for a model to show.
   const std::string project = *root_ + "/holdout_project";

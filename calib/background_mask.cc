@@ -375,7 +375,9 @@ cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
       if (klass[col] == kFrame || in_box[col] == 0) {
         label[col] = cv::GC_BGD;
       } else if (klass[col] == kPlain) {
-        label[col] = band.InBand(row, col, work.rows, work.cols) ? cv::GC_BGD : cv::GC_PR_BGD;
+        // The backdrop's own colours stay backdrop: the cut would otherwise close real openings
+        // (between a temple's columns) that its smoothness finds too thin.
+        label[col] = cv::GC_BGD;
       } else {
         label[col] = klass[col] == kShade && shade_reached[col] ? cv::GC_PR_BGD : cv::GC_PR_FGD;
       }

@@ -80,9 +80,8 @@ struct ObjectMaskReport {
 
 // The object mask (CV_8UC1, 255 = object) of a photo whose backdrop is `model`:
 //  - the frame, and pixels within `tolerance` of a backdrop colour, are backdrop;
-//  - with `refine`, GrabCut (OpenCV) then decides over colour models of both, from: frame and
-//    border pixels of the backdrop's colours as sure backdrop, the other backdrop-coloured
-//    pixels and those that are only a shade of them (shadows, vignetting, gradients: a gain in
+//  - with `refine`, GrabCut (OpenCV) then decides over colour models of both, from: the frame
+//    and pixels of the backdrop's colours as sure backdrop, pixels that are only a shade of them (shadows, vignetting, gradients: a gain in
 //    [kShadowGain, kLightGain], reached from the backdrop's colours through neighbours that
 //    differ by at most half the tolerance) as probable backdrop, the rest as probable object,
 //    and `object_seeds` (pixels of sparse points inside the volume) as sure object;

@@ -386,12 +386,14 @@ cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
       backdrop_like += !object;
     }
   }
+  std::vector<cv::Point> seed_pixels;
   for (const Eigen::Vector2d& seed : object_seeds) {
     const cv::Point at(static_cast<int>(std::floor(seed.x() * scale)),
                        static_cast<int>(std::floor(seed.y() * scale)));
     if (at.x < 0 || at.y < 0 || at.x >= work.cols || at.y >= work.rows) continue;
     if (labels.at<uint8_t>(at) == cv::GC_BGD) continue;  // frame, border or outside the volume
     labels.at<uint8_t>(at) = cv::GC_FGD;
+    seed_pixels.push_back(at);
     ++report->seeds;
     ++object_like;
   }
@@ -425,6 +427,50 @@ cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
       }
     } catch (const cv::Exception& error) {
       LOG(WARNING) << "GrabCut failed (" << error.what() << "); the colour rule's mask is used";
+    }
+  }
+  if (!mask.empty() && !seed_pixels.empty()) {
+    // The cut may take a whole region of object colours for backdrop: a cloth behind the object
+    // (right), or the object's own shadowed side (wrong). The sparse points tell them apart: a
+    // region the cut took whose sparse points are at least a quarter as dense as on the object
+    // it kept is object, and goes back.
+    cv::Mat removed = colour_rule & inside_box & ~mask;
+    for (const cv::Point& p : seed_pixels) removed.at<uint8_t>(p) = 255;
+    cv::Mat components;
+    const int count = cv::connectedComponents(removed, components, 8, CV_32S);
+    std::vector<int> seeds_in(count, 0), area(count, 0);
+    for (int row = 0; row < components.rows; ++row) {
+      const int* c = components.ptr<int>(row);
+      for (int col = 0; col < components.cols; ++col) ++area[c[col]];
+    }
+    cv::Mat seed_mask(mask.size(), CV_8UC1, cv::Scalar(0));
+    for (const cv::Point& p : seed_pixels) seed_mask.at<uint8_t>(p) = 255;
+    const cv::Mat kept = mask & ~seed_mask;
+    int kept_seeds = 0;
+    for (const cv::Point& p : seed_pixels) {
+      // A seed touching the kept object is on it; one the cut left alone inside a region it
+      // took speaks for that region.
+      bool touches_kept = false;
+      for (int dy = -1; dy <= 1 && !touches_kept; ++dy) {
+        for (int dx = -1; dx <= 1 && !touches_kept; ++dx) {
+          const cv::Point q(p.x + dx, p.y + dy);
+          touches_kept = q.x >= 0 && q.y >= 0 && q.x < kept.cols && q.y < kept.rows &&
+                         kept.at<uint8_t>(q) != 0;
+        }
+      }
+      const int c = components.at<int>(p);
+      if (touches_kept || area[c] <= 1) {
+        ++kept_seeds;
+      } else {
+        ++seeds_in[c];
+      }
+    }
+    const double density = static_cast<double>(kept_seeds) / std::max(1, cv::countNonZero(mask));
+    for (int c = 1; c < count; ++c) {
+      if (area[c] > 1 && seeds_in[c] >= 2 && seeds_in[c] >= 0.25 * density * area[c]) {
+        mask.setTo(255, components == c);
+        ++report->regions_restored;
+      }
     }
   }
   if (mask.empty()) mask = colour_rule & inside_box;

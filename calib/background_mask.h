@@ -76,6 +76,7 @@ struct ObjectMaskReport {
   int seeds = 0;              // sparse points used as sure object
   bool refined = false;       // GrabCut ran (it needs both some object and some backdrop)
   bool cut_to_box = false;    // pixels whose rays miss the volume were set to backdrop
+  int regions_restored = 0;   // regions the cut took that the sparse points gave back
 };
 
 // The object mask (CV_8UC1, 255 = object) of a photo whose backdrop is `model`:
@@ -85,6 +86,8 @@ struct ObjectMaskReport {
 //    [kShadowGain, kLightGain], reached from the backdrop's colours through neighbours that
 //    differ by at most half the tolerance) as probable backdrop, the rest as probable object,
 //    and `object_seeds` (pixels of sparse points inside the volume) as sure object;
+//    a region the cut takes from the colour rule's object goes back when the seeds in it are at
+//    least a quarter as dense as on the object it kept (the object's shadowed side, not a cloth);
 //  - `box_hull` (the volume's outline in the photo, possibly empty): pixels outside it are sure
 //    backdrop, since no carving can use them;
 //  - then cleaned of specks (opening 3x3) and pinholes (closing 5x5).

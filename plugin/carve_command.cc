@@ -277,6 +277,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
           static_cast<double>(photo.backdrop.frame[2]), static_cast<double>(photo.backdrop.frame[3])});
       json.Key("sparse_point_seeds").Value(photo.mask.seeds)
           .Key("graph_cut").Value(photo.mask.refined)
+          .Key("regions_restored_by_seeds").Value(photo.mask.regions_restored)
           .Key("cut_to_volume").Value(photo.mask.cut_to_box);
     }
     json.EndObject();

@@ -20,6 +20,7 @@
 #include "export/point_cloud_compare.h"
 #include "plugin/commands.h"
 #include "plugin/json_writer.h"
+#include "plugin/version.h"
 #include "plugin/workspace.h"
 
 namespace raycarve {
@@ -218,6 +219,10 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
   const CarveStatistics& s = run.result->statistics;
   JsonWriter json;
   json.BeginObject()
+      .Key("raycarve_version").Value(Version())
+      .Key("commit").Value(BuildCommit())
+      .Key("command_line").Value(RunCommandLine())
+      .Key("start_time").Value(RunStartTime())
       .Key("model_path").Value(run.model_path)
       .Key("image_path").Value(run.image_path)
       .Key("num_views").Value(run.num_views)

@@ -19,6 +19,7 @@
 #include "export/volume_renderer.h"
 #include "plugin/commands.h"
 #include "plugin/json_writer.h"
+#include "plugin/version.h"
 
 namespace raycarve {
 
@@ -160,6 +161,10 @@ int RunHoldout(int argc, char** argv) {
   if (error) throw InputError(out.string() + ": cannot create: " + error.message());
   JsonWriter json;
   json.BeginObject()
+      .Key("raycarve_version").Value(Version())
+      .Key("commit").Value(BuildCommit())
+      .Key("command_line").Value(RunCommandLine())
+      .Key("start_time").Value(RunStartTime())
       .Key("model_path").Value(project.model_path)
       .Key("every").Value(every)
       .Key("score_mask_path").Value(score_mask_path)

@@ -1,12 +1,15 @@
 #include <cstring>
 #include <exception>
 #include <iostream>
+#include <cstdlib>
 #include <string>
+#include <vector>
 
 #include <glog/logging.h>
 
 #include "calib/input_error.h"
 #include "plugin/commands.h"
+#include "plugin/version.h"
 
 namespace {
 
@@ -42,7 +45,7 @@ const Command kCommands[] = {
 };
 
 void PrintUsage() {
-  std::cout << "raycarve: voxel colouring of COLMAP projects on the CPU\n\n"
+  std::cout << raycarve::VersionLine() << ": voxel colouring of COLMAP projects on the CPU\n\n"
                "Usage: raycarve <command> [options]   (raycarve <command> --help)\n\nCommands:\n";
   for (const Command& command : kCommands) {
     std::cout << "  " << command.name << std::string(20 - std::strlen(command.name), ' ')
@@ -50,15 +53,79 @@ void PrintUsage() {
   }
 }
 
+// Takes glog's flags as COLMAP does (--log_to_stderr, --log_level, --v; "--name value" or
+// "--name=value") out of argv, applies them and returns the rest. Throws InputError on a value
+// that is not a number.
+std::vector<char*> TakeLoggingFlags(int argc, char** argv) {
+  std::vector<char*> rest;
+  for (int i = 0; i < argc; ++i) {
+    const std::string argument = argv[i];
+    std::string name, value;
+    bool matched = false;
+    for (const char* flag : {"log_to_stderr", "log_level", "v"}) {
+      const std::string prefix = std::string("--") + flag;
+      if (argument == prefix) {
+        name = flag;
+        matched = true;
+        const bool has_next = i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0;
+        value = has_next ? argv[++i] : (name == "log_to_stderr" ? "1" : "");
+      } else if (argument.rfind(prefix + "=", 0) == 0) {
+        name = flag;
+        matched = true;
+        value = argument.substr(prefix.size() + 1);
+      }
+      if (matched) break;
+    }
+    if (!matched) {
+      rest.push_back(argv[i]);
+      continue;
+    }
+    char* end = nullptr;
+    const long number = std::strtol(value.c_str(), &end, 10);
+    if (value.empty() || end == nullptr || *end != '\0' || number < 0 || number > 1000) {
+      throw raycarve::InputError("--" + name + ": expected a number from 0 to 1000, got '" +
+                                 value + "'");
+    }
+    if (name == "log_to_stderr") {
+      FLAGS_logtostderr = number != 0;
+    } else {
+      FLAGS_v = static_cast<int>(number);  // COLMAP's --log_level is glog's verbosity
+    }
+  }
+  rest.push_back(nullptr);
+  return rest;
+}
+
+// A message that already names the command ("raycarve carve: ...") without the name, so that
+// it is printed once.
+std::string WithoutPrefix(const std::string& message, const std::string& name) {
+  const std::string prefix = "raycarve " + name + ": ";
+  return message.rfind(prefix, 0) == 0 ? message.substr(prefix.size()) : message;
+}
+
 }  // namespace
 
-int main(int argc, char** argv) {
-  google::InitGoogleLogging(argv[0]);
+int main(int original_argc, char** original_argv) {
+  google::InitGoogleLogging(original_argv[0]);
+  raycarve::RecordRun(original_argc, original_argv);
   FLAGS_logtostderr = true;
+  std::vector<char*> arguments;
+  try {
+    arguments = TakeLoggingFlags(original_argc, original_argv);
+  } catch (const raycarve::InputError& error) {
+    std::cerr << "raycarve: error: " << error.what() << std::endl;
+    return 1;
+  }
+  const int argc = static_cast<int>(arguments.size()) - 1;
+  char** argv = arguments.data();
   if (argc < 2 || std::string(argv[1]) == "help" || std::string(argv[1]) == "--help" ||
       std::string(argv[1]) == "-h") {
-    PrintUsage();
-    return argc < 2 ? 1 : 0;
+    PrintUsage();  // no arguments: the usage, as COLMAP prints it, and success
+    return 0;
+  }
+  if (std::string(argv[1]) == "--version" || std::string(argv[1]) == "version") {
+    std::cout << raycarve::VersionLine() << "\n";
+    return 0;
   }
   const std::string name = argv[1];
   for (const Command& command : kCommands) {
@@ -66,10 +133,12 @@ int main(int argc, char** argv) {
     try {
       return command.run(argc, argv);
     } catch (const raycarve::InputError& error) {
-      std::cerr << "raycarve " << name << ": error: " << error.what() << std::endl;
+      std::cerr << "raycarve " << name << ": error: " << WithoutPrefix(error.what(), name)
+                << std::endl;
       return 1;
     } catch (const std::exception& error) {
-      std::cerr << "raycarve " << name << ": unexpected error: " << error.what() << std::endl;
+      std::cerr << "raycarve " << name << ": unexpected error: " << WithoutPrefix(error.what(), name)
+                << std::endl;
       return 2;
     }
   }

@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <charconv>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <sstream>
+
+#include <glog/logging.h>
 
 #include "calib/input_error.h"
 
@@ -84,7 +88,84 @@ void OptionParser::AddDefault(const std::string& name, bool* value, const std::s
   option.assign = [value](const std::string& text) { *value = text == "1" || text == "true"; };
 }
 
+void OptionParser::Assign(Option* option, const std::string& value) {
+  if (!option->allowed_values.empty() &&
+      std::find(option->allowed_values.begin(), option->allowed_values.end(), value) ==
+          option->allowed_values.end()) {
+    std::string allowed;
+    for (const std::string& v : option->allowed_values) allowed += (allowed.empty() ? "" : ", ") + v;
+    throw InputError("--" + option->name + " '" + value + "' is not one of: " + allowed);
+  }
+  option->assign(value);
+  option->set = true;
+}
+
+void OptionParser::ReadProjectFile(const std::string& path) {
+  std::error_code error;
+  const uintmax_t size = std::filesystem::file_size(path, error);
+  if (error || !std::filesystem::is_regular_file(path)) {
+    throw InputError(path + ": --project_path: not a readable file");
+  }
+  if (size > (1u << 20)) {
+    throw InputError(path + ": --project_path: " + std::to_string(size) +
+                     " bytes; an option file holds at most 1 MiB");
+  }
+  std::ifstream file(path);
+  std::string line, section;
+  std::vector<std::string> ignored;
+  for (int number = 1; std::getline(file, line); ++number) {
+    const auto trim = [](std::string text) {
+      const size_t begin = text.find_first_not_of(" \t\r");
+      const size_t end = text.find_last_not_of(" \t\r");
+      return begin == std::string::npos ? std::string() : text.substr(begin, end - begin + 1);
+    };
+    line = trim(line);
+    if (line.empty() || line[0] == '#' || line[0] == ';') continue;
+    if (line.front() == '[' && line.back() == ']') {
+      section = trim(line.substr(1, line.size() - 2));
+      continue;
+    }
+    const size_t equals = line.find('=');
+    if (equals == std::string::npos) {
+      throw InputError(path + ":" + std::to_string(number) + ": expected key=value or [section], got '" +
+                       line + "'");
+    }
+    const std::string key = trim(line.substr(0, equals));
+    const std::string value = trim(line.substr(equals + 1));
+    // Top-level keys and those under [raycarve] or [<command>] are this command's; COLMAP's own
+    // sections ([SiftExtraction], ...) and keys this command does not take are left to COLMAP.
+    const bool ours = section.empty() || section == "raycarve" || section == command_;
+    auto option = std::find_if(options_.begin(), options_.end(),
+                               [&](const Option& o) { return o.name == key; });
+    if (!ours || option == options_.end()) {
+      ignored.push_back(section.empty() ? key : section + "." + key);
+      continue;
+    }
+    try {
+      Assign(&*option, value);
+    } catch (const InputError& bad) {
+      throw InputError(path + ":" + std::to_string(number) + ": " + bad.what());
+    }
+  }
+  if (!ignored.empty()) {
+    std::string names;
+    for (size_t k = 0; k < ignored.size() && k < 8; ++k) names += (k ? ", " : "") + ignored[k];
+    if (ignored.size() > 8) names += ", ...";
+    LOG(INFO) << path << ": " << ignored.size() << " keys that raycarve " << command_
+              << " does not take were left alone (" << names << ")";
+  }
+}
+
 bool OptionParser::Parse(int argc, char** argv, int first) {
+  // An option file first, so that the command line overrides it.
+  for (int i = first; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (argument == "--project_path" && i + 1 < argc) {
+      ReadProjectFile(argv[i + 1]);
+    } else if (argument.rfind("--project_path=", 0) == 0) {
+      ReadProjectFile(argument.substr(std::string("--project_path=").size()));
+    }
+  }
   for (int i = first; i < argc; ++i) {
     std::string argument = argv[i];
     if (argument == "--help" || argument == "-h") {
@@ -92,7 +173,7 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
       return false;
     }
     if (argument.rfind("--", 0) != 0) {
-      throw InputError("raycarve " + command_ + ": unexpected argument '" + argument +
+      throw InputError("unexpected argument '" + argument +
                        "' (options are --name value; see --help)");
     }
     std::string name = argument.substr(2);
@@ -104,10 +185,14 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
       name = name.substr(0, equals);
       has_value = true;
     }
+    if (name == "project_path") {
+      if (!has_value) ++i;  // read above
+      continue;
+    }
     auto option = std::find_if(
         options_.begin(), options_.end(), [&](const Option& o) { return o.name == name; });
     if (option == options_.end()) {
-      throw InputError("raycarve " + command_ + ": unknown option --" + name + " (see --help)");
+      throw InputError("unknown option --" + name + " (see --help)");
     }
     if (!has_value) {
       const bool next_is_value = i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0;
@@ -116,24 +201,14 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
       } else if (option->is_flag) {
         value = "1";
       } else {
-        throw InputError("raycarve " + command_ + ": option --" + name + " needs a value");
+        throw InputError("option --" + name + " needs a value");
       }
     }
-    if (!option->allowed_values.empty() &&
-        std::find(option->allowed_values.begin(), option->allowed_values.end(), value) ==
-            option->allowed_values.end()) {
-      std::string allowed;
-      for (const std::string& v : option->allowed_values) allowed += (allowed.empty() ? "" : ", ") + v;
-      throw InputError("raycarve " + command_ + ": --" + name + " '" + value +
-                       "' is not one of: " + allowed);
-    }
-    option->assign(value);
-    option->set = true;
+    Assign(&*option, value);
   }
   for (const Option& option : options_) {
     if (option.required && !option.set) {
-      throw InputError("raycarve " + command_ + ": option --" + option.name +
-                       " is required (see --help)");
+      throw InputError("option --" + option.name + " is required (see --help)");
     }
   }
   return true;
@@ -160,6 +235,9 @@ std::string OptionParser::Help() const {
     text << (option.required ? "\n      (required)" : "\n      default: " + option.default_text)
          << "\n";
   }
+  text << "\nEvery command also takes --project_path FILE.ini (COLMAP's option files: key=value\n"
+          "lines, [sections]; the command line overrides it) and glog's --log_to_stderr,\n"
+          "--log_level and --v as COLMAP does.\n";
   return text.str();
 }
 

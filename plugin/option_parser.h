@@ -10,6 +10,10 @@ namespace raycarve {
 // Command-line options in COLMAP's style: `--name value` or `--name=value`, every option with a
 // default or marked required, and a help text listing defaults and allowed values.
 //
+// `--project_path FILE.ini` reads options from COLMAP's INI format first (key=value lines;
+// keys outside a section or under [raycarve] or [<command>] that the command takes are set, the
+// rest, such as COLMAP's own sections, left alone); the command line overrides it.
+//
 // Parse throws InputError on an unknown option, a missing value, a value that does not parse as
 // the option's type or is not among its allowed values, or a missing required option. `--help`
 // makes Parse return false after printing the help to stdout.
@@ -47,6 +51,10 @@ class OptionParser {
     std::function<void(const std::string&)> assign;
   };
   Option& Add(const std::string& name, const std::string& help, std::string default_text);
+  // Checks `value` against the option's allowed values and assigns it.
+  void Assign(Option* option, const std::string& value);
+  // --project_path: COLMAP's INI format; known keys (top level, [raycarve], [<command>]) set.
+  void ReadProjectFile(const std::string& path);
 
   std::string command_;
   std::string description_;

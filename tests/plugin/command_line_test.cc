@@ -16,6 +16,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The number after "key": in a JSON text (defined below).
+double JsonNumber(const std::string& json, const std::string& key);
+
 class CommandLine : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -74,13 +77,77 @@ TEST_F(CommandLine, UsageHelpAndUnknownCommands) {
   std::string output;
   EXPECT_EQ(Run("help", &output), 0);
   EXPECT_NE(output.find("model_info"), std::string::npos);
-  EXPECT_EQ(Run("", &output), 1);
+  // No arguments: the usage and success, as COLMAP does.
+  EXPECT_EQ(Run("", &output), 0);
+  EXPECT_NE(output.find("model_info"), std::string::npos);
   EXPECT_EQ(Run("carve_everything", &output), 1);
   EXPECT_NE(output.find("unknown command 'carve_everything'"), std::string::npos);
   EXPECT_EQ(Run("calibrate --help", &output), 0);
   EXPECT_NE(output.find("--workspace_path"), std::string::npos);
   ExpectUserError("model_info --input_path x --bogus 1", {"unknown option --bogus"});
   ExpectUserError("synth --output_path x --views many", {"--views", "'many'"});
+}
+
+TEST_F(CommandLine, SaysItsVersionAndRecordsTheRunInTheReport) {
+  std::string output;
+  ASSERT_EQ(Run("--version", &output), 0);
+  EXPECT_EQ(output.rfind("raycarve 0.1.0 (commit ", 0), 0u) << output;
+  EXPECT_EQ(Run("version", &output), 0);
+  EXPECT_EQ(output.rfind("raycarve 0.1.0 (commit ", 0), 0u) << output;
+  const std::string out = *root_ + "/identity";
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + out + " --resolution 16",
+                &output),
+            0)
+      << output;
+  const std::string report = testing::ReadFileBytes(out + "/report.json");
+  EXPECT_NE(report.find("\"raycarve_version\": \"0.1.0\""), std::string::npos) << report;
+  EXPECT_NE(report.find("--resolution 16\""), std::string::npos) << report;  // the command line
+  EXPECT_NE(report.find("\"start_time\": \"20"), std::string::npos) << report;
+}
+
+TEST_F(CommandLine, ErrorsNameTheCommandOnce) {
+  std::string output;
+  EXPECT_EQ(Run("carve --bogus 1", &output), 1);
+  EXPECT_NE(output.find("raycarve carve: error: unknown option --bogus"), std::string::npos)
+      << output;
+  EXPECT_EQ(output.find("raycarve carve: error: raycarve carve:"), std::string::npos) << output;
+  EXPECT_EQ(Run("holdout --workspace_path " + Project() + " --every 1", &output), 1);
+  EXPECT_EQ(output.find("raycarve holdout: error: raycarve holdout:"), std::string::npos) << output;
+}
+
+TEST_F(CommandLine, TakesGlogsFlagsAsColmapDoes) {
+  const std::string model = Project() + "/sparse/0";
+  std::string output;
+  for (const std::string flags : {"--log_to_stderr 1 --log_level 2", "--v=1", "--log_to_stderr"}) {
+    EXPECT_EQ(Run("model_info --input_path " + model + " " + flags, &output), 0) << flags << output;
+    EXPECT_NE(output.find("images: 4"), std::string::npos) << flags << output;
+  }
+  ExpectUserError("model_info --input_path " + model + " --log_level loud", {"--log_level", "'loud'"});
+}
+
+TEST_F(CommandLine, ReadsOptionsFromAColmapIniFileThatTheCommandLineOverrides) {
+  const std::string ini = *root_ + "/project.ini";
+  // COLMAP's own sections and keys raycarve does not take are left alone.
+  testing::WriteFile(ini,
+                     "# options\nlog_to_stderr=1\nworkspace_path=" + Project() + "\nresolution=24\n"
+                     "database_path=" + Project() + "/database.db\n"
+                     "[SiftExtraction]\nuse_gpu=0\n[carve]\nmesh=voxels\n");
+  std::string output;
+  ASSERT_EQ(Run("carve --project_path " + ini + " --output_path " + *root_ + "/from_ini", &output), 0)
+      << output;
+  std::string report = testing::ReadFileBytes(*root_ + "/from_ini/report.json");
+  EXPECT_EQ(JsonNumber(report, "resolution"), 24);
+  EXPECT_NE(report.find("\"mesh_kind\": \"voxels\""), std::string::npos) << report;
+  ASSERT_EQ(Run("carve --project_path=" + ini + " --output_path " + *root_ + "/from_ini_16 --resolution 16",
+                &output),
+            0)
+      << output;
+  report = testing::ReadFileBytes(*root_ + "/from_ini_16/report.json");
+  EXPECT_EQ(JsonNumber(report, "resolution"), 16);
+  testing::WriteFile(ini, "resolution=many\n");
+  ExpectUserError("carve --project_path " + ini + " --workspace_path " + Project(),
+                  {ini + ":1:", "--resolution"});
+  ExpectUserError("carve --project_path " + *root_ + "/no.ini", {*root_ + "/no.ini", "--project_path"});
 }
 
 TEST_F(CommandLine, TruncatedBinaryFileIsNamedWithRecordAndField) {

@@ -1,5 +1,8 @@
 #include "calib/camera.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <cmath>
 #include <sstream>
 
@@ -23,6 +26,35 @@ double Camera::FocalLengthY() const {
 Eigen::Vector2d Camera::PrincipalPoint() const {
   return CameraModelHasSingleFocalLength(model) ? Eigen::Vector2d(params.at(1), params.at(2))
                                                 : Eigen::Vector2d(params.at(2), params.at(3));
+}
+
+Camera RescaledCamera(const Camera& camera, uint64_t new_width, uint64_t new_height) {
+  Camera rescaled = camera;
+  const double scale_x = static_cast<double>(new_width) / camera.width;
+  const double scale_y = static_cast<double>(new_height) / camera.height;
+  rescaled.width = new_width;
+  rescaled.height = new_height;
+  if (CameraModelHasSingleFocalLength(camera.model)) {
+    rescaled.params.at(0) *= 0.5 * (scale_x + scale_y);
+    rescaled.params.at(1) *= scale_x;
+    rescaled.params.at(2) *= scale_y;
+  } else {
+    rescaled.params.at(0) *= scale_x;
+    rescaled.params.at(1) *= scale_y;
+    rescaled.params.at(2) *= scale_x;
+    rescaled.params.at(3) *= scale_y;
+  }
+  return rescaled;
+}
+
+Eigen::Vector2i LimitedImageSize(uint64_t width, uint64_t height, int max_size) {
+  const uint64_t longer = std::max(width, height);
+  if (max_size <= 0 || longer <= static_cast<uint64_t>(max_size)) {
+    return Eigen::Vector2i(static_cast<int>(width), static_cast<int>(height));
+  }
+  const double scale = static_cast<double>(max_size) / longer;
+  return Eigen::Vector2i(std::max(1, static_cast<int>(std::lround(width * scale))),
+                         std::max(1, static_cast<int>(std::lround(height * scale))));
 }
 
 void ValidateCamera(const Camera& camera, const std::string& context) {

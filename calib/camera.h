@@ -28,6 +28,16 @@ struct Camera {
   Eigen::Vector2d PrincipalPoint() const;
 };
 
+// The camera of the same photo resampled to new_width x new_height, as COLMAP's
+// Camera::Rescale: focal lengths and principal point scale with the image (a single focal length
+// by the mean of the two scales); distortion, which acts on normalised coordinates, is unchanged.
+// A point's pixel (COLMAP convention, corner at 0) scales by the same factors.
+Camera RescaledCamera(const Camera& camera, uint64_t new_width, uint64_t new_height);
+
+// The size a photo of width x height gets under a --max_image_size of `max_size` (COLMAP's
+// meaning: the longer side at most max_size, the aspect kept, sides rounded; <= 0: unchanged).
+Eigen::Vector2i LimitedImageSize(uint64_t width, uint64_t height, int max_size);
+
 // Throws InputError, prefixed with `context` (file and camera), when the camera cannot be used:
 // wrong number of parameters, a non-finite parameter, a non-positive focal length or image size.
 void ValidateCamera(const Camera& camera, const std::string& context);

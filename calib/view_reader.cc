@@ -27,6 +27,7 @@ std::string ViewReaderSummary::Summary() const {
          << mean_backdrop.transpose() << ")";
   }
   if (no_plain_backdrop > 0) text << "; " << no_plain_backdrop << " photos without a plain backdrop";
+  if (num_downscaled > 0) text << "; " << num_downscaled << " photos reduced (--max_image_size)";
   return text.str();
 }
 
@@ -34,13 +35,14 @@ namespace {
 
 // The pixels of the image's sparse points that lie inside `volume` (all, when it is empty).
 std::vector<Eigen::Vector2d> SeedPixels(const Reconstruction& reconstruction, const Image& image,
-                                        const Eigen::AlignedBox3d& volume) {
+                                        const Eigen::AlignedBox3d& volume,
+                                        const Eigen::Vector2d& pixel_scale) {
   std::vector<Eigen::Vector2d> seeds;
   for (const Point2D& point2D : image.points2D) {
     const auto found = reconstruction.points3D.find(point2D.point3D_id);
     if (found == reconstruction.points3D.end()) continue;
     if (!volume.isEmpty() && !volume.contains(found->second.xyz)) continue;
-    seeds.push_back(point2D.xy);
+    seeds.push_back(point2D.xy.cwiseProduct(pixel_scale));
   }
   return seeds;
 }
@@ -80,6 +82,7 @@ namespace {
 // What loading one registered image gave.
 struct LoadedView {
   bool missing = false;  // photo not found, skipped
+  bool downscaled = false;
   std::string path;
   CalibratedView view;
   PhotoMaskInfo info;
@@ -112,7 +115,25 @@ LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, cons
   PhotoMaskInfo& info = loaded.info;
   info.name = image.name;
   info.source = "none";
-  const Camera& camera = reconstruction.cameras.at(image.camera_id);
+  const Camera& full_camera = reconstruction.cameras.at(image.camera_id);
+  if (rgb.cols != static_cast<int>(full_camera.width) ||
+      rgb.rows != static_cast<int>(full_camera.height)) {
+    throw InputError(path + ": photo of image " + std::to_string(image_id) + " is " +
+                     std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows) + ", its camera " +
+                     std::to_string(full_camera.camera_id) + " " +
+                     std::to_string(full_camera.width) + "x" + std::to_string(full_camera.height));
+  }
+  // Photos larger than max_image_size are reduced before anything else, one at a time.
+  const Eigen::Vector2i size =
+      LimitedImageSize(full_camera.width, full_camera.height, options.max_image_size);
+  const bool reduced = size.x() != rgb.cols || size.y() != rgb.rows;
+  const Camera camera = reduced ? RescaledCamera(full_camera, size.x(), size.y()) : full_camera;
+  const Eigen::Vector2d pixel_scale(static_cast<double>(size.x()) / full_camera.width,
+                                    static_cast<double>(size.y()) / full_camera.height);
+  if (reduced) {
+    cv::resize(rgb, rgb, cv::Size(size.x(), size.y()), 0, 0, cv::INTER_AREA);
+    loaded.downscaled = true;
+  }
   if (!options.mask_path.empty()) {
     const std::filesystem::path folder(options.mask_path);
     const std::string colmap_style = (folder / (image.name + ".png")).string();
@@ -124,6 +145,10 @@ LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, cons
     }
     mask = ReadImage(mask_file, cv::IMREAD_GRAYSCALE);
     if (mask.empty()) throw InputError(mask_file + ": mask cannot be decoded as an image");
+    if (reduced && mask.cols == static_cast<int>(full_camera.width) &&
+        mask.rows == static_cast<int>(full_camera.height)) {
+      cv::resize(mask, mask, cv::Size(size.x(), size.y()), 0, 0, cv::INTER_NEAREST);
+    }
     info.source = "file";
   } else if (options.background.mode == BackgroundOptions::Mode::kColour) {
     mask = ObjectMaskFromBackdrop(rgb, options.background.colour, options.background.tolerance);
@@ -136,7 +161,7 @@ LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, cons
     } else {
       mask = ObjectMaskFromModel(rgb, info.backdrop, options.background.tolerance,
                                  options.background.refine,
-                                 SeedPixels(reconstruction, image, options.volume),
+                                 SeedPixels(reconstruction, image, options.volume, pixel_scale),
                                  VolumeOutline(camera, image, options.volume), &info.mask);
       mask_file = path + " (backdrop mask)";
       info.source = "backdrop";
@@ -210,6 +235,7 @@ std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruc
       ++summary->no_plain_backdrop;
     }
     summary->photos.push_back(info);
+    summary->num_downscaled += result.downscaled;
     views.push_back(std::move(result.view));
   }
   summary->num_loaded = static_cast<int>(views.size());

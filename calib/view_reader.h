@@ -22,6 +22,9 @@ struct ViewReaderOptions {
   Eigen::AlignedBox3d volume;
   // Threads decoding and masking photos (0: one per core); the result is the same for any.
   int num_threads = 0;
+  // Photos whose longer side exceeds this are scaled down to it (INTER_AREA; masks by nearest
+  // neighbour), their cameras with them (RescaledCamera); <= 0: full size.
+  int max_image_size = 0;
 };
 
 // What was found for one photo's mask.
@@ -42,6 +45,7 @@ struct ViewReaderSummary {
   Eigen::Vector3d mean_backdrop = Eigen::Vector3d::Zero();  // over masks_from_backdrop views
   std::vector<std::string> missing;  // photo paths not found (only with skip_missing_images)
   std::vector<PhotoMaskInfo> photos;  // per loaded view, in view order
+  int num_downscaled = 0;             // photos scaled down by max_image_size
   std::string Summary() const;
 };
 

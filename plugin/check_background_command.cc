@@ -18,7 +18,8 @@ int RunCheckBackground(int argc, char** argv) {
       "Measures how much of a point cloud is background: the share of its points that project "
       "onto background, in more than half of the masked views that see them. Masks come from "
       "--mask_path or, by default, from the photos' backdrop colour.");
-  parser.AddRequired("input", &cloud, "the point cloud to check (PLY, e.g. raycarve's cloud.ply)");
+  parser.AddRequired("cloud_path", &cloud, "the point cloud to check (PLY, e.g. raycarve's cloud.ply)");
+  parser.AddDeprecatedName("input", "cloud_path");
   parser.AddDefault("workspace_path", &workspace_path, "COLMAP project of the photos");
   parser.AddDefault("input_path", &input_path, "model folder, overriding the workspace's");
   parser.AddDefault("image_path", &image_path, "photo folder, overriding the workspace's");

@@ -90,8 +90,10 @@ int RunCompare(int argc, char** argv) {
       "Both must be in the same frame, or give --input_model and --reference_model: the input is "
       "then moved by the similarity that takes the input model's camera centres onto the "
       "reference model's (images matched by name; robust, refined with Ceres).");
-  parser.AddRequired("reference", &reference, "reference PLY (points or mesh)");
-  parser.AddRequired("input", &input, "reconstruction PLY (points or mesh)");
+  parser.AddRequired("reference_path", &reference, "reference PLY (points or mesh)");
+  parser.AddRequired("input_path", &input, "reconstruction PLY (points or mesh)");
+  parser.AddDeprecatedName("reference", "reference_path");
+  parser.AddDeprecatedName("input", "input_path");
   parser.AddDefault("threshold", &options.threshold,
                     "match distance for completeness, precision and F-score (world units)");
   parser.AddDefault("accuracy_quantile", &options.accuracy_quantile,

@@ -156,6 +156,10 @@ void OptionParser::ReadProjectFile(const std::string& path) {
   }
 }
 
+void OptionParser::AddDeprecatedName(const std::string& old_name, const std::string& name) {
+  deprecated_.emplace_back(old_name, name);
+}
+
 bool OptionParser::Parse(int argc, char** argv, int first) {
   // An option file first, so that the command line overrides it.
   for (int i = first; i < argc; ++i) {
@@ -188,6 +192,14 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
     if (name == "project_path") {
       if (!has_value) ++i;  // read above
       continue;
+    }
+    for (const auto& [old_name, current] : deprecated_) {
+      if (name == old_name) {
+        LOG(WARNING) << "raycarve " << command_ << ": --" << old_name << " is deprecated; use --"
+                     << current;
+        name = current;
+        break;
+      }
     }
     auto option = std::find_if(
         options_.begin(), options_.end(), [&](const Option& o) { return o.name == name; });
@@ -234,6 +246,9 @@ std::string OptionParser::Help() const {
     }
     text << (option.required ? "\n      (required)" : "\n      default: " + option.default_text)
          << "\n";
+  }
+  for (const auto& [old_name, current] : deprecated_) {
+    text << "  --" << old_name << "\n      deprecated name of --" << current << "\n";
   }
   text << "\nEvery command also takes --project_path FILE.ini (COLMAP's option files: key=value\n"
           "lines, [sections]; the command line overrides it) and glog's --log_to_stderr,\n"

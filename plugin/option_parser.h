@@ -31,6 +31,9 @@ class OptionParser {
   void AddDefault(const std::string& name, double* value, const std::string& help);
   void AddDefault(const std::string& name, bool* value, const std::string& help);
 
+  // An old name of an option: still accepted, with a warning that it is deprecated.
+  void AddDeprecatedName(const std::string& old_name, const std::string& name);
+
   // Parses argv[first..argc); returns false when --help was asked for.
   bool Parse(int argc, char** argv, int first = 2);
 
@@ -59,6 +62,7 @@ class OptionParser {
   std::string command_;
   std::string description_;
   std::vector<Option> options_;
+  std::vector<std::pair<std::string, std::string>> deprecated_;  // old name, current name
 };
 
 }  // namespace raycarve

@@ -24,7 +24,8 @@ int RunRender(int argc, char** argv) {
       "Draws a coloured point cloud (raycarve's cloud.ply, COLMAP's fused.ply) into cameras of a "
       "COLMAP model, z-buffered splats: writes <name>.render.png and <name>.silhouette.png per "
       "camera (undistorted, pinhole), and with --image_path <name>.side.png (photo | render).");
-  parser.AddRequired("input", &input, "PLY point cloud to draw");
+  parser.AddRequired("cloud_path", &input, "PLY point cloud to draw");
+  parser.AddDeprecatedName("input", "cloud_path");
   parser.AddRequired("input_path", &model_path, "COLMAP model whose cameras draw it");
   parser.AddRequired("output_path", &output_path, "folder for the images (created)");
   parser.AddDefault("image_path", &image_path, "the model's photos, for side-by-side images");

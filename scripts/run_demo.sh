@@ -15,7 +15,7 @@ build/plugin/raycarve model_info --input_path "$out/scene/sparse/0" \
   --output_path "$out/model_info.json" > /dev/null
 build/plugin/raycarve carve --workspace_path "$out/scene" --output_path "$out/carve"
 # Measured against the scene's true surface (truth.ply); 0.05 is about 2 voxels at 128.
-build/plugin/raycarve compare --reference "$out/scene/truth.ply" --input "$out/carve/cloud.ply" \
+build/plugin/raycarve compare --reference_path "$out/scene/truth.ply" --input_path "$out/carve/cloud.ply" \
   --threshold 0.05 --output_path "$out/carve/compare.json" | head -2
 echo
 echo "Outputs in $out/:"

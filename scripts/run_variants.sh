@@ -19,7 +19,7 @@ run() {
     --resolution "$resolution" --threshold "$threshold" --num_threads 1 "$@" > "$out/$name.log" 2>&1
   local report="$out/$name/report.json" voxel
   voxel=$(json_number "$report" voxel_size)
-  build/plugin/raycarve compare --reference "$out/scene/truth.ply" --input "$out/$name/cloud.ply" \
+  build/plugin/raycarve compare --reference_path "$out/scene/truth.ply" --input_path "$out/$name/cloud.ply" \
     --threshold "$(awk -v v="$voxel" 'BEGIN { print 2 * v }')" --output_path "$out/$name/compare.json" > /dev/null
   printf "| %s | %.2f | %s | %s | %s | %.1f%% | %.4f | %.1f%% |\n" "$name" \
     "$(json_number "$report" convergence_seconds)" "$(json_number "$report" evaluated)" \

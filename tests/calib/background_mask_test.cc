@@ -206,5 +206,35 @@ TEST(AutomaticMasks, ANaturalSceneGetsNone) {
   for (const auto& [name, mask] : made.masks) EXPECT_TRUE(mask.empty()) << name;
 }
 
+TEST(ViewReader, MaxImageSizeScalesPhotosAndCamerasAlike) {
+  SyntheticSceneOptions options = testing::SceneOptions(2, 320, 240, true, 200);
+  options.camera_model = CameraModelId::kRadial;
+  const SyntheticScene scene = GenerateSyntheticScene(options);
+  const std::string folder = testing::MakeTemporaryDirectory("max_image_size");
+  WriteSyntheticProject(scene, folder);
+  ViewReaderOptions full_options;
+  full_options.mask_path = folder + "/masks";
+  ViewReaderOptions half_options = full_options;
+  half_options.max_image_size = 160;
+  ViewReaderSummary summary;
+  const std::vector<CalibratedView> full =
+      ReadCalibratedViews(scene.reconstruction, folder + "/images", full_options, nullptr);
+  const std::vector<CalibratedView> half =
+      ReadCalibratedViews(scene.reconstruction, folder + "/images", half_options, &summary);
+  std::filesystem::remove_all(folder);
+  EXPECT_EQ(summary.num_downscaled, 2);
+  ASSERT_EQ(half.size(), full.size());
+  for (size_t v = 0; v < half.size(); ++v) {
+    EXPECT_EQ(half[v].width, 160);
+    EXPECT_EQ(half[v].height, 120);
+    EXPECT_EQ(half[v].mask.size(), cv::Size(160, 120));
+    for (const auto& [id, point3D] : scene.reconstruction.points3D) {
+      if (!(full[v].Depth(point3D.xyz) > 0.0)) continue;
+      EXPECT_NEAR((half[v].Project(point3D.xyz) - 0.5 * full[v].Project(point3D.xyz)).norm(), 0.0,
+                  1e-9);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace raycarve

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include "calib/camera.h"
 #include "calib/input_error.h"
+#include "samples/synthetic_scene.h"
 #include "calib/pixel.h"
 
 namespace raycarve {
@@ -149,6 +151,45 @@ TEST(PixelConvention, TopLeftPixelCentreIsHalfAPixelInCOLMAPAndZeroInOpenCV) {
   EXPECT_EQ(ColmapFromOpenCv(Eigen::Vector2d(3.0, 4.0)), Eigen::Vector2d(3.5, 4.5));
   // A point exactly on the border between the first two pixels.
   EXPECT_EQ(OpenCvFromColmap(Eigen::Vector2d(1.0, 1.0)), Eigen::Vector2d(0.5, 0.5));
+}
+
+TEST(RescaledCamera, APointProjectsToItsPixelScaledForEveryModel) {
+  // Halving the photo halves every pixel coordinate (COLMAP's corner-at-0 convention).
+  for (CameraModelId model : SupportedCameraModels()) {
+    Camera camera;
+    camera.model = model;
+    camera.width = 4000;
+    camera.height = 3000;
+    camera.params = ExampleCameraParams(model, 4000, 3000, 3500.0);
+    const Camera half = RescaledCamera(camera, 2000, 1500);
+    EXPECT_EQ(half.width, 2000u);
+    EXPECT_EQ(half.height, 1500u);
+    for (const Eigen::Vector2d normalized :
+         {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(0.21, -0.13), Eigen::Vector2d(-0.4, 0.3)}) {
+      const Eigen::Vector2d full = camera.ImgFromCam(normalized);
+      const Eigen::Vector2d reduced = half.ImgFromCam(normalized);
+      EXPECT_NEAR((reduced - 0.5 * full).norm(), 0.0, 1e-9) << CameraModelName(model);
+    }
+  }
+  // Scales that differ along the axes: fx, fy and the principal point follow each.
+  Camera pinhole;
+  pinhole.model = CameraModelId::kPinhole;
+  pinhole.width = 1000;
+  pinhole.height = 500;
+  pinhole.params = {900.0, 910.0, 500.0, 250.0};
+  const Camera squeezed = RescaledCamera(pinhole, 500, 400);
+  EXPECT_DOUBLE_EQ(squeezed.params[0], 450.0);
+  EXPECT_DOUBLE_EQ(squeezed.params[1], 728.0);
+  EXPECT_DOUBLE_EQ(squeezed.params[2], 250.0);
+  EXPECT_DOUBLE_EQ(squeezed.params[3], 200.0);
+}
+
+TEST(LimitedImageSize, KeepsTheAspectAndLeavesSmallerPhotosAlone) {
+  EXPECT_EQ(LimitedImageSize(4000, 3000, 2400), Eigen::Vector2i(2400, 1800));
+  EXPECT_EQ(LimitedImageSize(3000, 4000, 2400), Eigen::Vector2i(1800, 2400));
+  EXPECT_EQ(LimitedImageSize(640, 480, 2400), Eigen::Vector2i(640, 480));
+  EXPECT_EQ(LimitedImageSize(4000, 3000, 0), Eigen::Vector2i(4000, 3000));
+  EXPECT_EQ(LimitedImageSize(4001, 3, 1000), Eigen::Vector2i(1000, 1));
 }
 
 }  // namespace

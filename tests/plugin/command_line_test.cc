@@ -470,12 +470,21 @@ TEST_F(CommandLine, CompareMeasuresTheCarvedCloudAgainstTheGroundTruth) {
             0)
       << output;
   ASSERT_TRUE(fs::is_regular_file(Project() + "/truth.ply"));
-  ASSERT_EQ(Run("compare --reference " + Project() + "/truth.ply --input " + out +
+  ASSERT_EQ(Run("compare --reference_path " + Project() + "/truth.ply --input_path " + out +
                     "/cloud.ply --threshold 0.2 --output_path " + out + "/compare.json",
                 &output),
             0)
       << output;
   const std::string report = testing::ReadFileBytes(out + "/compare.json");
+  // The old names still work, and say they are deprecated.
+  ASSERT_EQ(Run("compare --reference " + Project() + "/truth.ply --input " + out +
+                    "/cloud.ply --threshold 0.2 --output_path " + out + "/compare_old.json",
+                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("--reference is deprecated; use --reference_path"), std::string::npos)
+      << output;
+  EXPECT_EQ(testing::ReadFileBytes(out + "/compare_old.json"), report);
   EXPECT_GT(JsonNumber(report, "num_reference_points"), 1000);
   // The metrics themselves are tested in export/point_cloud_compare_test; on this tiny project
   // (4 views of 96x72, 40 voxels) completeness at 0.2 measured 0.227.

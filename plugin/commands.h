@@ -104,6 +104,17 @@ LoadedProject LoadProject(const std::string& command,
                           bool colour_calibration = false,
                           int hold_out_every = 0);
 
+// Memory held per photo pixel while carving (the photo, its undistorted view, validity and mask,
+// rays and their statistics; ~10 bytes measured on 3-megapixel photos), and the share of the
+// machine's memory the photos may take.
+constexpr double kBytesPerPhotoPixel = 10.0;
+constexpr double kUsableMemoryShare = 0.75;
+// Refuses, before any photo is read, a project whose photos (reduced to `max_image_size`) would
+// need more than kUsableMemoryShare of `physical_bytes` (0: this machine's memory): the
+// message gives the estimate and a --max_image_size that fits.
+void CheckPhotosFitInMemory(const Reconstruction& reconstruction, int max_image_size,
+                            double physical_bytes = 0.0);
+
 // Throws InputError when no part of the project's volume is seen by `min_views` of `views`
 // (a --bbox in another frame or unit, bounds from points far from every camera's view): the
 // message names the box, how much of it each photo sees and, for a --bbox, the sparse points'

@@ -1,6 +1,7 @@
 #include "plugin/workspace.h"
 
 #include <algorithm>
+#include <iomanip>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <sstream>
 
 #include <glog/logging.h>
+#include <unistd.h>
 
 #include "calib/colour_calibration.h"
 #include "calib/input_error.h"
@@ -126,6 +128,42 @@ WorkspacePaths ResolveWorkspace(const std::string& workspace_path,
                    "cameras.bin or cameras.txt); give --input_path");
 }
 
+void CheckPhotosFitInMemory(const Reconstruction& reconstruction, int max_image_size,
+                            double physical_bytes) {
+  if (physical_bytes <= 0.0) {
+    const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGESIZE);
+    physical_bytes = pages > 0 && page_size > 0 ? static_cast<double>(pages) * page_size : 0.0;
+  }
+  if (physical_bytes <= 0.0) return;  // unknown: nothing to compare with
+  double pixels = 0.0;
+  Eigen::Vector2i largest(0, 0);
+  for (const auto& [id, image] : reconstruction.images) {
+    const Camera& camera = reconstruction.cameras.at(image.camera_id);
+    const Eigen::Vector2i size = LimitedImageSize(camera.width, camera.height, max_image_size);
+    pixels += static_cast<double>(size.x()) * size.y();
+    if (size.x() * static_cast<double>(size.y()) > largest.x() * static_cast<double>(largest.y())) {
+      largest = size;
+    }
+  }
+  const double needed = kBytesPerPhotoPixel * pixels;
+  if (needed <= kUsableMemoryShare * physical_bytes) return;
+  // The longer side at which the photos would fit, for the message.
+  const double fit_scale = std::sqrt(kUsableMemoryShare * physical_bytes / needed);
+  const int suggestion = static_cast<int>(std::max(largest.x(), largest.y()) * fit_scale) / 100 * 100;
+  std::ostringstream text;
+  text << reconstruction.images.size() << " photos of up to " << largest.x() << "x" << largest.y()
+       << " pixels ("
+       << (max_image_size > 0 ? "after --max_image_size " + std::to_string(max_image_size)
+                              : std::string("full size"))
+       << ") need about "
+       << std::setprecision(3) << needed / (1 << 30) << " GiB while carving ("
+       << kBytesPerPhotoPixel << " bytes a pixel), more than " << kUsableMemoryShare * 100
+       << "% of this machine's " << physical_bytes / (1 << 30)
+       << " GiB: give --max_image_size " << std::max(100, suggestion)
+       << " or fewer, or use fewer photos";
+  throw InputError(text.str());
+}
+
 LoadedProject LoadProject(const std::string& command,
                           const std::string& workspace_path,
                           const std::string& input_path,
@@ -168,6 +206,7 @@ LoadedProject LoadProject(const std::string& command,
   }
   project.bounds = ResolveBounds(project.reconstruction, bounds_flags, paths.model_path);
   LOG(INFO) << project.bounds.Summary();
+  CheckPhotosFitInMemory(project.reconstruction, view_options.max_image_size);
   LOG(INFO) << "loading and undistorting " << registered << " photos from " << paths.image_path;
   ViewReaderOptions reader_options = view_options;
   reader_options.volume = project.bounds.box;

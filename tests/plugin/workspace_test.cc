@@ -6,6 +6,7 @@
 
 #include "calib/input_error.h"
 #include "calib/model_writer.h"
+#include "plugin/commands.h"
 #include "tests/test_support.h"
 
 namespace raycarve {
@@ -64,6 +65,37 @@ TEST(Workspace, SeveralMapperModelsGiveTheLargestOrTheOneAskedFor) {
         << error.what();
   }
   std::filesystem::remove_all(root);
+}
+
+TEST(PhotoMemory, ARealSizeProjectFitsAtTheDefaultMaxImageSizeAndIsRefusedAtFullSize) {
+  // 200 photos of 12 megapixels on a machine of 24 GiB.
+  Reconstruction project;
+  Camera camera;
+  camera.camera_id = 1;
+  camera.model = CameraModelId::kSimpleRadial;
+  camera.width = 4000;
+  camera.height = 3000;
+  camera.params = {3500.0, 2000.0, 1500.0, 0.01};
+  project.cameras.emplace(1, camera);
+  for (image_t id = 1; id <= 200; ++id) {
+    Image image;
+    image.image_id = id;
+    image.camera_id = 1;
+    image.name = "photo" + std::to_string(id) + ".jpg";
+    project.images.emplace(id, image);
+  }
+  const double machine = 24.0 * (1 << 30);
+  EXPECT_NO_THROW(CheckPhotosFitInMemory(project, kDefaultMaxImageSize, machine));
+  try {
+    CheckPhotosFitInMemory(project, 0, machine);
+    FAIL() << "200 photos of 12 MP at full size accepted";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("200 photos of up to 4000x3000"), std::string::npos) << message;
+    EXPECT_NE(message.find("--max_image_size 3500"), std::string::npos) << message;
+  }
+  // The suggestion fits.
+  EXPECT_NO_THROW(CheckPhotosFitInMemory(project, 3500, machine));
 }
 
 }  // namespace

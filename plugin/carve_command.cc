@@ -12,6 +12,7 @@
 
 #include <glog/logging.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
@@ -91,15 +92,30 @@ CarveRun CarveProject(const CarveRequest& request) {
             << " threshold "
             << (request.options.auto_threshold ? std::string("auto (from the sparse points)")
                                                : std::to_string(request.options.threshold));
-  auto progress = [](const CarveProgress& p) {
-    LOG(INFO) << "carving "
-              << (p.levels > 1 ? "level " + std::to_string(p.level + 1) + "/" +
-                                     std::to_string(p.levels) + " "
-                               : std::string())
-              << std::fixed << std::setprecision(1) << p.seconds << " s: evaluated "
-              << p.evaluated << ", carved " << p.carved << ", queue " << p.queued << ", "
-              << static_cast<int64_t>(p.seconds > 0 ? p.evaluated / p.seconds : 0)
-              << " evaluations/s";
+  // Progress: the share of the work seen so far (evaluations against evaluations plus the
+  // queue, an estimate: carving queues more) and the time left at the current rate; a bar
+  // redrawn in place on a terminal, a log line otherwise.
+  const bool terminal = isatty(STDERR_FILENO) != 0;
+  auto progress = [terminal](const CarveProgress& p) {
+    const double share =
+        p.evaluated + p.queued > 0 ? static_cast<double>(p.evaluated) / (p.evaluated + p.queued) : 0.0;
+    const double rate = p.seconds > 0 ? p.evaluated / p.seconds : 0.0;
+    const double left = rate > 0 ? p.queued / rate : 0.0;
+    const std::string level = p.levels > 1 ? "level " + std::to_string(p.level + 1) + "/" +
+                                                 std::to_string(p.levels) + " "
+                                           : std::string();
+    if (terminal) {
+      const int width = 30, filled = static_cast<int>(std::lround(share * width));
+      std::fprintf(stderr, "\rcarving %s[%s%s] %3.0f%%  %.1f s, about %.1f s left  ", level.c_str(),
+                   std::string(filled, '#').c_str(), std::string(width - filled, ' ').c_str(),
+                   100.0 * share, p.seconds, left);
+      std::fflush(stderr);
+      return;
+    }
+    LOG(INFO) << "carving " << level << std::fixed << std::setprecision(1) << p.seconds
+              << " s: evaluated " << p.evaluated << ", carved " << p.carved << ", queue "
+              << p.queued << " (about " << std::lround(100.0 * share) << "% of the work seen, "
+              << left << " s left at " << static_cast<int64_t>(rate) << " evaluations/s)";
   };
   CarveOptions options = request.options;
   options.surface_points = project.surface_points;
@@ -112,6 +128,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   }
   run.result = std::make_unique<CarveResult>(
       CarveVolume(views, run.bounds.box, options, progress, request.progress_seconds));
+  if (terminal) std::fprintf(stderr, "\n");
   for (const LevelStatistics& level : run.result->statistics.levels) {
     if (!options.auto_threshold) break;
     if (level.threshold_from_data) {

@@ -104,6 +104,13 @@ LoadedProject LoadProject(const std::string& command,
                           bool colour_calibration = false,
                           int hold_out_every = 0);
 
+// sfm --colmap_options: "Section.name=value,..." split into the arguments of the COLMAP step
+// that takes each section. Throws InputError on a malformed item or an unknown section.
+struct ColmapPassThrough {
+  std::vector<std::string> extractor, matcher, mapper;
+};
+ColmapPassThrough SplitColmapOptions(const std::string& text);
+
 // Memory held per photo pixel while carving (the photo, its undistorted view, validity and mask,
 // rays and their statistics; ~10 bytes measured on 3-megapixel photos), and the share of the
 // machine's memory the photos may take.

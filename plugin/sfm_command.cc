@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include <glog/logging.h>
 
@@ -45,6 +46,38 @@ void RunStep(const std::string& colmap, const std::string& step,
 
 }  // namespace
 
+ColmapPassThrough SplitColmapOptions(const std::string& text) {
+  ColmapPassThrough passed;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    if (item.empty()) continue;
+    const size_t dot = item.find('.'), equals = item.find('=');
+    if (dot == std::string::npos || equals == std::string::npos || dot > equals || dot == 0 ||
+        equals == dot + 1 || equals + 1 == item.size()) {
+      throw InputError("--colmap_options: '" + item + "' is not Section.name=value");
+    }
+    const std::string section = item.substr(0, dot);
+    const std::vector<std::string> option = {"--" + item.substr(0, equals),
+                                             item.substr(equals + 1)};
+    std::vector<std::string>* step = nullptr;
+    if (section == "ImageReader" || section == "SiftExtraction") step = &passed.extractor;
+    if (section == "SiftMatching" || section == "ExhaustiveMatching" ||
+        section == "TwoViewGeometry") {
+      step = &passed.matcher;
+    }
+    if (section == "Mapper") step = &passed.mapper;
+    if (step == nullptr) {
+      throw InputError("--colmap_options: section '" + section +
+                       "' is none of the steps' (ImageReader, SiftExtraction: feature_extractor; "
+                       "SiftMatching, ExhaustiveMatching, TwoViewGeometry: exhaustive_matcher; "
+                       "Mapper: mapper)");
+    }
+    step->insert(step->end(), option.begin(), option.end());
+  }
+  return passed;
+}
+
 int RunSfm(int argc, char** argv) {
   std::string image_path, workspace_path, camera_model = "SIMPLE_RADIAL", camera_params;
   std::string colmap_path = "colmap";
@@ -78,7 +111,13 @@ int RunSfm(int argc, char** argv) {
   parser.AddDefault("init_min_tri_angle", &init_min_tri_angle,
                     "Mapper.init_min_tri_angle in degrees (lower it for narrow rings)");
   parser.AddDefault("num_threads", &num_threads, "threads for COLMAP (-1: all)");
+  std::string colmap_options;
+  parser.AddDefault("colmap_options", &colmap_options,
+                    "further COLMAP options, comma-separated Section.name=value (e.g. "
+                    "SiftExtraction.max_num_features=4096,Mapper.ba_refine_focal_length=0), each "
+                    "given to the step that takes its section; they come last, so they win");
   if (!parser.Parse(argc, argv)) return 0;
+  const ColmapPassThrough passed = SplitColmapOptions(colmap_options);
 
   // Check everything before running anything.
   const CameraModelId model_id = CameraModelIdFromName(camera_model, "--camera_model");
@@ -135,11 +174,14 @@ int RunSfm(int argc, char** argv) {
   if (!camera_params.empty()) {
     extract.insert(extract.end(), {"--ImageReader.camera_params", camera_params});
   }
+  extract.insert(extract.end(), passed.extractor.begin(), passed.extractor.end());
   RunStep(colmap, "feature_extractor", extract);
   LOG(INFO) << "sfm: 2/3 exhaustive matching";
-  RunStep(colmap, "exhaustive_matcher",
-          {"--database_path", database.string(), "--SiftMatching.use_gpu", "0",
-           "--SiftMatching.num_threads", threads});
+  std::vector<std::string> match = {"--database_path", database.string(),
+                                    "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads",
+                                    threads};
+  match.insert(match.end(), passed.matcher.begin(), passed.matcher.end());
+  RunStep(colmap, "exhaustive_matcher", match);
   LOG(INFO) << "sfm: 3/3 mapping";
   std::vector<std::string> map = {
       "--database_path", database.string(), "--image_path", image_path,
@@ -155,6 +197,7 @@ int RunSfm(int argc, char** argv) {
                            "--Mapper.ba_refine_principal_point", "0",
                            "--Mapper.ba_refine_extra_params", "0"});
   }
+  map.insert(map.end(), passed.mapper.begin(), passed.mapper.end());
   RunStep(colmap, "mapper", map);
 
   const std::vector<ModelCandidate> models = NumberedModels(sparse.string());

@@ -98,5 +98,20 @@ TEST(PhotoMemory, ARealSizeProjectFitsAtTheDefaultMaxImageSizeAndIsRefusedAtFull
   EXPECT_NO_THROW(CheckPhotosFitInMemory(project, 3500, machine));
 }
 
+TEST(SfmPassThrough, GivesEachColmapOptionToTheStepThatTakesItsSection) {
+  const ColmapPassThrough passed = SplitColmapOptions(
+      "SiftExtraction.max_num_features=4096,Mapper.ba_refine_focal_length=0,"
+      "SiftMatching.max_ratio=0.7,ImageReader.default_focal_length_factor=1.5");
+  EXPECT_EQ(passed.extractor,
+            (std::vector<std::string>{"--SiftExtraction.max_num_features", "4096",
+                                      "--ImageReader.default_focal_length_factor", "1.5"}));
+  EXPECT_EQ(passed.matcher, (std::vector<std::string>{"--SiftMatching.max_ratio", "0.7"}));
+  EXPECT_EQ(passed.mapper, (std::vector<std::string>{"--Mapper.ba_refine_focal_length", "0"}));
+  EXPECT_TRUE(SplitColmapOptions("").mapper.empty());
+  EXPECT_THROW(SplitColmapOptions("PatchMatchStereo.window_radius=5"), InputError);
+  EXPECT_THROW(SplitColmapOptions("Mapper.min_num_matches"), InputError);
+  EXPECT_THROW(SplitColmapOptions("min_num_matches=3"), InputError);
+}
+
 }  // namespace
 }  // namespace raycarve

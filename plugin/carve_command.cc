@@ -546,8 +546,8 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "skip registered images whose photo is missing instead of failing");
   parser->AddDefault("max_image_size", &request->view_options.max_image_size,
                      "photos longer than this on their longer side are scaled down to it, their "
-                     "cameras with them, as COLMAP's --max_image_size (about 10 bytes a pixel are "
-                     "held while carving: 200 photos at 2400 take ~9 GB); <= 0: full size");
+                     "cameras with them, as COLMAP's --max_image_size (about 14 bytes a pixel are "
+                     "held while carving: 200 photos at 2400 take ~12 GB); <= 0: full size");
   parser->AddDefault("mask_path", &request->view_options.mask_path,
                      "folder of object masks (<photo name>.png, non-zero = object): background "
                      "pixels are left out, and the silhouettes pre-carve the volume");

@@ -92,10 +92,10 @@ TEST(PhotoMemory, ARealSizeProjectFitsAtTheDefaultMaxImageSizeAndIsRefusedAtFull
   } catch (const InputError& error) {
     const std::string message = error.what();
     EXPECT_NE(message.find("200 photos of up to 4000x3000"), std::string::npos) << message;
-    EXPECT_NE(message.find("--max_image_size 3500"), std::string::npos) << message;
+    EXPECT_NE(message.find("--max_image_size 3000"), std::string::npos) << message;
   }
   // The suggestion fits.
-  EXPECT_NO_THROW(CheckPhotosFitInMemory(project, 3500, machine));
+  EXPECT_NO_THROW(CheckPhotosFitInMemory(project, 3000, machine));
 }
 
 TEST(SfmPassThrough, GivesEachColmapOptionToTheStepThatTakesItsSection) {

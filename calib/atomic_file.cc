@@ -1,6 +1,11 @@
 #include "calib/atomic_file.h"
 
+#include <algorithm>
 #include <filesystem>
+#include <vector>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include "calib/input_error.h"
 
@@ -18,6 +23,58 @@ void RenameIntoPlace(const std::string& temporary, const std::string& path) {
     std::filesystem::remove(temporary, error);
     throw InputError(path + ": cannot move the written file into place: " + error.message());
   }
+}
+
+namespace {
+
+// fsync of a file or folder; a failure to sync is reported (the data may not be on disk).
+void Sync(const std::filesystem::path& path, bool folder) {
+  const int fd = open(path.c_str(), folder ? O_RDONLY | O_DIRECTORY : O_RDONLY);
+  if (fd < 0) throw InputError(path.string() + ": cannot open to sync it to disk");
+  const int status = fsync(fd);
+  close(fd);
+  if (status != 0) throw InputError(path.string() + ": cannot sync it to disk");
+}
+
+}  // namespace
+
+std::string StagingFolderFor(const std::string& folder) {
+  const std::filesystem::path root(folder);
+  std::error_code error;
+  std::filesystem::create_directories(root, error);
+  if (error) throw InputError(folder + ": cannot create: " + error.message());
+  for (const auto& entry : std::filesystem::directory_iterator(root, error)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_directory() && name.rfind(".raycarve-partial-", 0) == 0) {
+      std::filesystem::remove_all(entry.path(), error);
+    }
+  }
+  const std::filesystem::path staging = root / (".raycarve-partial-" + std::to_string(getpid()));
+  std::filesystem::create_directory(staging, error);
+  if (error) throw InputError(staging.string() + ": cannot create: " + error.message());
+  return staging.string();
+}
+
+void MoveOutputSetIntoPlace(const std::string& staging, const std::string& folder,
+                            const std::string& last) {
+  const std::filesystem::path from(staging), to(folder);
+  std::vector<std::filesystem::path> files;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(from, error)) {
+    if (entry.is_regular_file()) files.push_back(std::filesystem::relative(entry.path(), from));
+  }
+  if (error) throw InputError(staging + ": cannot list the outputs: " + error.message());
+  std::sort(files.begin(), files.end());
+  std::stable_partition(files.begin(), files.end(),
+                        [&](const std::filesystem::path& file) { return file != last; });
+  for (const std::filesystem::path& file : files) Sync(from / file, false);
+  for (const std::filesystem::path& file : files) {
+    std::filesystem::create_directories((to / file).parent_path(), error);
+    if (error) throw InputError((to / file).parent_path().string() + ": cannot create: " + error.message());
+    RenameIntoPlace((from / file).string(), (to / file).string());
+  }
+  Sync(to, true);
+  std::filesystem::remove_all(from, error);
 }
 
 }  // namespace raycarve

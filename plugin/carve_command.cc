@@ -14,6 +14,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
 #include "calib/view_reader.h"
@@ -75,6 +76,18 @@ CarveRun CarveProject(const CarveRequest& request) {
     mask_targets[v] = OutputFileInside((std::filesystem::path(run.output_path) / "masks").string(),
                                        views[v].name + ".png", inputs);
   }
+  // Every output is written to a staging folder and moved into place together at the end,
+  // report.json last: an interrupted run leaves the previous outputs whole. Made before the work,
+  // so that an output folder that cannot be written is found at once.
+  const std::filesystem::path final_out(run.output_path);
+  const std::string staging = StagingFolderFor(run.output_path);
+  struct RemoveUnlessMoved {  // a run that fails leaves no staging folder behind
+    std::string path;
+    ~RemoveUnlessMoved() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  } staging_guard{staging};
   stage = Clock::now();
   const VoxelGrid grid(run.bounds.box, request.options.resolution);
   const ViewReaderSummary& masks = project.view_summary;
@@ -146,9 +159,7 @@ CarveRun CarveProject(const CarveRequest& request) {
 
   stage = Clock::now();
   std::error_code error;
-  std::filesystem::create_directories(run.output_path, error);
-  if (error) throw InputError(run.output_path + ": cannot create: " + error.message());
-  const std::filesystem::path out(run.output_path);
+  const std::filesystem::path out(staging);
   std::vector<exporter::ColouredPoint> points;
   if (request.mesh_kind == "voxels") {
     points = exporter::SurfacePoints(*run.result, request.options.min_views);
@@ -217,7 +228,8 @@ CarveRun CarveProject(const CarveRequest& request) {
   for (size_t v = 0; v < views.size(); ++v) {
     const CalibratedView& view = views[v];
     if (view.mask.empty()) continue;
-    const std::filesystem::path& mask_path = mask_targets[v];  // checked before carving
+    // Checked before carving; written to the same place under the staging folder.
+    const std::filesystem::path mask_path = out / std::filesystem::relative(mask_targets[v], final_out);
     std::filesystem::create_directories(mask_path.parent_path(), error);
     if (error) throw InputError(mask_path.parent_path().string() + ": cannot create: " + error.message());
     WriteImageAtomically(mask_path.string(), view.mask);
@@ -230,6 +242,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   }
   WriteTextFileAtomically((out / "convergence.csv").string(), csv.str());
   WriteTextFileAtomically((out / "report.json").string(), CarveReportJson(request, run));
+  MoveOutputSetIntoPlace(out.string(), final_out.string(), "report.json");
   return run;
 }
 

@@ -150,6 +150,40 @@ TEST_F(CommandLine, ReadsOptionsFromAColmapIniFileThatTheCommandLineOverrides) {
   ExpectUserError("carve --project_path " + *root_ + "/no.ini", {*root_ + "/no.ini", "--project_path"});
 }
 
+TEST_F(CommandLine, ARunKilledWhileWritingLeavesThePreviousOutputsWhole) {
+  const std::string out = *root_ + "/killed";
+  std::string output;
+  const std::string carve = "'" + testing::RaycarveBinary() + "' carve --workspace_path " +
+                            Project() + " --output_path " + out;
+  ASSERT_EQ(testing::RunShell(carve + " --resolution 24", &output), 0) << output;
+  const std::string report = testing::ReadFileBytes(out + "/report.json");
+  const std::string cloud = testing::ReadFileBytes(out + "/cloud.ply");
+  // A second run with other options, killed as soon as it starts writing its outputs (the
+  // staging folder appears before the mesh is made, well before anything moves into place).
+  const std::string script =
+      "(" + carve + " --resolution 96 --mesh_refine_passes 4 > /dev/null 2>&1 & echo $! > " + out +
+      ".pid); "
+      "for i in $(seq 1 3000); do ls -d " + out + "/.raycarve-partial-* > /dev/null 2>&1 && break; "
+      "sleep 0.01; done; kill -9 $(cat " + out + ".pid); sleep 0.2";
+  testing::WriteFile(out + ".sh", script + "\n");
+  ASSERT_EQ(testing::RunShell("bash " + out + ".sh", &output), 0) << output;
+  bool interrupted = false;
+  for (const auto& entry : fs::directory_iterator(out)) {
+    interrupted |= entry.path().filename().string().rfind(".raycarve-partial-", 0) == 0;
+  }
+  EXPECT_TRUE(interrupted) << "the second run was not caught while writing";
+  EXPECT_EQ(testing::ReadFileBytes(out + "/report.json"), report);
+  EXPECT_EQ(testing::ReadFileBytes(out + "/cloud.ply"), cloud);
+  // The next run clears the interrupted run's staging folder and replaces the set.
+  ASSERT_EQ(testing::RunShell(carve + " --resolution 32", &output), 0) << output;
+  EXPECT_NE(testing::ReadFileBytes(out + "/report.json"), report);
+  for (const auto& entry : fs::directory_iterator(out)) {
+    EXPECT_EQ(entry.path().filename().string().rfind(".raycarve-partial-", 0), std::string::npos)
+        << entry.path();
+    EXPECT_EQ(entry.path().filename().string().rfind(".tmp.", 0), std::string::npos) << entry.path();
+  }
+}
+
 TEST_F(CommandLine, TruncatedBinaryFileIsNamedWithRecordAndField) {
   const std::string model = CopyModel("truncated");
   const std::string images = model + "/images.bin";

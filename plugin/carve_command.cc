@@ -76,6 +76,22 @@ CarveRun CarveProject(const CarveRequest& request) {
     mask_targets[v] = OutputFileInside((std::filesystem::path(run.output_path) / "masks").string(),
                                        views[v].name + ".png", inputs);
   }
+  // A masks folder already in the output that no earlier carve wrote (no report.json beside it)
+  // is the user's: it is never written into.
+  {
+    const std::filesystem::path masks_folder = std::filesystem::path(run.output_path) / "masks";
+    const bool ours = std::filesystem::exists(std::filesystem::path(run.output_path) / "report.json");
+    bool any_mask = false;
+    for (const CalibratedView& view : views) any_mask |= !view.mask.empty();
+    std::error_code ignored;
+    if (any_mask && !ours && std::filesystem::is_directory(masks_folder) &&
+        !std::filesystem::is_empty(masks_folder, ignored)) {
+      throw InputError(masks_folder.string() +
+                       ": already holds files that raycarve did not write (no report.json beside "
+                       "it); carve would write its masks there: give another --output_path (or "
+                       "--mask_path " + masks_folder.string() + " to carve with them)");
+    }
+  }
   // Every output is written to a staging folder and moved into place together at the end,
   // report.json last: an interrupted run leaves the previous outputs whole. Made before the work,
   // so that an output folder that cannot be written is found at once.

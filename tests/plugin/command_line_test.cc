@@ -184,6 +184,31 @@ TEST_F(CommandLine, ARunKilledWhileWritingLeavesThePreviousOutputsWhole) {
   }
 }
 
+TEST_F(CommandLine, AMasksFolderThatCarveDidNotWriteIsNeverWrittenInto) {
+  // A studio project whose own folder holds the user's masks, carved into that folder.
+  const std::string studio = *root_ + "/own_masks";
+  std::string output;
+  ASSERT_EQ(Run("synth --output_path " + studio +
+                    " --views 4 --width 96 --height 72 --points 300 --backdrop uniform",
+                &output),
+            0)
+      << output;
+  const std::string mask = studio + "/masks/view001.png.png";
+  const std::string before = testing::ReadFileBytes(mask);
+  ExpectUserError("carve --workspace_path " + studio + " --output_path " + studio +
+                      " --resolution 16",
+                  {studio + "/masks", "raycarve did not write", "--mask_path"});
+  EXPECT_EQ(testing::ReadFileBytes(mask), before);
+  // An earlier carve's own output folder is written again.
+  const std::string out = studio + "/out";
+  for (int run = 0; run < 2; ++run) {
+    ASSERT_EQ(Run("carve --workspace_path " + studio + " --output_path " + out + " --resolution 16",
+                  &output),
+              0)
+        << output;
+  }
+}
+
 TEST_F(CommandLine, TruncatedBinaryFileIsNamedWithRecordAndField) {
   const std::string model = CopyModel("truncated");
   const std::string images = model + "/images.bin";

@@ -9,6 +9,7 @@
 #include <glog/logging.h>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "carve/carver.h"
 #include "export/carve_export.h"
@@ -155,10 +156,17 @@ int RunHoldout(int argc, char** argv) {
     }
   }
 
-  const std::filesystem::path out = std::filesystem::path(project.output_path) / "holdout";
-  std::error_code error;
-  std::filesystem::create_directories(out, error);
-  if (error) throw InputError(out.string() + ": cannot create: " + error.message());
+  // Written as a set, as carve's outputs: staged, then moved into place with holdout.json last.
+  const std::filesystem::path final_out = std::filesystem::path(project.output_path) / "holdout";
+  const std::string staging = StagingFolderFor(final_out.string());
+  struct RemoveUnlessMoved {  // a run that fails leaves no staging folder behind
+    std::string path;
+    ~RemoveUnlessMoved() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  } staging_guard{staging};
+  const std::filesystem::path out(staging);
   JsonWriter json;
   json.BeginObject()
       .Key("raycarve_version").Value(Version())
@@ -251,15 +259,16 @@ int RunHoldout(int argc, char** argv) {
     // The model that was scored, for a look at it.
     exporter::WriteMeshPly(model.mesh, (out / "mesh.ply").string());
   }
-  const std::string report = (out / "holdout.json").string();
-  WriteTextFileAtomically(report, json.str());
+  WriteTextFileAtomically((out / "holdout.json").string(), json.str());
+  MoveOutputSetIntoPlace(staging, final_out.string(), "holdout.json");
+  const std::string report = (final_out / "holdout.json").string();
   std::printf("mean over %zu held-out views: PSNR %.2f dB, silhouette IoU %s\n"
               "block PSNR: each photo against its own means over blocks a voxel wide, on the "
               "object: about the most one colour per voxel can score (mean %.2f dB)\n"
               "wrote %s, %s/<view>.png (photo | render | error x4)%s\n",
               held_out.size(), mean_psnr,
               iou_count > 0 ? std::to_string(mean_iou).c_str() : "n/a (no masks)", mean_block_psnr,
-              report.c_str(), out.string().c_str(),
+              report.c_str(), final_out.string().c_str(),
               render == "mesh" && result ? " and mesh.ply" : "");
   if (render == "mesh" && result) {
     std::printf("the voxel volume drawn into the same views: PSNR %.2f dB, silhouette IoU %s "

@@ -38,7 +38,7 @@ void Sync(const std::filesystem::path& path, bool folder) {
 
 }  // namespace
 
-std::string StagingFolderFor(const std::string& folder) {
+StagedOutputs::StagedOutputs(const std::string& folder) : folder_(folder) {
   const std::filesystem::path root(folder);
   std::error_code error;
   std::filesystem::create_directories(root, error);
@@ -52,18 +52,22 @@ std::string StagingFolderFor(const std::string& folder) {
   const std::filesystem::path staging = root / (".raycarve-partial-" + std::to_string(getpid()));
   std::filesystem::create_directory(staging, error);
   if (error) throw InputError(staging.string() + ": cannot create: " + error.message());
-  return staging.string();
+  staging_ = staging.string();
 }
 
-void MoveOutputSetIntoPlace(const std::string& staging, const std::string& folder,
-                            const std::string& last) {
-  const std::filesystem::path from(staging), to(folder);
+StagedOutputs::~StagedOutputs() {
+  std::error_code ignored;
+  std::filesystem::remove_all(staging_, ignored);
+}
+
+void StagedOutputs::MoveIntoPlace(const std::string& last) {
+  const std::filesystem::path from(staging_), to(folder_);
   std::vector<std::filesystem::path> files;
   std::error_code error;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(from, error)) {
     if (entry.is_regular_file()) files.push_back(std::filesystem::relative(entry.path(), from));
   }
-  if (error) throw InputError(staging + ": cannot list the outputs: " + error.message());
+  if (error) throw InputError(staging_ + ": cannot list the outputs: " + error.message());
   std::sort(files.begin(), files.end());
   std::stable_partition(files.begin(), files.end(),
                         [&](const std::filesystem::path& file) { return file != last; });

@@ -15,15 +15,25 @@ std::string TemporaryPathFor(const std::string& path);
 void RenameIntoPlace(const std::string& temporary, const std::string& path);
 
 // A set of outputs that should be replaced together (a cloud, its mesh and the report that
-// describes them): written under `staging`, then, once complete, each file synced to disk and
-// renamed into `folder` (same relative path), `last` after all the others, and the folder synced.
-// An interrupted run leaves the previous set whole beside the staging folder. Throws InputError
-// naming the file on failure.
-//
-// StagingFolderFor(folder): `<folder>/.raycarve-partial-<pid>`, created empty; staging folders
-// left by earlier, interrupted runs in `folder` are removed first.
-std::string StagingFolderFor(const std::string& folder);
-void MoveOutputSetIntoPlace(const std::string& staging, const std::string& folder,
-                            const std::string& last);
+// describes them). The constructor makes `<folder>/.raycarve-partial-<pid>`, empty, after
+// removing staging folders that earlier, interrupted runs left in `folder`; the outputs are
+// written under path(). MoveIntoPlace then syncs each file to disk and renames it into `folder`
+// (same relative path), `last` after all the others, and syncs the folder. An interrupted run
+// leaves the previous set whole; a run that fails before MoveIntoPlace leaves no staging folder
+// (the destructor removes it). Throws InputError naming the file on failure.
+class StagedOutputs {
+ public:
+  explicit StagedOutputs(const std::string& folder);
+  ~StagedOutputs();
+  StagedOutputs(const StagedOutputs&) = delete;
+  StagedOutputs& operator=(const StagedOutputs&) = delete;
+
+  const std::string& path() const { return staging_; }
+  void MoveIntoPlace(const std::string& last);
+
+ private:
+  std::string folder_;
+  std::string staging_;
+};
 
 }  // namespace raycarve

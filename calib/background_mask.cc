@@ -466,10 +466,18 @@ cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
       }
     }
     const double density = static_cast<double>(kept_seeds) / std::max(1, cv::countNonZero(mask));
+    std::vector<uint8_t> restore(count, 0);
     for (int c = 1; c < count; ++c) {
-      if (area[c] > 1 && seeds_in[c] >= 2 && seeds_in[c] >= 0.25 * density * area[c]) {
-        mask.setTo(255, components == c);
-        ++report->regions_restored;
+      restore[c] = area[c] > 1 && seeds_in[c] >= 2 && seeds_in[c] >= 0.25 * density * area[c];
+      report->regions_restored += restore[c];
+    }
+    if (report->regions_restored > 0) {
+      for (int row = 0; row < components.rows; ++row) {
+        const int* c = components.ptr<int>(row);
+        uint8_t* out = mask.ptr<uint8_t>(row);
+        for (int col = 0; col < components.cols; ++col) {
+          if (restore[c[col]]) out[col] = 255;
+        }
       }
     }
   }

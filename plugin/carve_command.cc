@@ -96,14 +96,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   // report.json last: an interrupted run leaves the previous outputs whole. Made before the work,
   // so that an output folder that cannot be written is found at once.
   const std::filesystem::path final_out(run.output_path);
-  const std::string staging = StagingFolderFor(run.output_path);
-  struct RemoveUnlessMoved {  // a run that fails leaves no staging folder behind
-    std::string path;
-    ~RemoveUnlessMoved() {
-      std::error_code ignored;
-      std::filesystem::remove_all(path, ignored);
-    }
-  } staging_guard{staging};
+  StagedOutputs staged(run.output_path);
   stage = Clock::now();
   const VoxelGrid grid(run.bounds.box, request.options.resolution);
   const ViewReaderSummary& masks = project.view_summary;
@@ -175,7 +168,7 @@ CarveRun CarveProject(const CarveRequest& request) {
 
   stage = Clock::now();
   std::error_code error;
-  const std::filesystem::path out(staging);
+  const std::filesystem::path out(staged.path());
   std::vector<exporter::ColouredPoint> points;
   if (request.mesh_kind == "voxels") {
     points = exporter::SurfacePoints(*run.result, request.options.min_views);
@@ -258,7 +251,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   }
   WriteTextFileAtomically((out / "convergence.csv").string(), csv.str());
   WriteTextFileAtomically((out / "report.json").string(), CarveReportJson(request, run));
-  MoveOutputSetIntoPlace(out.string(), final_out.string(), "report.json");
+  staged.MoveIntoPlace("report.json");
   return run;
 }
 

@@ -158,15 +158,8 @@ int RunHoldout(int argc, char** argv) {
 
   // Written as a set, as carve's outputs: staged, then moved into place with holdout.json last.
   const std::filesystem::path final_out = std::filesystem::path(project.output_path) / "holdout";
-  const std::string staging = StagingFolderFor(final_out.string());
-  struct RemoveUnlessMoved {  // a run that fails leaves no staging folder behind
-    std::string path;
-    ~RemoveUnlessMoved() {
-      std::error_code ignored;
-      std::filesystem::remove_all(path, ignored);
-    }
-  } staging_guard{staging};
-  const std::filesystem::path out(staging);
+  StagedOutputs staged(final_out.string());
+  const std::filesystem::path out(staged.path());
   JsonWriter json;
   json.BeginObject()
       .Key("raycarve_version").Value(Version())
@@ -260,7 +253,7 @@ int RunHoldout(int argc, char** argv) {
     exporter::WriteMeshPly(model.mesh, (out / "mesh.ply").string());
   }
   WriteTextFileAtomically((out / "holdout.json").string(), json.str());
-  MoveOutputSetIntoPlace(staging, final_out.string(), "holdout.json");
+  staged.MoveIntoPlace("holdout.json");
   const std::string report = (final_out / "holdout.json").string();
   std::printf("mean over %zu held-out views: PSNR %.2f dB, silhouette IoU %s\n"
               "block PSNR: each photo against its own means over blocks a voxel wide, on the "

@@ -8,6 +8,8 @@
 # Usage: scripts/run_large_project.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
+command -v convert > /dev/null || { echo "run_large_project.sh needs convert (apt-get install imagemagick)" >&2; exit 1; }
+command -v python3 > /dev/null || { echo "run_large_project.sh needs python3 (apt-get install python3)" >&2; exit 1; }
 scripts/setup.sh raycarve >&2
 rc=build/plugin/raycarve
 out=out/large_project

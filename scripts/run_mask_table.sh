@@ -11,6 +11,7 @@
 # Usage: scripts/run_mask_table.sh   (data: $RAYCARVE_DATA_DIR or ../shared/data)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+command -v python3 > /dev/null || { echo "run_mask_table.sh needs python3 (apt-get install python3)" >&2; exit 1; }
 data=${RAYCARVE_DATA_DIR:-../shared/data}
 scripts/setup.sh raycarve >&2
 make -C build mask_iou >/dev/null

@@ -7,8 +7,13 @@
 // (completeness).
 //   scripts/run_benchmark.sh [--views 14 --width 800 --height 600 --resolutions 128,256
 //                             --threads 1,2 --vis_lookup footprint --incremental_statistics 1
-//                             --lod_levels 1,0,3]   (0: automatic, the command line's default;
-//                             the levels column shows how many it chose)
+//                             --lod_levels 1,0,3 --batch_voxels 1,64]   (levels 0: automatic,
+//                             the command line's default; the levels column shows how many it
+//                             chose)
+// Per run also where the threads' time went: the wall time of the parallel sections of carving
+// and colouring, and per thread its work in them and its waiting (the rest of that wall time).
+// The serial time (convergence + colouring - parallel) and the total work project the time on
+// more cores: about serial + work / n, while the work per batch outweighs a hand-over.
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -87,6 +92,7 @@ int main(int argc, char** argv) {
   std::vector<int> thread_counts = {1};
   // One level (the paper's ray casting) and the command line's automatic levels of detail.
   std::vector<int> level_counts = {1, raycarve::kAutomaticLevels};
+  std::vector<int> batch_sizes = {raycarve::CarveOptions().batch_voxels};
   if (raycarve::ResolveNumThreads(-1) > 1) thread_counts.push_back(raycarve::ResolveNumThreads(-1));
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
@@ -103,9 +109,13 @@ int main(int argc, char** argv) {
       }
       if (value != "both") lookups = {lookup};
     }
-    else if (flag == "--resolutions" || flag == "--threads" || flag == "--lod_levels") {
+    else if (flag == "--resolutions" || flag == "--threads" || flag == "--lod_levels" ||
+             flag == "--batch_voxels") {
       std::vector<int>& numbers =
-          flag == "--threads" ? thread_counts : (flag == "--lod_levels" ? level_counts : resolutions);
+          flag == "--threads" ? thread_counts
+                              : (flag == "--lod_levels" ? level_counts
+                                                        : (flag == "--batch_voxels" ? batch_sizes
+                                                                                    : resolutions));
       numbers.clear();
       std::stringstream list(value);
       std::string item;
@@ -130,15 +140,17 @@ int main(int argc, char** argv) {
   }
 
   const std::vector<Eigen::Vector3d> truth = raycarve::SampleTrueSurface(scene, 20000, 5, 2);
-  std::printf("%-10s %-10s %-7s %-6s %-14s %10s %10s %12s %12s %12s %12s %9s %12s\n", "resolution",
-              "vis", "threads", "levels", "grid", "set-up s", "converge s", "memory MiB",
-              "peak RSS MiB", "carved", "evaluated", "precision", "completeness");
+  std::printf("%-10s %-10s %-5s %-7s %-6s %-14s %8s %10s %8s %10s %10s %10s %12s %12s %9s %12s   %s\n",
+              "resolution", "vis", "batch", "threads", "levels", "grid", "set-up s", "converge s",
+              "colour s", "parallel s", "memory MiB", "peak RSS", "carved", "evaluated",
+              "precision", "completeness", "work s / wait s per thread");
   std::ostringstream json;
   json << "[";
   bool first = true;
   for (size_t k = 0; k < resolutions.size(); ++k) {
    for (const int levels : level_counts) {
    for (const raycarve::VisLookup lookup : lookups) {
+   for (const int batch : batch_sizes) {
    for (const int threads : thread_counts) {
     if (lookup == raycarve::VisLookup::kRayLists && threads != thread_counts.front()) continue;
     raycarve::CarveOptions options;
@@ -148,6 +160,7 @@ int main(int argc, char** argv) {
     options.incremental_statistics = incremental_statistics;
     options.num_threads = lookup == raycarve::VisLookup::kRayLists ? 1 : threads;
     options.lod_levels = levels;
+    options.batch_voxels = batch;
     const std::string vis = raycarve::VisLookupToString(lookup);
     if (!raycarve::CheckCarveFits(views, scene.object_box, options, &reason)) {
       std::fprintf(stderr, "resolution %d: %s\n", resolutions[k], reason.c_str());
@@ -159,24 +172,42 @@ int main(int argc, char** argv) {
     std::snprintf(grid, sizeof(grid), "%dx%dx%d", s.dimensions.x(), s.dimensions.y(), s.dimensions.z());
     const double memory = s.peak_memory_bytes / (1024.0 * 1024.0);
     const Quality quality = MeasureQuality(result, truth);
-    std::printf("%-10d %-10s %-7d %-6d %-14s %10.2f %10.2f %12.1f %12.1f %12lld %12lld %8.1f%% %11.1f%%\n",
-                resolutions[k], vis.c_str(), options.num_threads, static_cast<int>(s.levels.size()), grid,
-                s.setup_seconds, s.carve_seconds, memory, PeakResidentMiB(),
-                static_cast<long long>(s.carved), static_cast<long long>(s.evaluated),
-                100.0 * quality.precision, 100.0 * quality.completeness);
+    std::string threads_text, threads_json;
+    for (size_t t = 0; t < s.thread_work_seconds.size(); ++t) {
+      const double work = s.thread_work_seconds[t], wait = s.parallel_seconds - work;
+      char entry[64];
+      std::snprintf(entry, sizeof(entry), "%s%.2f/%.2f", t == 0 ? "" : " ", work, wait);
+      threads_text += entry;
+      std::snprintf(entry, sizeof(entry), "%s{\"work_seconds\": %.4f, \"wait_seconds\": %.4f}",
+                    t == 0 ? "" : ", ", work, wait);
+      threads_json += entry;
+    }
+    std::printf("%-10d %-10s %-5d %-7d %-6d %-14s %8.2f %10.2f %8.2f %10.2f %10.1f %10.1f %12lld %12lld %8.1f%% %11.1f%%   %s\n",
+                resolutions[k], vis.c_str(), batch, s.threads, static_cast<int>(s.levels.size()),
+                grid, s.setup_seconds, s.carve_seconds, s.colour_seconds, s.parallel_seconds,
+                memory, PeakResidentMiB(), static_cast<long long>(s.carved),
+                static_cast<long long>(s.evaluated), 100.0 * quality.precision,
+                100.0 * quality.completeness, threads_text.c_str());
     std::fflush(stdout);
     json << (first ? "" : ",") << "\n  {\"resolution\": " << resolutions[k]
-         << ", \"vis_lookup\": \"" << vis << "\", \"threads\": " << options.num_threads
+         << ", \"vis_lookup\": \"" << vis << "\", \"batch_voxels\": " << batch
+         << ", \"threads_asked\": " << options.num_threads << ", \"threads\": " << s.threads
          << ", \"lod_levels\": " << s.levels.size()
          << ", \"lod_automatic\": " << (levels == raycarve::kAutomaticLevels ? "true" : "false")
          << ", \"grid\": \"" << grid
          << "\", \"views\": " << views.size() << ", \"width\": " << scene_options.width
          << ", \"height\": " << scene_options.height << ", \"setup_seconds\": " << s.setup_seconds
-         << ", \"convergence_seconds\": " << s.carve_seconds << ", \"memory_mib\": " << memory
+         << ", \"convergence_seconds\": " << s.carve_seconds
+         << ", \"colour_seconds\": " << s.colour_seconds
+         << ", \"parallel_seconds\": " << s.parallel_seconds
+         << ", \"parallel_runs\": " << s.parallel_runs << ", \"inline_runs\": " << s.inline_runs
+         << ", \"per_thread\": [" << threads_json << "]"
+         << ", \"memory_mib\": " << memory
          << ", \"peak_rss_mib\": " << PeakResidentMiB() << ", \"carved\": " << s.carved
          << ", \"evaluated\": " << s.evaluated << ", \"precision\": " << quality.precision
          << ", \"completeness\": " << quality.completeness << "}";
     first = false;
+   }
    }
    }
    }

@@ -33,6 +33,12 @@ constexpr double kBytesPerLayeredPixel = 4.0 + 4 * 12.0;
 // Solid, surface and in-queue bits, plus a generous byte for the CVSVL's entries.
 constexpr double kBytesPerVoxel = 3.0 / 8.0 + 1.0;
 constexpr double kBytesPerListedVoxel = kBytesPerVoxel + 4.0;
+// Batched carving: voxels a group claims at once for judging (see ClaimItems).
+constexpr int kClaimChunk = 8;
+
+int64_t ElapsedNanoseconds(Clock::time_point since) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - since).count();
+}
 
 // Appends to `stats` the colour statistics of pixels [begin, end), grouped view by view (a new
 // entry wherever the view changes).
@@ -105,6 +111,73 @@ std::vector<cv::Mat> KnownSurfaceDepths(const std::vector<CalibratedView>& views
     }
   }
   return depths;
+}
+
+// Whether `options` carve in batches (CarveOptions::batch_voxels), given ray casting that finds
+// Vis by footprints.
+bool Batched(const CarveOptions& options) {
+  return options.batch_voxels > 1 && options.method == CarveMethod::kRay &&
+         options.vis_lookup == VisLookup::kFootprint && options.order == CarveOrder::kFifo &&
+         options.decision == CarveDecision::kThreshold && !options.incremental_statistics;
+}
+
+// Calls body(item, group) for items [0, count) on `workers`, each group claiming `chunk`
+// consecutive items at a time from `next`. Consecutive items of a batch are neighbouring voxels,
+// whose rays are neighbouring pixels: claimed together, one thread's writes stay off the cache
+// lines the other threads write.
+template <typename Body>
+void ClaimItems(ViewWorkers& workers, std::atomic<int>& next, int count, int chunk, Body body) {
+  next.store(0, std::memory_order_relaxed);
+  auto task = [&](int group) {
+    for (int first; (first = next.fetch_add(chunk, std::memory_order_relaxed)) < count;) {
+      const int last = std::min(count, first + chunk);
+      for (int item = first; item < last; ++item) body(item, group);
+    }
+  };
+  workers.Run(task);
+}
+
+// Calls work(view) for every view on `workers`, the groups claiming views one at a time: each
+// group first its own (view v belongs to group v mod G, so that a view's rays stay in one core's
+// cache from task to task), then any left, in `order` (the costliest first).
+template <typename Work>
+void ClaimViews(ViewWorkers& workers, const std::vector<int>& order,
+                std::atomic<uint8_t>* claimed, Work work) {
+  for (int view : order) claimed[view].store(0, std::memory_order_relaxed);
+  auto task = [&](int group) {
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int view : order) {
+        if (pass == 0 && workers.GroupOf(view) != group) continue;
+        if (claimed[view].load(std::memory_order_relaxed) != 0 ||
+            claimed[view].exchange(1, std::memory_order_relaxed) != 0) {
+          continue;
+        }
+        work(view);
+      }
+      if (workers.num_groups() == 1) break;
+    }
+  };
+  workers.Run(task);
+}
+
+// Removes from `values` [0, n) every value seen earlier in it, keeping the order of the rest;
+// returns how many are left. Neighbouring pixels' rays mostly reach the same voxels, and queueing
+// a voxel twice in a row is a no-op: done on the workers, this spares the serial queueing most of
+// its work without changing what is queued. (Short runs checked in full, longer ones against
+// the previous value only.)
+size_t KeepFirstOccurrences(int64_t* values, size_t n) {
+  constexpr size_t kFullCheck = 64;
+  size_t kept = 0;
+  for (size_t i = 0; i < n; ++i) {
+    bool seen = false;
+    if (n <= kFullCheck) {
+      for (size_t j = 0; j < kept && !seen; ++j) seen = values[j] == values[i];
+    } else {
+      seen = kept > 0 && values[kept - 1] == values[i];
+    }
+    if (!seen) values[kept++] = values[i];
+  }
+  return kept;
 }
 
 // The grid of `options` over `box`, once the carving is known to fit (CHECKed).
@@ -219,6 +292,10 @@ bool CarveOptions::IsValid(std::string* reason) const {
   }
   if (min_views < 1) {
     *reason = "min_views must be >= 1";
+    return false;
+  }
+  if (batch_voxels < 1 || batch_voxels > 65536) {
+    *reason = "batch_voxels must be in [1, 65536], got " + std::to_string(batch_voxels);
     return false;
   }
   if (!(auto_threshold_quantile > 0.0 && auto_threshold_quantile <= 1.0)) {
@@ -383,9 +460,17 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
     }
     known_depth_ = KnownSurfaceDepths(views, volume_.grid(), options.surface_points);
   }
-  view_parallel_ = ray_visibility_ != nullptr && ray_visibility_->ViewParallel() &&
-                   order_ == CarveOrder::kFifo && workers_.num_groups() > 1;
-  if (view_parallel_) groups_.resize(workers_.num_groups());
+  batched_ = Batched(options) && ray_visibility_ != nullptr && ray_visibility_->ViewParallel();
+  batch_voxels_ = batched_ ? options.batch_voxels : 1;
+  view_parallel_ = !batched_ && ray_visibility_ != nullptr && ray_visibility_->ViewParallel() &&
+                   order_ == CarveOrder::kFifo && workers_.num_groups() > 1 &&
+                   workers_.num_groups() <= static_cast<int>(views.size());
+  if (view_parallel_ || batched_) groups_.resize(workers_.num_groups());
+  if (batched_) {
+    view_buffers_.resize(views.size());
+    view_claimed_ = std::make_unique<std::atomic<uint8_t>[]>(views.size());
+    for (int view = 0; view < static_cast<int>(views.size()); ++view) claim_order_.push_back(view);
+  }
   if (options.incremental_statistics) {
     CHECK(ray_visibility_ != nullptr) << "incremental statistics need ray casting";
     sums_ = std::make_unique<VoxelColourSums>(volume_.grid().num_voxels(),
@@ -448,13 +533,17 @@ Consistency IncrementalCarver::Evaluate(int64_t voxel, bool need_vis) {
     FindVis(voxel, /*gather=*/true);
   }
   prefetched_ = -1;
-  Consistency consistency = test_.Evaluate(stats_);
+  return Judge(voxel, stats_);
+}
+
+Consistency IncrementalCarver::Judge(int64_t voxel, const std::vector<ViewColourStats>& stats) const {
+  Consistency consistency = test_.Evaluate(stats);
   if (min_coverage_ > 0.0 && consistency.judged) {
     // Judged only where enough views see most of the voxel: not through a small hole.
     const VoxelGrid& grid = volume_.grid();
     const Eigen::Vector3d centre = grid.Centre(grid.Voxel(voxel));
     int covered = 0;
-    for (const ViewColourStats& view_stats : stats_) {
+    for (const ViewColourStats& view_stats : stats) {
       if (view_stats.count == 0) continue;
       const CalibratedView& view = views_[view_stats.view];
       const double depth = view.Depth(centre);
@@ -472,7 +561,7 @@ Consistency IncrementalCarver::Evaluate(int64_t voxel, bool need_vis) {
   if (patterns_ && consistency.judged && consistency.consistent) {
     const PatchCorrelation patches = CorrelatePatches(
         views_, volume_.grid().Centre(volume_.grid().Voxel(voxel)), volume_.grid().voxel_size(),
-        stats_);
+        stats);
     if (patches.textured) {
       consistency.pattern_error = patches.error();
       consistency.consistent = consistency.pattern_error <= pattern_threshold_;
@@ -579,11 +668,12 @@ int64_t IncrementalCarver::PeekNextSolid() const {
   return queued && volume_.IsSolid(voxel) ? voxel : -1;
 }
 
-bool IncrementalCarver::BehindKnownSurface(int64_t voxel) const {
+bool IncrementalCarver::BehindKnownSurface(int64_t voxel,
+                                           const std::vector<ViewColourStats>& stats) const {
   if (known_depth_.empty()) return false;
   const VoxelGrid& grid = volume_.grid();
   const Eigen::Vector3d centre = grid.Centre(grid.Voxel(voxel));
-  for (const ViewColourStats& view_stats : stats_) {
+  for (const ViewColourStats& view_stats : stats) {
     if (view_stats.count == 0) continue;
     const cv::Mat& depths = known_depth_[view_stats.view];
     if (depths.empty()) continue;
@@ -601,7 +691,162 @@ bool IncrementalCarver::BehindKnownSurface(int64_t voxel) const {
   return false;
 }
 
+void IncrementalCarver::FormBatch(Batch* batch) {
+  batch->entries.clear();
+  while (static_cast<int>(batch->entries.size()) < batch_voxels_ && !queue_.empty()) {
+    const int64_t voxel = queue_.front();
+    queue_.pop_front();
+    if (!volume_.IsSolid(voxel)) {
+      queued_[voxel >> 6] &= ~(uint64_t{1} << (voxel & 63));
+      continue;
+    }
+    batch->entries.emplace_back();
+    batch->entries.back().voxel = voxel;
+  }
+  batch->views.resize(batch->entries.size() * views_.size());
+}
+
+void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* finding,
+                                    int finding_slot) {
+  const int num_views = static_cast<int>(views_.size());
+  const VoxelGrid& grid = volume_.grid();
+  auto work = [&](int view) {
+    const Clock::time_point start = Clock::now();
+    ViewBuffers& buffers = view_buffers_[view];
+    if (carving != nullptr) {
+      const std::vector<PixelRef>& vis = buffers.vis[carving_slot];
+      buffers.reached.clear();
+      for (int k : batch_carved_) {
+        BatchView& at = carving->views[static_cast<size_t>(k) * num_views + view];
+        at.reached_begin = buffers.reached.size();
+        ray_visibility_->AdvanceRays(vis.data() + at.vis_begin, vis.data() + at.vis_end,
+                                     &buffers.reached);
+        at.reached_end = at.reached_begin + KeepFirstOccurrences(
+            buffers.reached.data() + at.reached_begin, buffers.reached.size() - at.reached_begin);
+        buffers.reached.resize(at.reached_end);
+      }
+    }
+    if (finding != nullptr) {
+      std::vector<PixelRef>& vis = buffers.vis[finding_slot];
+      vis.clear();
+      for (size_t k = 0; k < finding->entries.size(); ++k) {
+        BatchView& at = finding->views[k * num_views + view];
+        at.vis_begin = vis.size();
+        ray_visibility_->ComputeVisInView(grid.Voxel(finding->entries[k].voxel), view, &vis);
+        at.vis_end = vis.size();
+        at.stats = ViewColourStats();
+        at.stats.view = view;
+        for (size_t p = at.vis_begin; p < at.vis_end; ++p) at.stats.Add(PixelColour(vis[p]));
+      }
+    }
+    buffers.nanoseconds += ElapsedNanoseconds(start);
+  };
+  ClaimViews(workers_, claim_order_, view_claimed_.get(), work);
+  SortViewsByCost();
+}
+
+void IncrementalCarver::SortViewsByCost() {
+  std::stable_sort(claim_order_.begin(), claim_order_.end(), [this](int a, int b) {
+    return view_buffers_[a].nanoseconds > view_buffers_[b].nanoseconds;
+  });
+  for (ViewBuffers& buffers : view_buffers_) buffers.nanoseconds = 0;
+}
+
+void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
+  const int num_views = static_cast<int>(views_.size());
+  auto judge = [&](int k, int group) {
+    std::vector<ViewColourStats>& stats = groups_[group].stats;
+    stats.clear();
+    BatchEntry& entry = batch->entries[k];
+    entry.num_pixels = 0;
+    for (int view = 0; view < num_views; ++view) {
+      const BatchView& at = batch->views[static_cast<size_t>(k) * num_views + view];
+      if (at.stats.count == 0) continue;
+      stats.push_back(at.stats);
+      entry.num_pixels += at.stats.count;
+    }
+    entry.consistency = Judge(entry.voxel, stats);
+    entry.carve = !entry.consistency.consistent;
+    entry.kept_protected = false;
+    if (entry.carve && (IsProtected(entry.voxel) || BehindKnownSurface(entry.voxel, stats))) {
+      entry.carve = false;
+      entry.kept_protected = true;
+    }
+    if (colouring) {
+      // The pixels' distance to the voxel's colour, summed view by view in pixel order.
+      double error = 0.0;
+      for (int view = 0; view < num_views; ++view) {
+        const BatchView& at = batch->views[static_cast<size_t>(k) * num_views + view];
+        const std::vector<PixelRef>& vis = view_buffers_[view].vis[slot];
+        for (size_t p = at.vis_begin; p < at.vis_end; ++p) {
+          error += (PixelColour(vis[p]) - entry.consistency.colour).norm();
+        }
+      }
+      entry.reprojection_error = error;
+    }
+  };
+  ClaimItems(workers_, next_item_, static_cast<int>(batch->entries.size()), kClaimChunk, judge);
+}
+
+void IncrementalCarver::ReturnPendingBatch() {
+  if (!batch_found_) return;
+  // The queued bits are still set: the voxels go back to the front, in their order.
+  const std::vector<BatchEntry>& entries = batches_[current_].entries;
+  for (auto entry = entries.rbegin(); entry != entries.rend(); ++entry) {
+    queue_.push_front(entry->voxel);
+  }
+  batches_[current_].entries.clear();
+  batch_found_ = false;
+}
+
+bool IncrementalCarver::StepBatch() {
+  Batch& current = batches_[current_];
+  if (!batch_found_) {
+    FormBatch(&current);
+    if (current.entries.empty()) return false;
+    RunViewTask(nullptr, 0, &current, current_);
+  }
+  // Every voxel judged against the rays as they stood before any of the batch was carved.
+  JudgeEntries(&current, current_, /*colouring=*/false);
+  evaluated_ += static_cast<int64_t>(current.entries.size());
+  batch_carved_.clear();
+  for (int k = 0; k < static_cast<int>(current.entries.size()); ++k) {
+    const BatchEntry& entry = current.entries[k];
+    queued_[entry.voxel >> 6] &= ~(uint64_t{1} << (entry.voxel & 63));
+    protected_kept_ += entry.kept_protected;
+    if (entry.carve) batch_carved_.push_back(k);
+  }
+  for (int k : batch_carved_) {
+    exposed_.clear();
+    volume_.Carve(current.entries[k].voxel, &exposed_);
+  }
+  carved_ += static_cast<int64_t>(batch_carved_.size());
+  // The rays that ended in the carved voxels step on (through all of them), and the next batch's
+  // Vis is found after them, view by view in one task.
+  const int next_slot = 1 - current_;
+  Batch& next = batches_[next_slot];
+  FormBatch(&next);
+  if (!batch_carved_.empty() || !next.entries.empty()) {
+    RunViewTask(batch_carved_.empty() ? nullptr : &current, current_,
+                next.entries.empty() ? nullptr : &next, next_slot);
+  }
+  // Queued carved voxel by carved voxel, view by view: the same for any number of groups.
+  const int num_views = static_cast<int>(views_.size());
+  for (int k : batch_carved_) {
+    for (int view = 0; view < num_views; ++view) {
+      const BatchView& at = current.views[static_cast<size_t>(k) * num_views + view];
+      const std::vector<int64_t>& reached = view_buffers_[view].reached;
+      for (size_t p = at.reached_begin; p < at.reached_end; ++p) Enqueue(reached[p]);
+    }
+  }
+  max_queue_ = std::max(max_queue_, queue_size() + next.entries.size());
+  current_ = next_slot;
+  batch_found_ = !next.entries.empty();
+  return true;
+}
+
 bool IncrementalCarver::Step() {
+  if (batched_) return StepBatch();
   int64_t voxel = 0;
   if (!Pop(&voxel)) {
     if (!visibility_->StartPass()) return false;
@@ -622,7 +867,7 @@ bool IncrementalCarver::Step() {
        ReprojectionChange(consistency.colour) >= 0.0)) {
     return true;
   }
-  if (IsProtected(voxel) || BehindKnownSurface(voxel)) {
+  if (IsProtected(voxel) || BehindKnownSurface(voxel, stats_)) {
     ++protected_kept_;
     return true;
   }
@@ -657,6 +902,7 @@ bool IncrementalCarver::Step() {
 }
 
 void IncrementalCarver::CarveAndQueue(int64_t voxel) {
+  ReturnPendingBatch();
   prefetched_ = -1;
   vis_.clear();
   visibility_->ComputeVis(voxel, &vis_);
@@ -708,6 +954,37 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
   std::vector<ColouredVoxel> surface;
   double error = 0.0;
   int64_t explained = 0;
+  if (batched_) {
+    // Judged on every thread, a chunk of the surface at a time; summed in surface order.
+    ReturnPendingBatch();
+    const std::vector<int64_t> voxels = volume_.SurfaceVoxels();
+    constexpr size_t kChunk = 4096;
+    Batch& chunk = batches_[current_];
+    for (size_t first = 0; first < voxels.size(); first += kChunk) {
+      chunk.entries.clear();
+      for (size_t i = first; i < std::min(voxels.size(), first + kChunk); ++i) {
+        chunk.entries.emplace_back();
+        chunk.entries.back().voxel = voxels[i];
+      }
+      chunk.views.resize(chunk.entries.size() * views_.size());
+      RunViewTask(nullptr, 0, &chunk, current_);
+      JudgeEntries(&chunk, current_, /*colouring=*/true);
+      for (const BatchEntry& entry : chunk.entries) {
+        ColouredVoxel coloured;
+        coloured.index = entry.voxel;
+        coloured.colour = entry.consistency.colour.cast<float>();
+        coloured.num_views = entry.consistency.num_views;
+        coloured.num_pixels = entry.consistency.num_pixels;
+        surface.push_back(coloured);
+        error += entry.reprojection_error;
+        explained += entry.num_pixels;
+      }
+    }
+    chunk.entries.clear();
+    error += threshold_ * static_cast<double>(std::max<int64_t>(0, usable_pixels_ - explained));
+    surface_reprojection_error_ = usable_pixels_ == 0 ? 0.0 : error / usable_pixels_;
+    return surface;
+  }
   for (int64_t voxel : volume_.SurfaceVoxels()) {
     const Consistency consistency = Evaluate(voxel);
     ColouredVoxel coloured;
@@ -795,6 +1072,18 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   int64_t hull_carved = 0;  // the first level's visual hull, in final voxels
   std::unique_ptr<IncrementalCarver> carver;
   std::vector<CalibratedView> reduced_views;  // the photos of a coarse level, when reduced
+  auto add_worker_times = [&statistics](const IncrementalCarver& level_carver) {
+    const ViewWorkers::Times times = level_carver.worker_times();
+    statistics.parallel_seconds += times.wall_seconds;
+    statistics.parallel_runs += times.runs;
+    statistics.inline_runs += times.inline_runs;
+    if (statistics.thread_work_seconds.size() < times.busy_seconds.size()) {
+      statistics.thread_work_seconds.resize(times.busy_seconds.size(), 0.0);
+    }
+    for (size_t t = 0; t < times.busy_seconds.size(); ++t) {
+      statistics.thread_work_seconds[t] += times.busy_seconds[t];
+    }
+  };
   for (int level = 0; level < num_levels; ++level) {
     const Clock::time_point level_start = Clock::now();
     CarveOptions level_options = options;
@@ -874,8 +1163,9 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
                                   statistics.evaluated + carver->evaluated()});
     };
     sample(SecondsSince(start));
-    for (int64_t steps = 1; carver->Step(); ++steps) {
-      if ((steps & 1023) != 0) continue;
+    for (int64_t next_check = 1024; carver->Step();) {
+      if (carver->evaluated() < next_check) continue;
+      next_check = carver->evaluated() + 1024;
       const double seconds = SecondsSince(start);
       if (seconds >= next_sample) {
         sample(seconds);
@@ -907,6 +1197,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     statistics.passes = std::max(statistics.passes, carver->passes());
     statistics.threads = carver->threads();
     statistics.peak_memory_bytes = std::max(statistics.peak_memory_bytes, carver->MemoryBytes());
+    if (level + 1 < num_levels) add_worker_times(*carver);
   }
   statistics.carve_seconds = SecondsSince(start);
   statistics.dimensions = carver->volume().grid().dimensions();
@@ -922,6 +1213,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     if (voxel.num_pixels > 0) ++statistics.visible_surface;
   }
   statistics.colour_seconds = SecondsSince(colour_start);
+  add_worker_times(*carver);
   statistics.final_surface = carver->volume().num_surface();
   statistics.final_solid = carver->volume().num_solid();
   result.volume = std::move(*carver->mutable_volume());

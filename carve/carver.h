@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -127,11 +128,22 @@ struct CarveOptions {
   // (the demo at 128 voxels, threshold 30: completeness 44% with 1, 94.4% with 1.1, 93.7% with
   // 1.2, 92.7% with 1.5, 92.0% in one level).
   double lod_threshold_scale = 1.2;
-  // Threads for ray casting with the footprint lookup and fifo order: each takes every n-th view
-  // (rays are per view) for Vis(V), colour gathering and stepping rays (see view_workers.h).
-  // The carving is identical for any count. < 1: one per hardware thread. Other methods, ray
-  // lists and the evidence order use one.
+  // Threads for ray casting with the footprint lookup and fifo order (see batch_voxels). The
+  // carving is identical for any count. < 1: one per core. Other methods, ray lists and the
+  // evidence order use one.
   int num_threads = 1;
+  // Ray casting with the footprint lookup, fifo order and the threshold decision, without
+  // incremental statistics: the CVSVL is handed out this many voxels at a time. The voxels of a
+  // batch are judged at once against the rays as they stand (Vis(V) found and tested for each, on
+  // every thread), the inconsistent ones are carved in queue order, then the rays that ended in
+  // them step on (on every thread) and the voxels they reach are queued, batch by batch in queue
+  // order. A voxel of the batch that a ray of another carved voxel reaches is queued again and
+  // judged with its new pixels, as any voxel whose visibility changed is. The batch is the unit
+  // of work handed to the threads, so it does not depend on their number and neither does the
+  // carving. 1: the seed paper's one voxel at a time (its threads then share each voxel's views:
+  // a hand-over per voxel, which costs more than it saves on fine grids). Measured in
+  // docs/carving.md.
+  int batch_voxels = 64;
   // Ray casting: keep colour statistics per voxel and view incrementally (voxel_colour_sums.h):
   // evaluating a voxel reads its sums, and Vis(V) is found only for voxels carved (or judged by
   // the reprojection decision). Same carving, 56 bytes per view and voxel holding rays.
@@ -198,6 +210,13 @@ struct CarveStatistics {
   // level's set-up (refinements and later set-ups too).
   double carve_seconds = 0.0;
   double colour_seconds = 0.0;  // colouring the final surface
+  // Where the threads' time went in carving and colouring (every level; ViewWorkers::Times): the
+  // wall time of the parallel sections, and per thread its work in them (its waiting is the rest).
+  // Set-up, and the serial parts between sections, are outside.
+  double parallel_seconds = 0.0;
+  std::vector<double> thread_work_seconds;
+  int64_t parallel_runs = 0;
+  int64_t inline_runs = 0;  // sections run on one thread because the others fell behind
   size_t peak_memory_bytes = 0;  // volume, visibility structures and the CVSVL
   std::vector<CurveSample> curve;
   std::vector<LevelStatistics> levels;  // one per level of detail (one without)
@@ -270,8 +289,10 @@ class IncrementalCarver {
   // The ray-cast visibility, or nullptr with another method.
   RayCastVisibility* ray_visibility() { return ray_visibility_; }
   int passes() const { return passes_; }
-  // Threads the carving runs on (1 unless view-parallel ray casting).
-  int threads() const { return view_parallel_ ? workers_.num_groups() : 1; }
+  // Threads the carving runs on (1 unless batched or view-parallel ray casting).
+  int threads() const { return batched_ || view_parallel_ ? workers_.num_groups() : 1; }
+  // Where the threads' time went so far (see ViewWorkers::Times).
+  ViewWorkers::Times worker_times() const { return workers_.times(); }
   int64_t evaluated() const { return evaluated_; }
   int64_t carved() const { return carved_; }
   // Evaluations that found a protected voxel inconsistent and kept it
@@ -280,7 +301,9 @@ class IncrementalCarver {
   bool IsProtected(int64_t voxel) const {
     return !protected_.empty() && ((protected_[voxel >> 6] >> (voxel & 63)) & 1) != 0;
   }
-  size_t queue_size() const { return queue_.size() + heap_.size(); }
+  size_t queue_size() const {
+    return queue_.size() + heap_.size() + (batch_found_ ? batches_[current_].entries.size() : 0);
+  }
   // Volume, visibility structures and the CVSVL at its largest so far.
   size_t MemoryBytes() const;
   // The mean reprojection error over usable pixels (see CarveStatistics); costs an evaluation of
@@ -294,6 +317,11 @@ class IncrementalCarver {
   // V's consistency, with Vis(V) in vis_ (with incremental statistics, only when `need_vis`;
   // vis_ready_ says whether vis_ holds it).
   Consistency Evaluate(int64_t voxel, bool need_vis = true);
+  // The test's verdict on V from its views' statistics, with the coverage rule and the patterns.
+  // Reads only; safe on several threads.
+  Consistency Judge(int64_t voxel, const std::vector<ViewColourStats>& stats) const;
+  // Batched carving (CarveOptions::batch_voxels): one batch per Step.
+  bool StepBatch();
   // Vis(V) into vis_ (and, with `gather`, its statistics into stats_).
   void FindVis(int64_t voxel, bool gather);
   // Carves a solid voxel whatever its consistency, updating visibility and queueing the voxels
@@ -311,8 +339,8 @@ class IncrementalCarver {
                      bool gather = true,
                      bool advance_found = false);
   // With protection: whether V lies at or behind the known surface (within
-  // kKnownSurfaceMarginVoxels) in a view of stats_ whose known depth covers V's centre.
-  bool BehindKnownSurface(int64_t voxel) const;
+  // kKnownSurfaceMarginVoxels) in a view of `stats` whose known depth covers V's centre.
+  bool BehindKnownSurface(int64_t voxel, const std::vector<ViewColourStats>& stats) const;
   // The voxel Pop will hand out next if it is known now and still solid (fifo only), else -1.
   int64_t PeekNextSolid() const;
   // With vis_ holding Vis(V) and `colour` V's colour: the change of the reprojection error of
@@ -340,8 +368,69 @@ class IncrementalCarver {
   ViewWorkers workers_;  // declared before visibility_, which uses it to set up rays
   std::unique_ptr<Visibility> visibility_;
   RayCastVisibility* ray_visibility_;  // visibility_ when it is ray casting, else nullptr
-  // Ray casting spread over workers_ (see CarveOptions::num_threads).
+  // Ray casting spread over workers_ (see CarveOptions::num_threads): in batches, or one voxel
+  // at a time by views.
+  bool batched_ = false;
+  int batch_voxels_ = 1;
   bool view_parallel_ = false;
+  // A voxel of a batch and the verdict on it.
+  struct BatchEntry {
+    int64_t voxel = 0;
+    Consistency consistency;
+    bool carve = false;
+    bool kept_protected = false;      // inconsistent, but known surface
+    double reprojection_error = 0.0;  // ColourSurface: summed |pixel - colour| over Vis
+    int num_pixels = 0;               // |Vis|
+  };
+  // Per voxel of a batch and view (index in the batch x views + view): where its pixels there
+  // lie in the view's buffers (Vis, then the voxels their rays reached), and their statistics
+  // (count 0: none).
+  struct BatchView {
+    ViewColourStats stats;
+    size_t vis_begin = 0, vis_end = 0;
+    size_t reached_begin = 0, reached_end = 0;
+  };
+  struct Batch {
+    std::vector<BatchEntry> entries;
+    std::vector<BatchView> views;
+  };
+  // Per view: the Vis pixels of the two batches in flight (the one being carved and the next),
+  // the voxels its rays reached, and the time it took in the last task.
+  struct alignas(64) ViewBuffers {
+    std::vector<PixelRef> vis[2];
+    std::vector<int64_t> reached;
+    int64_t nanoseconds = 0;
+  };
+  // Batched carving is a pipeline of two batches: batches_[current_] has its Vis found (when
+  // batch_found_) and is judged and carved next; in the same task that steps its carved voxels'
+  // rays, each view then finds the Vis of the next batch (taken from the queue after the carve,
+  // before the arrivals are queued; its voxels keep their queued bits until judged, so that
+  // arrivals do not queue them again: their Vis already holds the new pixels).
+  // Up to `batch_voxels_` solid voxels from the queue into `batch`, their queued bits left set.
+  void FormBatch(Batch* batch);
+  // One task over the views: steps the rays of `carving`'s carved voxels (when not null; Vis in
+  // slot `carving_slot`), then finds the Vis of `finding`'s voxels (when not null; into slot
+  // `finding_slot`). Views are claimed one at a time, each group first its own (view v
+  // belongs to group v mod G, so that a view's rays stay in one core's cache from batch to
+  // batch), then any left, the costliest of the last task first. Which group takes a view never
+  // changes what is computed.
+  void RunViewTask(Batch* carving, int carving_slot, Batch* finding, int finding_slot);
+  // Judges every voxel of `batch` (Vis found in `slot`), the groups claiming voxels; with
+  // `colouring`, also each one's reprojection error.
+  void JudgeEntries(Batch* batch, int slot, bool colouring);
+  // Sorts claim_order_ by the views' time in the last tasks, the costliest first.
+  void SortViewsByCost();
+  // Puts a batch found but not yet judged back at the front of the queue (before carving
+  // outside the pipeline: its Vis would go stale).
+  void ReturnPendingBatch();
+  Batch batches_[2];
+  std::vector<int> batch_carved_;  // indices into the current batch, in queue order
+  int current_ = 0;
+  bool batch_found_ = false;
+  std::vector<ViewBuffers> view_buffers_;
+  std::vector<int> claim_order_;  // views, costliest first
+  std::unique_ptr<std::atomic<uint8_t>[]> view_claimed_;
+  std::atomic<int> next_item_{0};  // the next item a group claims in a batched task
   std::vector<GroupBuffers> groups_;
   std::vector<size_t> advance_begin_;  // per view: where its pixels start in the rays to step
   int64_t prefetched_ = -1;  // the voxel whose Vis and statistics vis_ and stats_ already hold

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <chrono>
 
+#if defined(__linux__)
+#include <sched.h>
+#endif
+
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #endif
@@ -13,7 +17,7 @@ namespace {
 // Waiting for the other side: first spinning (a few microseconds: the serial work between two
 // tasks of a carve), then yielding the core (when there are more threads than cores, the thread
 // waited for may need it), then sleeping (an idle pool costs nothing).
-constexpr int kSpins = 256;
+constexpr int kSpins = 4096;
 constexpr int kYields = 64;
 // Runs per judgement of the workers, and runs on the calling thread alone before trying again.
 constexpr int kWindowRuns = 256;
@@ -44,12 +48,20 @@ inline bool KeepWaiting(int round) {
 
 int ResolveNumThreads(int num_threads) {
   if (num_threads >= 1) return num_threads;
+#if defined(__linux__)
+  // A container or `taskset` may give the process fewer cores than the machine has.
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
+#endif
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
-ViewWorkers::ViewWorkers(int num_views, int num_threads)
+ViewWorkers::ViewWorkers(int num_views, int num_threads, int max_groups)
     : num_views_(num_views),
-      num_groups_(std::max(1, std::min(ResolveNumThreads(num_threads), num_views))) {
+      num_groups_(std::max(1, std::min(ResolveNumThreads(num_threads),
+                                       max_groups > 0 ? max_groups : num_views))),
+      busy_(num_groups_) {
   for (int group = 1; group < num_groups_; ++group) {
     threads_.emplace_back([this, group] { WorkerLoop(group); });
   }
@@ -71,10 +83,27 @@ ViewWorkers::~ViewWorkers() {
   for (std::thread& thread : threads_) thread.join();
 }
 
+ViewWorkers::Times ViewWorkers::times() const {
+  Times times;
+  times.runs = runs_;
+  times.inline_runs = inline_total_;
+  times.wall_seconds = 1e-9 * static_cast<double>(wall_nanoseconds_);
+  for (const Busy& busy : busy_) times.busy_seconds.push_back(1e-9 * busy.nanoseconds);
+  return times;
+}
+
 void ViewWorkers::RunErased(void (*call)(void*, int), void* task) {
-  if (inline_runs_left_ > 0) {
-    --inline_runs_left_;
+  ++runs_;
+  if (num_groups_ == 1 || inline_runs_left_ > 0) {
+    const int64_t start = NowNanoseconds();
+    if (num_groups_ > 1) {
+      --inline_runs_left_;
+      ++inline_total_;
+    }
     for (int group = 0; group < num_groups_; ++group) call(task, group);
+    const int64_t elapsed = NowNanoseconds() - start;
+    wall_nanoseconds_ += elapsed;
+    busy_[0].nanoseconds += elapsed;
     return;
   }
   const int64_t start = NowNanoseconds();
@@ -96,7 +125,10 @@ void ViewWorkers::RunErased(void (*call)(void*, int), void* task) {
     caller_sleeping_.store(false);
     break;
   }
-  Account(own_done - start, NowNanoseconds() - own_done);
+  const int64_t end = NowNanoseconds();
+  wall_nanoseconds_ += end - start;
+  busy_[0].nanoseconds += own_done - start;
+  Account(own_done - start, end - own_done);
 }
 
 void ViewWorkers::Account(int64_t own_nanoseconds, int64_t wait_nanoseconds) {
@@ -126,7 +158,9 @@ void ViewWorkers::WorkerLoop(int group) {
     }
     seen = generation;
     if (stop_.load()) return;
+    const int64_t start = NowNanoseconds();
     call_(task_, group);
+    busy_[group].nanoseconds += NowNanoseconds() - start;
     if (pending_.fetch_sub(1) == 1 && caller_sleeping_.load()) {
       std::lock_guard<std::mutex> lock(mutex_);
       caller_wake_.notify_one();

@@ -9,14 +9,19 @@
 
 namespace raycarve {
 
-// Fork-join over the views, for ray-cast carving on several cores. The views are dealt out to
-// groups like cards (view v to group v mod G), one thread per group (the calling thread takes
-// group 0), and Run(task) calls task(group) for every group at once and returns when all have
-// finished. Dealing rather than cutting into halves matters: neighbouring views see the same
-// voxels, so with halves a voxel seen from one side would load one thread only.
+// Fork-join for carving on several cores: one thread per group (the calling thread takes group
+// 0), and Run(task) calls task(group) for every group at once and returns when all have
+// finished. Two ways of sharing the work use it:
+// - by view: the views are dealt out to groups like cards (view v to group v mod G). Dealing
+//   rather than cutting into halves matters: neighbouring views see the same voxels, so with
+//   halves a voxel seen from one side would load one thread only. (Set-up, and carving one voxel
+//   at a time: a few microseconds of work per hand-over.)
+// - by item: the groups claim items (voxels of a batch) from a shared counter, so that a slow
+//   item holds up no one else; what each item gives is kept per item, so that the result does
+//   not depend on which group took it.
 //
-// Carving hands the workers a few microseconds of work per voxel, so they spin briefly for the
-// next task before sleeping on a condition variable; an idle pool costs nothing.
+// Workers spin briefly for the next task before sleeping on a condition variable; an idle pool
+// costs nothing.
 //
 // Fork-join this fine-grained only pays while every thread has a core. When the workers fall
 // behind (more threads than cores, or other busy processes: measured, 4 threads on 2 cores
@@ -28,9 +33,9 @@ namespace raycarve {
 // its own output buffers). Run is called from one thread at a time.
 class ViewWorkers {
  public:
-  // `num_threads` < 1 means one per hardware thread. At most one group per view; with one
-  // group no thread is started and Run calls the task directly.
-  ViewWorkers(int num_views, int num_threads);
+  // `num_threads` < 1 means one per core this process may use. At most `max_groups` groups
+  // (0: one per view); with one group no thread is started and Run calls the task directly.
+  ViewWorkers(int num_views, int num_threads, int max_groups = 0);
   ~ViewWorkers();
   ViewWorkers(const ViewWorkers&) = delete;
   ViewWorkers& operator=(const ViewWorkers&) = delete;
@@ -43,12 +48,19 @@ class ViewWorkers {
 
   template <typename Task>
   void Run(Task& task) {
-    if (num_groups_ == 1) {
-      task(0);
-      return;
-    }
     RunErased([](void* erased, int group) { (*static_cast<Task*>(erased))(group); }, &task);
   }
+
+  // Where the time of the runs so far went, for projecting how the work scales: the wall time
+  // spent inside Run (from its start until the last group finished) and, per group, the time its
+  // thread spent working on tasks. A group's waiting is the wall time less its work.
+  struct Times {
+    int64_t runs = 0;
+    int64_t inline_runs = 0;  // runs done on the calling thread alone (see above)
+    double wall_seconds = 0.0;
+    std::vector<double> busy_seconds;  // per group
+  };
+  Times times() const;
 
  private:
   void RunErased(void (*call)(void*, int), void* task);
@@ -65,6 +77,14 @@ class ViewWorkers {
   int64_t window_own_ = 0;
   int64_t window_wait_ = 0;
   std::vector<std::thread> threads_;
+  int64_t runs_ = 0;
+  int64_t inline_total_ = 0;
+  int64_t wall_nanoseconds_ = 0;
+  // Per group, on a cache line of its own: written by the group's thread, read between runs.
+  struct alignas(64) Busy {
+    int64_t nanoseconds = 0;
+  };
+  std::vector<Busy> busy_;
   // The caller's and the workers' flags sit on cache lines of their own. The task being run is
   // written before generation_ is raised and read after it is seen.
   alignas(64) void (*call_)(void*, int) = nullptr;
@@ -80,7 +100,8 @@ class ViewWorkers {
   std::condition_variable caller_wake_;
 };
 
-// Threads a pool would use for `num_threads` (< 1: the hardware's).
+// Threads a pool would use for `num_threads` (< 1: the cores this process may run on, from its
+// CPU affinity where the system reports one, else the hardware's threads).
 int ResolveNumThreads(int num_threads);
 
 }  // namespace raycarve

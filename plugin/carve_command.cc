@@ -297,6 +297,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("min_component_voxels").Value(request.options.min_component_voxels)
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
       .Key("num_threads").Value(ResolveNumThreads(request.options.num_threads))
+      .Key("batch_voxels").Value(request.options.batch_voxels)
       .Key("incremental_statistics").Value(request.options.incremental_statistics)
       .Key("max_memory_gib").Value(request.options.max_memory_gib)
       .Key("max_image_size").Value(request.view_options.max_image_size)
@@ -375,6 +376,8 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("evaluated").Value(s.evaluated)
       .Key("passes").Value(s.passes)
       .Key("threads").Value(s.threads)
+      .Key("parallel_seconds").Value(s.parallel_seconds)
+      .Key("thread_work_seconds").Value(s.thread_work_seconds)
       .Key("reprojection_error_before").Value(s.reprojection_error_before)
       .Key("reprojection_error_after").Value(s.reprojection_error_after)
       .Key("final_solid").Value(s.final_solid)
@@ -557,8 +560,11 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "estimate a gain and offset per photo and channel from the sparse points' "
                      "colours (Ceres, robust) and correct the photos before carving");
   parser->AddDefault("num_threads", &request->options.num_threads,
-                     "threads for ray casting, each taking every n-th view (-1: one per core); "
-                     "the carving is identical for any count");
+                     "threads for ray casting and colouring (-1: one per core, at most one per "
+                     "photo); the carving is identical for any count");
+  parser->AddDefault("batch_voxels", &request->options.batch_voxels,
+                     "voxels judged at once (on every thread) against the rays as they stand, "
+                     "then carved together; 1: the seed paper's one voxel at a time");
   parser->AddDefault("incremental_statistics", &request->options.incremental_statistics,
                      "ray casting: keep per-voxel colour sums as rays arrive instead of gathering "
                      "Vis(V)'s pixels at every evaluation (same carving)");
@@ -750,7 +756,7 @@ int RunCarve(int argc, char** argv) {
       "  carved          %lld voxels (%lld by the visual hull of %d masked views, %lld in specks),"
       " %lld evaluations\n"
       "  levels          %zu (%s)\n"
-      "  convergence     %.2f s (+ %.2f s set-up), carving structures' peak %.1f MiB\n"
+      "  convergence     %.2f s (+ %.2f s set-up) on %d %s, carving structures' peak %.1f MiB\n"
       "  process memory  %.1f MiB at its peak (resident: photos, views, grid, mesh)\n"
       "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more\n"
       "  sparse points   %s\n"
@@ -762,8 +768,8 @@ int RunCarve(int argc, char** argv) {
       static_cast<long long>(s.num_voxels), static_cast<long long>(s.carved),
       static_cast<long long>(s.visual_hull_carved), s.views_with_masks,
       static_cast<long long>(s.component_carved), static_cast<long long>(s.evaluated),
-      s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds,
-      s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
+      s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds, s.threads,
+      s.threads == 1 ? "thread" : "threads", s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,
       sparse_line.c_str(), mask_line.c_str(), run.output_path.c_str(), run.num_cloud_points,
       run.num_mesh_triangles, run.output_path.c_str());

@@ -35,8 +35,10 @@ TEST(IncrementalCarver, KeepsItsInvariantsWhileCarving) {
   std::vector<bool> ever_empty(volume.grid().num_voxels(), false);
   std::vector<PixelRef> vis;
   int checks = 0;
-  for (int64_t step = 1; carver.Step(); ++step) {
-    if (step % 1500 != 0) continue;
+  // Checked every 1500 evaluations (a step is one batch of voxels; CarveOptions::batch_voxels).
+  for (int64_t next_check = 1500; carver.Step();) {
+    if (carver.evaluated() < next_check) continue;
+    next_check = carver.evaluated() + 1500;
     ++checks;
     for (int64_t i = 0; i < volume.grid().num_voxels(); ++i) {
       if (ever_empty[i]) {
@@ -106,6 +108,7 @@ TEST(CarveVolume, FootprintScansAndRayListsCarveIdentically) {
   const SyntheticScene scene = Scene(6, 160, 120);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
   CarveOptions options = Options(48, 30.0);
+  options.batch_voxels = 1;  // ray lists carve one voxel at a time
   const CarveResult footprint = CarveVolume(views, scene.object_box, options);
   options.vis_lookup = VisLookup::kRayLists;
   const CarveResult lists = CarveVolume(views, scene.object_box, options);
@@ -116,19 +119,41 @@ TEST(CarveVolume, FootprintScansAndRayListsCarveIdentically) {
 TEST(CarveVolume, AnyNumberOfThreadsCarvesExactlyAsOneDoes) {
   const SyntheticScene scene = Scene(6, 160, 120);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
-  for (const CarveDecision decision : {CarveDecision::kThreshold, CarveDecision::kReprojection}) {
+  struct Variant {
+    CarveDecision decision;
+    int batch_voxels;  // 1: one voxel at a time, its views shared by the threads
+    int lod_levels;
+  };
+  for (const Variant& variant : {Variant{CarveDecision::kThreshold, 64, 1},
+                                 Variant{CarveDecision::kThreshold, 7, 2},
+                                 Variant{CarveDecision::kThreshold, 1, 1},
+                                 Variant{CarveDecision::kReprojection, 64, 1}}) {
     CarveOptions options = Options(48, 30.0);
-    options.decision = decision;
+    options.decision = variant.decision;
+    options.batch_voxels = variant.batch_voxels;
+    options.lod_levels = variant.lod_levels;
     options.num_threads = 1;
+    const std::string name = CarveDecisionToString(variant.decision) + ", batches of " +
+                             std::to_string(variant.batch_voxels) + ", " +
+                             std::to_string(variant.lod_levels) + " levels, ";
     const CarveResult one = CarveVolume(views, scene.object_box, options);
-    EXPECT_GT(one.statistics.carved, 1000);
-    // 2 threads: views dealt 3 and 3; 4: dealt 2, 2, 1, 1 (more threads than this machine's
-    // cores is allowed, only slower).
-    for (const int threads : {2, 4}) {
+    EXPECT_GT(one.statistics.carved, 1000) << name;
+    EXPECT_EQ(one.statistics.threads, 1) << name;
+    // 2 threads: views dealt 3 and 3; 4: dealt 2, 2, 1, 1; 9: more threads than views, capped
+    // at one a view (more threads than this machine's cores is allowed, only slower).
+    for (const int threads : {2, 4, 9}) {
       options.num_threads = threads;
       const CarveResult many = CarveVolume(views, scene.object_box, options);
-      ExpectSameCarving(many, one, std::to_string(threads) + " threads");
-      EXPECT_EQ(many.statistics.reprojection_error_after, one.statistics.reprojection_error_after);
+      ExpectSameCarving(many, one, name + std::to_string(threads) + " threads");
+      EXPECT_EQ(many.statistics.reprojection_error_after, one.statistics.reprojection_error_after)
+          << name << threads << " threads";
+      EXPECT_EQ(many.statistics.threads, std::min<int>(threads, views.size())) << name;
+      // Every thread worked, and none worked longer than the parallel sections lasted.
+      ASSERT_EQ(many.statistics.thread_work_seconds.size(), many.statistics.threads) << name;
+      for (double work : many.statistics.thread_work_seconds) {
+        EXPECT_LE(work, many.statistics.parallel_seconds + 1e-6) << name;
+      }
+      EXPECT_GT(many.statistics.parallel_runs, 0) << name;
     }
   }
 }
@@ -148,6 +173,7 @@ TEST(CarveVolume, IncrementalStatisticsCarveExactlyAsGatheringDoes) {
                                  Variant{CarveDecision::kThreshold, CarveOrder::kVisiblePixels, 1, 1},
                                  Variant{CarveDecision::kThreshold, CarveOrder::kFifo, 2, 1}}) {
     CarveOptions options = Options(48, 30.0);
+    options.batch_voxels = 1;  // incremental statistics carve one voxel at a time
     options.decision = variant.decision;
     options.order = variant.order;
     options.lod_levels = variant.lod_levels;
@@ -181,7 +207,6 @@ double JudgedSurfaceNearTruth(const CarveResult& result) {
   }
   return judged == 0 ? 0.0 : static_cast<double>(near) / judged;
 }
-
 
 // Ray casting judged on GVC's schedule: changes are not reported, and every pass re-judges the
 // whole surface, but always with the current visibility (fresh rays) instead of stale buffers.
@@ -239,6 +264,7 @@ TEST(CarveVolume, RayCastingGvcAndGvcLdiConvergeToPhotoConsistentVolumes) {
   const SyntheticScene scene = Scene(6, 160, 120);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
   CarveOptions options = Options(40, 30.0);
+  options.batch_voxels = 1;  // as GVC-LDI's queue hands out voxels
   const CarveResult ray = CarveVolume(views, scene.object_box, options);
   options.method = CarveMethod::kGvcLdi;
   const CarveResult ldi = CarveVolume(views, scene.object_box, options);
@@ -424,6 +450,7 @@ TEST(CarveVolume, GvcCarvesMoreThanRayCastingBecauseItsBuffersAreStaleNotBecause
   const SyntheticScene scene = Scene(8, 320, 240);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
   CarveOptions options = Options(96, 30.0);
+  options.batch_voxels = 1;  // first-in first-out, one voxel at a time
   const CarveResult ray = CarveVolume(views, scene.object_box, options);
   options.method = CarveMethod::kGvc;
   const CarveResult gvc = CarveVolume(views, scene.object_box, options);
@@ -473,7 +500,14 @@ TEST(CarveVolume, OnAUniformBackdropOnlyMasksCarveTheSceneToItsTruth) {
 TEST(CarveVolume, CarvesTheGeneratedSceneToItsTrueSurface) {
   const SyntheticScene scene = Scene(8, 320, 240);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
-  const CarveResult result = CarveVolume(views, scene.object_box, Options(96, 30.0));
+  // One voxel at a time, the paper's order: at threshold 30 without known surface, carving runs
+  // away by chance, and what survives depends on the order (completeness, measured, over batches
+  // of 1, 2, 4, ..., 256 voxels: 0.918, 0.786, 0.879, 0.925, 0.794, 0.866, 0.730, 0.669, 0.575;
+  // accuracy 0.84-0.89 for all). The command line's known surface stops the runaway, and then
+  // the order hardly matters (BatchesCarveAsCloseToTheTruthAsOneVoxelAtATime).
+  CarveOptions options = Options(96, 30.0);
+  options.batch_voxels = 1;
+  const CarveResult result = CarveVolume(views, scene.object_box, options);
   const double voxel = result.volume.grid().voxel_size();
   const CarveStatistics& s = result.statistics;
   EXPECT_GT(s.carved, s.num_voxels / 2);
@@ -634,6 +668,51 @@ TEST(CarveVolume, TheDataDrivenDefaultsCarveGeneratedScenesWithRealPhotoFaultsTo
     EXPECT_GT(precision, least_precision) << name;
     EXPECT_GT(completeness, 0.95) << name;
     EXPECT_GT(precision + completeness, old_precision + old_completeness - 0.02) << name;
+  }
+}
+
+// Batches judge their voxels against the rays as they stand before any of them is carved, so
+// they do not carve exactly as one voxel at a time does (voxel colouring's result depends on the
+// order, and the first-in first-out order is one of many): where a carve runs away (threshold 30
+// without known surface) the volumes differ much, yet both are as close to the truth; with the
+// defaults' known surface they agree closely.
+// Measured (8 views of 320x240, detail texture, 96 voxels; precision / completeness, one at a
+// time, then batches of 16, 64, 256): threshold 30 0.829 / 0.937, 0.839 / 0.930, 0.837 / 0.929,
+// 0.846 / 0.924; defaults 0.918 / 0.995, 0.921 / 0.996, 0.922 / 0.995, 0.922 / 0.994.
+TEST(CarveVolume, BatchesCarveAsCloseToTheTruthAsOneVoxelAtATime) {
+  SyntheticSceneOptions scene_options = testing::SceneOptions(8, 320, 240, false, 2000);
+  scene_options.detail_texture = true;
+  const SyntheticScene scene = GenerateSyntheticScene(scene_options);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  for (const bool defaults : {false, true}) {
+    CarveOptions options = Options(96, 30.0);
+    if (defaults) {
+      options.surface_points = testing::SceneSurfacePoints(scene, 2);
+      options.auto_threshold = true;
+      options.protect_surface_points = true;
+    }
+    options.batch_voxels = 1;
+    const CarveResult single = CarveVolume(views, scene.object_box, options);
+    const auto [single_precision, single_completeness] = Quality(single, scene);
+    for (const int batch : {16, 64, 256}) {
+      options.batch_voxels = batch;
+      const CarveResult batched = CarveVolume(views, scene.object_box, options);
+      const auto [precision, completeness] = Quality(batched, scene);
+      const double iou = CompareVolumes(single.volume, batched.volume).iou();
+      std::printf("%s, batches of %d: precision %.3f, completeness %.3f (one at a time %.3f, "
+                  "%.3f); solid IoU with one at a time %.3f; evaluations %lld (%lld)\n",
+                  defaults ? "defaults" : "threshold 30", batch, precision, completeness,
+                  single_precision, single_completeness, iou,
+                  static_cast<long long>(batched.statistics.evaluated),
+                  static_cast<long long>(single.statistics.evaluated));
+      EXPECT_GT(precision, single_precision - 0.02) << batch;
+      EXPECT_GT(completeness, single_completeness - 0.02) << batch;
+      // Voxels whose pixels changed within their batch are judged again: a few more evaluations.
+      EXPECT_LT(batched.statistics.evaluated, 1.25 * single.statistics.evaluated) << batch;
+      if (defaults) {
+        EXPECT_GT(iou, 0.9) << batch;
+      }
+    }
   }
 }
 

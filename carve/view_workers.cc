@@ -57,10 +57,9 @@ int ResolveNumThreads(int num_threads) {
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
-ViewWorkers::ViewWorkers(int num_views, int num_threads, int max_groups)
+ViewWorkers::ViewWorkers(int num_views, int num_threads)
     : num_views_(num_views),
-      num_groups_(std::max(1, std::min(ResolveNumThreads(num_threads),
-                                       max_groups > 0 ? max_groups : num_views))),
+      num_groups_(std::max(1, std::min(ResolveNumThreads(num_threads), num_views))),
       busy_(num_groups_) {
   for (int group = 1; group < num_groups_; ++group) {
     threads_.emplace_back([this, group] { WorkerLoop(group); });

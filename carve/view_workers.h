@@ -16,9 +16,9 @@ namespace raycarve {
 //   rather than cutting into halves matters: neighbouring views see the same voxels, so with
 //   halves a voxel seen from one side would load one thread only. (Set-up, and carving one voxel
 //   at a time: a few microseconds of work per hand-over.)
-// - by item: the groups claim items (voxels of a batch) from a shared counter, so that a slow
-//   item holds up no one else; what each item gives is kept per item, so that the result does
-//   not depend on which group took it.
+// - by claiming: the groups claim views or voxels of a batch one at a time, so that a slow one
+//   holds up no one else; what each gives is kept per view or voxel, so that the result does not
+//   depend on which group took it (batched carving, carver.h).
 //
 // Workers spin briefly for the next task before sleeping on a condition variable; an idle pool
 // costs nothing.
@@ -33,9 +33,9 @@ namespace raycarve {
 // its own output buffers). Run is called from one thread at a time.
 class ViewWorkers {
  public:
-  // `num_threads` < 1 means one per core this process may use. At most `max_groups` groups
-  // (0: one per view); with one group no thread is started and Run calls the task directly.
-  ViewWorkers(int num_views, int num_threads, int max_groups = 0);
+  // `num_threads` < 1 means one per core this process may use. At most one group per view; with
+  // one group no thread is started and Run calls the task directly.
+  ViewWorkers(int num_views, int num_threads);
   ~ViewWorkers();
   ViewWorkers(const ViewWorkers&) = delete;
   ViewWorkers& operator=(const ViewWorkers&) = delete;

@@ -154,12 +154,14 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   refinement.depth_tolerance = grid.voxel_size();
   refinement.voxel_size = grid.voxel_size();
   refinement.min_views = std::max(2, options.min_views);
+  refinement.num_threads = options.num_threads;
   if (refinement.passes > 0) {
     model.refinement = RefineMeshFromPhotos(views, refinement, &model.mesh);
   }
   MeshColouringOptions colouring;
   colouring.min_views = options.min_views;
   colouring.depth_tolerance = grid.voxel_size();
+  colouring.num_threads = options.num_threads;
   model.colouring = ColourMeshFromPhotos(views, colouring, &model.mesh, &model.seen_by);
   return model;
 }

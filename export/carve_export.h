@@ -51,6 +51,8 @@ struct ModelMeshOptions {
   // corner. 24 is the iso-surface of a 2x2x2 block, the smallest speck the carve's default
   // --min_component_voxels 8 keeps; 0 keeps everything.
   int64_t min_component_vertices = 24;
+  // Threads for refining and colouring (0 or less: every core); the mesh does not depend on it.
+  int num_threads = 0;
   bool IsValid(std::string* reason) const;
 };
 struct ModelMesh {

@@ -95,7 +95,8 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
                                                              double depth_tolerance,
                                                              std::vector<uint8_t>* on_rim,
                                                              double voxel_size,
-                                                             double rim_voxels) {
+                                                             double rim_voxels,
+                                                             int num_threads) {
   CHECK(mesh.normals.size() == mesh.vertices.size()) << "the mesh needs vertex normals";
   const size_t n = mesh.vertices.size();
   std::vector<std::vector<VertexSighting>> sightings(n);
@@ -106,7 +107,8 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
   // Each view on its own (in parallel): the vertices it sees, and which lie on its mask's rim.
   std::vector<std::vector<std::pair<uint32_t, float>>> per_view(views.size());
   std::vector<std::vector<uint32_t>> rims(views.size());
-  ParallelRanges(views.size(), ResolveNumThreads(-1), /*min_per_thread=*/1, [&](size_t first, size_t last) {
+  ParallelRanges(views.size(), ResolveNumThreads(num_threads), /*min_per_thread=*/1,
+                 [&](size_t first, size_t last) {
     for (size_t v = first; v < last; ++v) {
       const CalibratedView& view = views[v];
       const Rendering drawn = RenderMesh(shape, view);
@@ -184,29 +186,34 @@ MeshColouringSummary ColourMeshFromPhotos(const std::vector<CalibratedView>& vie
   const size_t n = mesh->vertices.size();
   MeshColouringSummary summary;
   summary.vertices = static_cast<int64_t>(n);
-  const std::vector<std::vector<VertexSighting>> sightings =
-      FindVertexSightings(views, *mesh, options.depth_tolerance);
+  const std::vector<std::vector<VertexSighting>> sightings = FindVertexSightings(
+      views, *mesh, options.depth_tolerance, nullptr, 0.0, 1.0, options.num_threads);
   std::vector<std::vector<Sample>> samples(n);
   if (seen_by != nullptr) seen_by->assign(n, {});
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d world = mesh->vertices[i].cast<double>();
-    for (const VertexSighting& sighting : sightings[i]) {
-      Eigen::Vector3f colour;
-      if (!SamplePhoto(views[sighting.view], views[sighting.view].Project(world), &colour)) continue;
-      samples[i].push_back({colour, sighting.facing});
-      if (seen_by != nullptr) (*seen_by)[i].push_back(sighting.view);
+  // Each vertex on its own: its samples, and the robust colour of those (in parallel).
+  std::vector<Eigen::Vector3f> colours(n, Eigen::Vector3f::Zero());
+  std::vector<char> known(n, 0);
+  ParallelRanges(n, ResolveNumThreads(options.num_threads), /*min_per_thread=*/4096,
+                 [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const Eigen::Vector3d world = mesh->vertices[i].cast<double>();
+      for (const VertexSighting& sighting : sightings[i]) {
+        Eigen::Vector3f colour;
+        if (!SamplePhoto(views[sighting.view], views[sighting.view].Project(world), &colour)) continue;
+        samples[i].push_back({colour, sighting.facing});
+        if (seen_by != nullptr) (*seen_by)[i].push_back(sighting.view);
+      }
+      if (static_cast<int>(samples[i].size()) < options.min_views) continue;
+      colours[i] = RobustColour(samples[i], options.outlier_factor);
+      known[i] = 1;
     }
-  }
+  });
 
   // Colour from the photos where enough saw the vertex; the rest from coloured neighbours,
   // ring by ring.
-  std::vector<Eigen::Vector3f> colours(n, Eigen::Vector3f::Zero());
-  std::vector<char> known(n, 0);
   double views_sum = 0.0;
   for (size_t i = 0; i < n; ++i) {
-    if (static_cast<int>(samples[i].size()) < options.min_views) continue;
-    colours[i] = RobustColour(samples[i], options.outlier_factor);
-    known[i] = 1;
+    if (!known[i]) continue;
     ++summary.from_photos;
     views_sum += samples[i].size();
   }

@@ -21,6 +21,8 @@ struct MeshColouringOptions {
   // (at least kMinOutlierDistance RGB units) are left out: a highlight, an occluder the model
   // does not hold, a photo whose pose is off.
   double outlier_factor = 2.5;
+  // Threads (0 or less: every core); the colours do not depend on it.
+  int num_threads = 0;
 
   bool IsValid(std::string* reason) const;
 };
@@ -47,13 +49,15 @@ struct VertexSighting {
 // `on_rim`, when given, gets per vertex whether it lies on a silhouette's rim: in some view with
 // a mask it is not hidden (at most depth_tolerance behind the mesh's depth, facing or not) and
 // projects onto an object pixel within `rim_voxels` voxel widths (`voxel_size`, projected at
-// its depth) of the background.
+// its depth) of the background. The views are drawn on `num_threads` threads (0 or less: every
+// core).
 std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<CalibratedView>& views,
                                                              const TriangleMesh& mesh,
                                                              double depth_tolerance,
                                                              std::vector<uint8_t>* on_rim = nullptr,
                                                              double voxel_size = 0.0,
-                                                             double rim_voxels = 1.0);
+                                                             double rim_voxels = 1.0,
+                                                             int num_threads = 0);
 
 // The colour of `view`'s photo at a COLMAP pixel position, bilinear between pixel centres; false
 // where the position is outside the photo's data (invalid pixels) or, with a mask, off the object.

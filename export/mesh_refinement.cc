@@ -81,7 +81,8 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
   for (int pass = 0; pass < options.passes; ++pass) {
     std::vector<uint8_t> on_rim;
     const std::vector<std::vector<VertexSighting>> sightings = FindVertexSightings(
-        views, *mesh, options.depth_tolerance, &on_rim, options.voxel_size, 1.0);
+        views, *mesh, options.depth_tolerance, &on_rim, options.voxel_size, 1.0,
+        options.num_threads);
     std::vector<float> offsets(n, 0.0f);
     std::vector<uint8_t> judged(n, 0), moved(n, 0);
     const int threads = options.num_threads > 0 ? options.num_threads : ResolveNumThreads(-1);

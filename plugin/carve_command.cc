@@ -658,6 +658,9 @@ void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
                      std::to_string(request->mesh_max_faces));
   }
   request->mesh.max_triangles = static_cast<int64_t>(request->mesh_max_faces);
+  // --num_threads holds for every stage: loading the photos, carving, meshing, colouring.
+  request->mesh.num_threads = request->options.num_threads;
+  request->view_options.num_threads = request->options.num_threads;
   request->mesh.min_views = request->options.min_views;
   // The mesh drops what is smaller than the iso-surface of the smallest speck the carve keeps
   // (a cube of min_component_voxels voxels: 6 faces of n^(2/3) vertices).

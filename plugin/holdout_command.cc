@@ -177,6 +177,9 @@ int RunHoldout(int argc, char** argv) {
       .Value(model.geometry.seconds + model.refinement.seconds + model.colouring.seconds)
       .Key("model").Value(other_path.empty() ? std::string("carved") : other_path)
       .Key("carve").Value(result ? result->statistics.Summary() : std::string())
+      .Key("evaluated").Value(result ? result->statistics.evaluated : int64_t{0})
+      .Key("threads").Value(result ? result->statistics.threads : 0)
+      .Key("convergence_seconds").Value(result ? result->statistics.carve_seconds : 0.0)
       .Key("thresholds").Value(thresholds)
       .Key("surface_points").Value(static_cast<uint64_t>(options.surface_points.size()));
   json.Key("views").BeginArray();

@@ -71,5 +71,25 @@ TEST(ViewWorkers, WorkersThatFellAsleepWakeForTheNextRun) {
   EXPECT_EQ(calls, std::vector<int>(2, 5));
 }
 
+TEST(ViewWorkers, TheTimesSayHowLongEachGroupWorkedAndHowLongTheRunsTook) {
+  ViewWorkers workers(4, 2);
+  ASSERT_EQ(workers.num_groups(), 2);
+  for (int run = 0; run < 3; ++run) {
+    // Group 1 works 10 ms a run, group 0 nothing: the caller (group 0) waits for it.
+    auto task = [](int group) {
+      if (group == 1) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    };
+    workers.Run(task);
+  }
+  const ViewWorkers::Times times = workers.times();
+  EXPECT_EQ(times.runs, 3);
+  ASSERT_EQ(times.busy_seconds.size(), 2u);
+  EXPECT_GE(times.busy_seconds[1], 0.030);
+  EXPECT_LT(times.busy_seconds[0], 0.015);
+  // The runs lasted as long as the slower group worked, at least.
+  EXPECT_GE(times.wall_seconds, times.busy_seconds[1]);
+  EXPECT_LE(times.busy_seconds[1], times.wall_seconds);
+}
+
 }  // namespace
 }  // namespace raycarve

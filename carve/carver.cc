@@ -702,14 +702,13 @@ void IncrementalCarver::FormBatch(Batch* batch) {
     }
     batch->entries.emplace_back();
     batch->entries.back().voxel = voxel;
+    batch->entries.back().coordinates = volume_.grid().Voxel(voxel);
   }
   batch->views.resize(batch->entries.size() * views_.size());
 }
 
 void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* finding,
                                     int finding_slot) {
-  const int num_views = static_cast<int>(views_.size());
-  const VoxelGrid& grid = volume_.grid();
   auto work = [&](int view) {
     const Clock::time_point start = Clock::now();
     ViewBuffers& buffers = view_buffers_[view];
@@ -717,7 +716,7 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       const std::vector<PixelRef>& vis = buffers.vis[carving_slot];
       buffers.reached.clear();
       for (int k : batch_carved_) {
-        BatchView& at = carving->views[static_cast<size_t>(k) * num_views + view];
+        BatchView& at = carving->views[static_cast<size_t>(view) * carving->entries.size() + k];
         at.reached_begin = buffers.reached.size();
         ray_visibility_->AdvanceRays(vis.data() + at.vis_begin, vis.data() + at.vis_end,
                                      &buffers.reached);
@@ -729,11 +728,15 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
     if (finding != nullptr) {
       std::vector<PixelRef>& vis = buffers.vis[finding_slot];
       vis.clear();
-      for (size_t k = 0; k < finding->entries.size(); ++k) {
-        BatchView& at = finding->views[k * num_views + view];
+      const size_t num_entries = finding->entries.size();
+      BatchView* views = finding->views.data() + static_cast<size_t>(view) * num_entries;
+      for (size_t k = 0; k < num_entries; ++k) {
+        BatchView& at = views[k];
         at.vis_begin = vis.size();
-        ray_visibility_->ComputeVisInView(grid.Voxel(finding->entries[k].voxel), view, &vis);
+        ray_visibility_->ComputeVisInView(finding->entries[k].coordinates, view, &vis);
         at.vis_end = vis.size();
+        at.stats.count = 0;  // most views see none of a voxel: the rest stays as it was
+        if (at.vis_end == at.vis_begin) continue;
         at.stats = ViewColourStats();
         at.stats.view = view;
         for (size_t p = at.vis_begin; p < at.vis_end; ++p) at.stats.Add(PixelColour(vis[p]));
@@ -760,7 +763,7 @@ void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
     BatchEntry& entry = batch->entries[k];
     entry.num_pixels = 0;
     for (int view = 0; view < num_views; ++view) {
-      const BatchView& at = batch->views[static_cast<size_t>(k) * num_views + view];
+      const BatchView& at = batch->views[static_cast<size_t>(view) * batch->entries.size() + k];
       if (at.stats.count == 0) continue;
       stats.push_back(at.stats);
       entry.num_pixels += at.stats.count;
@@ -776,7 +779,7 @@ void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
       // The pixels' distance to the voxel's colour, summed view by view in pixel order.
       double error = 0.0;
       for (int view = 0; view < num_views; ++view) {
-        const BatchView& at = batch->views[static_cast<size_t>(k) * num_views + view];
+        const BatchView& at = batch->views[static_cast<size_t>(view) * batch->entries.size() + k];
         const std::vector<PixelRef>& vis = view_buffers_[view].vis[slot];
         for (size_t p = at.vis_begin; p < at.vis_end; ++p) {
           error += (PixelColour(vis[p]) - entry.consistency.colour).norm();
@@ -834,7 +837,7 @@ bool IncrementalCarver::StepBatch() {
   const int num_views = static_cast<int>(views_.size());
   for (int k : batch_carved_) {
     for (int view = 0; view < num_views; ++view) {
-      const BatchView& at = current.views[static_cast<size_t>(k) * num_views + view];
+      const BatchView& at = current.views[static_cast<size_t>(view) * current.entries.size() + k];
       const std::vector<int64_t>& reached = view_buffers_[view].reached;
       for (size_t p = at.reached_begin; p < at.reached_end; ++p) Enqueue(reached[p]);
     }
@@ -965,6 +968,7 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
       for (size_t i = first; i < std::min(voxels.size(), first + kChunk); ++i) {
         chunk.entries.emplace_back();
         chunk.entries.back().voxel = voxels[i];
+        chunk.entries.back().coordinates = volume_.grid().Voxel(voxels[i]);
       }
       chunk.views.resize(chunk.entries.size() * views_.size());
       RunViewTask(nullptr, 0, &chunk, current_);

@@ -376,13 +376,14 @@ class IncrementalCarver {
   // A voxel of a batch and the verdict on it.
   struct BatchEntry {
     int64_t voxel = 0;
+    Eigen::Vector3i coordinates = Eigen::Vector3i::Zero();
     Consistency consistency;
     bool carve = false;
     bool kept_protected = false;      // inconsistent, but known surface
     double reprojection_error = 0.0;  // ColourSurface: summed |pixel - colour| over Vis
     int num_pixels = 0;               // |Vis|
   };
-  // Per voxel of a batch and view (index in the batch x views + view): where its pixels there
+  // Per view and voxel of a batch (view x batch size + index in the batch): where its pixels there
   // lie in the view's buffers (Vis, then the voxels their rays reached), and their statistics
   // (count 0: none).
   struct BatchView {

@@ -17,7 +17,7 @@ namespace {
 // Waiting for the other side: first spinning (a few microseconds: the serial work between two
 // tasks of a carve), then yielding the core (when there are more threads than cores, the thread
 // waited for may need it), then sleeping (an idle pool costs nothing).
-constexpr int kSpins = 4096;
+constexpr int kSpins = 256;
 constexpr int kYields = 64;
 // Runs per judgement of the workers, and runs on the calling thread alone before trying again.
 constexpr int kWindowRuns = 256;

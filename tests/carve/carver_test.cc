@@ -67,6 +67,48 @@ TEST(IncrementalCarver, KeepsItsInvariantsWhileCarving) {
   EXPECT_EQ(carver.queue_size(), 0u);
 }
 
+// Carving outside the batches' pipeline (the removal of small components) while a batch is in
+// flight: the batch goes back to the queue first, so that no stale Vis is judged.
+TEST(IncrementalCarver, ABatchInFlightGoesBackToTheQueueWhenCarvingHappensOutsideThePipeline) {
+  const SyntheticScene scene = Scene(6, 120, 90);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  CarveOptions options = Options(24, 30.0);
+  options.num_threads = 2;
+  IncrementalCarver untouched(views, scene.object_box, options);
+  IncrementalCarver kept(views, scene.object_box, options);
+  IncrementalCarver emptied(views, scene.object_box, options);
+  for (int step = 0; step < 20; ++step) {
+    ASSERT_TRUE(kept.Step());
+    ASSERT_TRUE(emptied.Step());
+  }
+  const size_t queued = kept.queue_size();
+  ASSERT_GT(queued, 0u);
+  // Nothing smaller than 1 voxel: nothing carved, the batch stays in flight, the carving goes on
+  // exactly as without the call.
+  EXPECT_EQ(kept.RemoveSmallComponents(1), 0);
+  EXPECT_EQ(kept.queue_size(), queued);
+  while (kept.Step()) {
+  }
+  while (untouched.Step()) {
+  }
+  EXPECT_EQ(CompareVolumes(kept.volume(), untouched.volume()).differing(), 0);
+  EXPECT_EQ(kept.evaluated(), untouched.evaluated());
+  // Every piece is small: all carved, each voxel's rays stepped on, the batch back in the queue
+  // and skipped there (its voxels are gone).
+  const int64_t solid = emptied.volume().num_solid();
+  ASSERT_GT(solid, 0);
+  EXPECT_EQ(emptied.RemoveSmallComponents(int64_t{1} << 40), solid);
+  EXPECT_EQ(emptied.volume().num_solid(), 0);
+  while (emptied.Step()) {
+  }
+  EXPECT_EQ(emptied.queue_size(), 0u);
+  for (size_t v = 0; v < views.size(); ++v) {
+    for (int pixel = 0; pixel < views[v].width * views[v].height; ++pixel) {
+      ASSERT_EQ(emptied.ray_visibility()->rays(v).CurrentVoxel(pixel), RayImage::kNoVoxel);
+    }
+  }
+}
+
 TEST(CarveVolume, AThresholdSoLooseThatEverythingIsConsistentCarvesNothing) {
   const SyntheticScene scene = Scene(4, 80, 60);
   const CarveResult result =

@@ -122,12 +122,12 @@ bool Batched(const CarveOptions& options) {
 }
 
 // Calls body(item, group) for items [0, count) on `workers`, each group claiming `chunk`
-// consecutive items at a time from `next`. Consecutive items of a batch are neighbouring voxels,
+// consecutive items at a time. Consecutive items of a batch are neighbouring voxels,
 // whose rays are neighbouring pixels: claimed together, one thread's writes stay off the cache
 // lines the other threads write.
 template <typename Body>
-void ClaimItems(ViewWorkers& workers, std::atomic<int>& next, int count, int chunk, Body body) {
-  next.store(0, std::memory_order_relaxed);
+void ClaimItems(ViewWorkers& workers, int count, int chunk, Body body) {
+  std::atomic<int> next{0};
   auto task = [&](int group) {
     for (int first; (first = next.fetch_add(chunk, std::memory_order_relaxed)) < count;) {
       const int last = std::min(count, first + chunk);
@@ -700,9 +700,7 @@ void IncrementalCarver::FormBatch(Batch* batch) {
       queued_[voxel >> 6] &= ~(uint64_t{1} << (voxel & 63));
       continue;
     }
-    batch->entries.emplace_back();
-    batch->entries.back().voxel = voxel;
-    batch->entries.back().coordinates = volume_.grid().Voxel(voxel);
+    batch->Add(voxel, volume_.grid());
   }
   batch->views.resize(batch->entries.size() * views_.size());
 }
@@ -716,7 +714,7 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       const std::vector<PixelRef>& vis = buffers.vis[carving_slot];
       buffers.reached.clear();
       for (int k : batch_carved_) {
-        BatchView& at = carving->views[static_cast<size_t>(view) * carving->entries.size() + k];
+        BatchView& at = carving->At(view, k);
         at.reached_begin = buffers.reached.size();
         ray_visibility_->AdvanceRays(vis.data() + at.vis_begin, vis.data() + at.vis_end,
                                      &buffers.reached);
@@ -763,7 +761,7 @@ void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
     BatchEntry& entry = batch->entries[k];
     entry.num_pixels = 0;
     for (int view = 0; view < num_views; ++view) {
-      const BatchView& at = batch->views[static_cast<size_t>(view) * batch->entries.size() + k];
+      const BatchView& at = batch->At(view, k);
       if (at.stats.count == 0) continue;
       stats.push_back(at.stats);
       entry.num_pixels += at.stats.count;
@@ -779,7 +777,7 @@ void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
       // The pixels' distance to the voxel's colour, summed view by view in pixel order.
       double error = 0.0;
       for (int view = 0; view < num_views; ++view) {
-        const BatchView& at = batch->views[static_cast<size_t>(view) * batch->entries.size() + k];
+        const BatchView& at = batch->At(view, k);
         const std::vector<PixelRef>& vis = view_buffers_[view].vis[slot];
         for (size_t p = at.vis_begin; p < at.vis_end; ++p) {
           error += (PixelColour(vis[p]) - entry.consistency.colour).norm();
@@ -788,7 +786,7 @@ void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
       entry.reprojection_error = error;
     }
   };
-  ClaimItems(workers_, next_item_, static_cast<int>(batch->entries.size()), kClaimChunk, judge);
+  ClaimItems(workers_, static_cast<int>(batch->entries.size()), kClaimChunk, judge);
 }
 
 void IncrementalCarver::ReturnPendingBatch() {
@@ -837,7 +835,7 @@ bool IncrementalCarver::StepBatch() {
   const int num_views = static_cast<int>(views_.size());
   for (int k : batch_carved_) {
     for (int view = 0; view < num_views; ++view) {
-      const BatchView& at = current.views[static_cast<size_t>(view) * current.entries.size() + k];
+      const BatchView& at = current.At(view, k);
       const std::vector<int64_t>& reached = view_buffers_[view].reached;
       for (size_t p = at.reached_begin; p < at.reached_end; ++p) Enqueue(reached[p]);
     }
@@ -957,6 +955,14 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
   std::vector<ColouredVoxel> surface;
   double error = 0.0;
   int64_t explained = 0;
+  auto add = [&surface](int64_t voxel, const Consistency& consistency) {
+    ColouredVoxel coloured;
+    coloured.index = voxel;
+    coloured.colour = consistency.colour.cast<float>();
+    coloured.num_views = consistency.num_views;
+    coloured.num_pixels = consistency.num_pixels;
+    surface.push_back(coloured);
+  };
   if (batched_) {
     // Judged on every thread, a chunk of the surface at a time; summed in surface order.
     ReturnPendingBatch();
@@ -966,39 +972,25 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
     for (size_t first = 0; first < voxels.size(); first += kChunk) {
       chunk.entries.clear();
       for (size_t i = first; i < std::min(voxels.size(), first + kChunk); ++i) {
-        chunk.entries.emplace_back();
-        chunk.entries.back().voxel = voxels[i];
-        chunk.entries.back().coordinates = volume_.grid().Voxel(voxels[i]);
+        chunk.Add(voxels[i], volume_.grid());
       }
       chunk.views.resize(chunk.entries.size() * views_.size());
       RunViewTask(nullptr, 0, &chunk, current_);
       JudgeEntries(&chunk, current_, /*colouring=*/true);
       for (const BatchEntry& entry : chunk.entries) {
-        ColouredVoxel coloured;
-        coloured.index = entry.voxel;
-        coloured.colour = entry.consistency.colour.cast<float>();
-        coloured.num_views = entry.consistency.num_views;
-        coloured.num_pixels = entry.consistency.num_pixels;
-        surface.push_back(coloured);
+        add(entry.voxel, entry.consistency);
         error += entry.reprojection_error;
         explained += entry.num_pixels;
       }
     }
     chunk.entries.clear();
-    error += threshold_ * static_cast<double>(std::max<int64_t>(0, usable_pixels_ - explained));
-    surface_reprojection_error_ = usable_pixels_ == 0 ? 0.0 : error / usable_pixels_;
-    return surface;
-  }
-  for (int64_t voxel : volume_.SurfaceVoxels()) {
-    const Consistency consistency = Evaluate(voxel);
-    ColouredVoxel coloured;
-    coloured.index = voxel;
-    coloured.colour = consistency.colour.cast<float>();
-    coloured.num_views = consistency.num_views;
-    coloured.num_pixels = consistency.num_pixels;
-    surface.push_back(coloured);
-    for (const PixelRef& ref : vis_) error += (PixelColour(ref) - consistency.colour).norm();
-    explained += static_cast<int64_t>(vis_.size());
+  } else {
+    for (int64_t voxel : volume_.SurfaceVoxels()) {
+      const Consistency consistency = Evaluate(voxel);
+      add(voxel, consistency);
+      for (const PixelRef& ref : vis_) error += (PixelColour(ref) - consistency.colour).norm();
+      explained += static_cast<int64_t>(vis_.size());
+    }
   }
   error += threshold_ * static_cast<double>(std::max<int64_t>(0, usable_pixels_ - explained));
   surface_reprojection_error_ = usable_pixels_ == 0 ? 0.0 : error / usable_pixels_;

@@ -394,6 +394,12 @@ class IncrementalCarver {
   struct Batch {
     std::vector<BatchEntry> entries;
     std::vector<BatchView> views;
+    void Add(int64_t voxel, const VoxelGrid& grid) {
+      entries.emplace_back();
+      entries.back().voxel = voxel;
+      entries.back().coordinates = grid.Voxel(voxel);
+    }
+    BatchView& At(int view, size_t k) { return views[static_cast<size_t>(view) * entries.size() + k]; }
   };
   // Per view: the Vis pixels of the two batches in flight (the one being carved and the next),
   // the voxels its rays reached, and the time it took in the last task.
@@ -431,7 +437,6 @@ class IncrementalCarver {
   std::vector<ViewBuffers> view_buffers_;
   std::vector<int> claim_order_;  // views, costliest first
   std::unique_ptr<std::atomic<uint8_t>[]> view_claimed_;
-  std::atomic<int> next_item_{0};  // the next item a group claims in a batched task
   std::vector<GroupBuffers> groups_;
   std::vector<size_t> advance_begin_;  // per view: where its pixels start in the rays to step
   int64_t prefetched_ = -1;  // the voxel whose Vis and statistics vis_ and stats_ already hold

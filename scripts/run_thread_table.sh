@@ -18,19 +18,9 @@ data=${RAYCARVE_DATA_DIR:-../shared/data}
 scripts/setup.sh raycarve >&2
 out=out/thread_table
 mkdir -p "$out"
-json_number() { grep -o "\"$2\": [-0-9.e+]*" "$1" | head -1 | sed 's/.*: //'; }
-if [ ! -d "$out/paper/sparse" ]; then
-  build/plugin/raycarve synth --output_path "$out/paper" --scene paper --views 14 --width 800 \
-    --height 600 > "$out/paper.synth.log" 2>&1
-fi
-projects=()
-for set in templeSparseRing dinoSparseRing dinoRing; do
-  [ -d "$data/middlebury/$set" ] || { echo "skipping $set: not in $data" >&2; continue; }
-  for model in given sfm; do
-    projects+=("$set $model --input_path $data/middlebury/$set/colmap/$model --image_path $data/middlebury/$set")
-  done
-done
-projects+=("paper generated --workspace_path $out/paper")
+# shellcheck source=scripts/holdout_projects.sh
+source scripts/holdout_projects.sh
+holdout_projects
 configs=("defaults (batches of 64)|" "one voxel at a time|--batch_voxels 1")
 rows=()
 echo "| set | model | voxels | options | held-out PSNR | silhouette IoU | evaluations | threads | convergence s |"
@@ -81,12 +71,6 @@ for file in default one; do
   printf "| %s | %.2f | %.2f | %.2f |\n" "$label" "$wall" "$cpu" "$convergence"
   rows+=("{\"set\": \"demo\", \"options\": \"$label\", \"wall_seconds\": $wall, \"cpu_seconds\": $cpu, \"convergence_seconds\": $convergence}")
 done
-{
-  echo "["
-  for i in "${!rows[@]}"; do
-    echo "  ${rows[$i]}$([ "$i" -lt $((${#rows[@]} - 1)) ] && echo ,)"
-  done
-  echo "]"
-} > "$out/table.json"
+write_rows "$out/table.json"
 echo
 echo "holdout --every 4 at the defaults; demo runs alternate; JSON in $out/table.json"

@@ -13,18 +13,9 @@ data=${RAYCARVE_DATA_DIR:-../shared/data}
 scripts/setup.sh raycarve >&2
 out=out/threshold_table
 mkdir -p "$out"
-json_number() { grep -o "\"$2\": [-0-9.e+]*" "$1" | head -1 | sed 's/.*: //'; }
-if [ ! -d "$out/paper/sparse" ]; then
-  build/plugin/raycarve synth --output_path "$out/paper" --scene paper --views 14 --width 800 \
-    --height 600 > "$out/paper.synth.log" 2>&1
-fi
-projects=()
-for set in templeSparseRing dinoSparseRing dinoRing; do
-  for model in given sfm; do
-    projects+=("$set $model --input_path $data/middlebury/$set/colmap/$model --image_path $data/middlebury/$set")
-  done
-done
-projects+=("paper generated --workspace_path $out/paper")
+# shellcheck source=scripts/holdout_projects.sh
+source scripts/holdout_projects.sh
+holdout_projects
 configs=("defaults|" "threshold 30|--threshold 30" "threshold 60|--threshold 60" "silhouettes only|--threshold 1000000 --consistency mean_colour")
 echo "| set | model | voxels | options | held-out PSNR | silhouette IoU | thresholds (coarse to fine) | carve s |"
 echo "|---|---|---:|---|---:|---:|---|---:|"
@@ -49,12 +40,6 @@ for resolution in $resolutions; do
     done
   done
 done
-{
-  echo "["
-  for i in "${!rows[@]}"; do
-    echo "  ${rows[$i]}$([ "$i" -lt $((${#rows[@]} - 1)) ] && echo ,)"
-  done
-  echo "]"
-} > "$out/table.json"
+write_rows "$out/table.json"
 echo
 echo "holdout --every 4; the seconds are the whole holdout command (load, carve, render); JSON in $out/table.json"

@@ -12,6 +12,7 @@
 #        data: $RAYCARVE_DATA_DIR or ../shared/data)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+[ -x /usr/bin/time ] || { echo "run_thread_table.sh needs /usr/bin/time (apt-get install time)" >&2; exit 1; }
 resolutions=${1:-128 256}
 pairs=${2:-5}
 data=${RAYCARVE_DATA_DIR:-../shared/data}

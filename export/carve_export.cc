@@ -129,6 +129,25 @@ bool ModelMeshOptions::IsValid(std::string* reason) const {
   return true;
 }
 
+std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid& grid) {
+  // Smoothing rounds the wall's edges and refinement moves vertices up to a voxel along their
+  // normals: 1.5 voxels holds the wall, not the surface a voxel and more inside it.
+  const double reach = 1.5 * grid.voxel_size();
+  const double min_cosine = 0.5;
+  const Eigen::AlignedBox3d box = grid.Box();
+  std::vector<uint8_t> on_wall(mesh.vertices.size(), 0);
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
+    const Eigen::Vector3d n = mesh.normals[i].cast<double>();
+    for (int axis = 0; axis < 3 && on_wall[i] == 0; ++axis) {
+      const bool near_min = p[axis] - box.min()[axis] <= reach && -n[axis] >= min_cosine;
+      const bool near_max = box.max()[axis] - p[axis] <= reach && n[axis] >= min_cosine;
+      on_wall[i] = near_min || near_max;
+    }
+  }
+  return on_wall;
+}
+
 ModelMesh MeshCarvedModel(const CarveResult& result,
                           const std::vector<CalibratedView>& views,
                           const ModelMeshOptions& options) {
@@ -163,6 +182,9 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   colouring.depth_tolerance = grid.voxel_size();
   colouring.num_threads = options.num_threads;
   model.colouring = ColourMeshFromPhotos(views, colouring, &model.mesh, &model.seen_by);
+  model.on_grid_wall = GridWallVertices(model.mesh, grid);
+  model.grid_wall_vertices =
+      std::count(model.on_grid_wall.begin(), model.on_grid_wall.end(), uint8_t{1});
   return model;
 }
 
@@ -198,6 +220,7 @@ std::vector<ColouredPoint> SampleMeshPoints(const ModelMesh& model,
       const int nearest = w[0] >= w[1] && w[0] >= w[2] ? 0 : (w[1] >= w[2] ? 1 : 2);
       const std::vector<uint32_t>& seen = model.seen_by[t[nearest]];
       if (static_cast<int>(seen.size()) < min_views) continue;
+      if (!model.on_grid_wall.empty() && model.on_grid_wall[t[nearest]] != 0) continue;
       Eigen::Vector3d position = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero(),
                       colour = Eigen::Vector3d::Zero();
       for (int j = 0; j < 3; ++j) {

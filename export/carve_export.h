@@ -62,9 +62,20 @@ struct ModelMesh {
   MeshRefinementSummary refinement;
   MeshColouringSummary colouring;
   std::vector<std::vector<uint32_t>> seen_by;  // per vertex, the views (indices) that see it
+  // Per vertex, 1 where it lies on the grid's wall: the part of the surface that separates solid
+  // voxels from the space outside the grid (which the mesh treats as empty so that it closes).
+  // That is where the volume's box cuts the scene (a table or ground running on beyond it), not
+  // a surface: the photos see the scene beyond the box through it. Within 1.5 voxels of one of
+  // the box's faces, with the normal at most 60 degrees from that face's outward direction.
+  std::vector<uint8_t> on_grid_wall;
+  int64_t grid_wall_vertices = 0;
 };
+// Per vertex of `mesh` (with normals), 1 where it lies on the wall of `grid` (see
+// ModelMesh::on_grid_wall).
+std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid& grid);
+
 // Meshes the result's solid voxels (MeshSolidVoxels) and colours the mesh from `views`
-// (ColourMeshFromPhotos, depth tolerance one voxel).
+// (ColourMeshFromPhotos, depth tolerance one voxel); marks the vertices on the grid's wall.
 ModelMesh MeshCarvedModel(const CarveResult& result,
                           const std::vector<CalibratedView>& views,
                           const ModelMeshOptions& options);
@@ -73,8 +84,9 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
 // surface (a photo pixel's footprint gives the density of COLMAP's own fused clouds, which its
 // meshers' defaults expect), at fixed pseudo-random places (`seed`) in each triangle, with the
 // blend of the triangle's vertex colours and normals (unit, outward). A point is kept where its
-// nearest corner is seen by `min_views` or more photos; `visibility` gets, per point, the indices
-// of the views that see that corner (ModelMesh::seen_by).
+// nearest corner is seen by `min_views` or more photos and does not lie on the grid's wall
+// (ModelMesh::on_grid_wall); `visibility` gets, per point, the indices of the views that see that
+// corner (ModelMesh::seen_by).
 std::vector<ColouredPoint> SampleMeshPoints(const ModelMesh& model,
                                             double spacing,
                                             int min_views,

@@ -194,6 +194,7 @@ CarveRun CarveProject(const CarveRequest& request) {
     run.mesh_colouring = model.colouring;
     run.mesh_refinement = model.refinement;
     run.mesh_small_components_removed = model.small_components_removed;
+    run.mesh_grid_wall_vertices = model.grid_wall_vertices;
     // The cloud: the mesh's vertices that two or more photos see, and which ones, in COLMAP's
     // visibility format (image indices: positions among the model's images in id order).
     std::vector<std::vector<uint32_t>> visibility;
@@ -285,6 +286,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("protect_surface_points").Value(request.options.protect_surface_points)
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
       .Key("min_views").Value(request.options.min_views)
+      .Key("min_coverage").Value(request.options.min_coverage)
       .Key("order").Value(CarveOrderToString(request.options.order))
       .Key("decision").Value(CarveDecisionToString(request.options.decision))
       .Key("lod_levels").Value(request.options.lod_levels == kAutomaticLevels
@@ -457,6 +459,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
         .Key("closed_manifold").Value(t.IsClosedManifold())
         .Key("components").Value(static_cast<int64_t>(t.components))
         .Key("small_components_removed").Value(run.mesh_small_components_removed)
+        .Key("grid_wall_vertices").Value(run.mesh_grid_wall_vertices)
         .Key("boundary_edges").Value(static_cast<int64_t>(t.boundary_edges))
         .Key("non_manifold_edges").Value(static_cast<int64_t>(t.non_manifold_edges))
         .Key("non_manifold_vertices").Value(static_cast<int64_t>(t.non_manifold_vertices))
@@ -804,6 +807,11 @@ int RunCarve(int argc, char** argv) {
                 run.mesh_topology.IsClosedManifold() ? "closed and 2-manifold"
                                                      : "NOT closed 2-manifold (see report.json)",
                 100.0 * c.SeenShare(), request.mesh.min_views, c.mean_views);
+    if (run.mesh_grid_wall_vertices > 0) {
+      std::printf("                  %lld vertices on the volume box's walls, where the box cuts the "
+                  "scene: in the mesh, left out of the cloud\n",
+                  static_cast<long long>(run.mesh_grid_wall_vertices));
+    }
   }
   return 0;
 }

@@ -192,6 +192,7 @@ struct CarveRun {
   exporter::MeshColouringSummary mesh_colouring;  // the smooth mesh's (vertices 0 otherwise)
   exporter::MeshRefinementSummary mesh_refinement;
   int64_t mesh_small_components_removed = 0;
+  int64_t mesh_grid_wall_vertices = 0;  // on the grid's wall: left out of the cloud
   // The model's sparse points inside the grid against the cloud (accuracy: their 90% distance).
   bool has_sparse = false;
   exporter::CloudComparison sparse;

@@ -204,6 +204,66 @@ TEST(CarveExport, TheSmoothMeshIsClosedAndNearerTheTruthAndItsPhotoColoursBeatVo
   EXPECT_LT(mesh_error, 0.9 * voxel_error);
 }
 
+TEST(CarveExport, TheGridsWallsAreMarkedAndLeftOutOfTheCloud) {
+  // A slab filling the grid's lower third, as a ground running on beyond the volume's box: its
+  // top is surface, its sides and bottom are where the box cuts it. A cube floats above it.
+  const VoxelGrid grid(Eigen::AlignedBox3d(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()), 24);
+  std::vector<uint64_t> solid((grid.num_voxels() + 63) / 64, 0);
+  auto set = [&solid, &grid](int i, int j, int k) {
+    const int64_t index = grid.Index(Eigen::Vector3i(i, j, k));
+    solid[index >> 6] |= uint64_t{1} << (index & 63);
+  };
+  for (int k = 0; k < 8; ++k) {
+    for (int j = 0; j < 24; ++j) {
+      for (int i = 0; i < 24; ++i) set(i, j, k);
+    }
+  }
+  for (int k = 12; k < 18; ++k) {
+    for (int j = 9; j < 15; ++j) {
+      for (int i = 9; i < 15; ++i) set(i, j, k);
+    }
+  }
+  ModelMesh model;
+  model.mesh = MeshSolidVoxels(Volume(grid, solid), SurfaceMeshOptions(), &model.geometry);
+  ASSERT_FALSE(model.mesh.empty());
+  model.on_grid_wall = GridWallVertices(model.mesh, grid);
+  ASSERT_EQ(model.on_grid_wall.size(), model.mesh.vertices.size());
+  const double voxel = grid.voxel_size();
+  int walls = 0, tops = 0, cube = 0;
+  for (size_t i = 0; i < model.mesh.vertices.size(); ++i) {
+    const Eigen::Vector3f& p = model.mesh.vertices[i];
+    const Eigen::Vector3f& n = model.mesh.normals[i];
+    const bool inside_walls = (p.array() > 2.0 * voxel).all() && (p.array() < 1.0 - 2.0 * voxel).all();
+    if (p.z() > 0.25 && p.z() < 0.4 && inside_walls) {
+      ++tops;  // the slab's top, away from the walls
+      EXPECT_EQ(model.on_grid_wall[i], 0) << p.transpose() << " normal " << n.transpose();
+    } else if (p.z() > 0.45) {
+      ++cube;  // the floating cube
+      EXPECT_EQ(model.on_grid_wall[i], 0) << p.transpose();
+    } else if (p.z() < 0.25 * voxel || p.x() < 0.25 * voxel || p.x() > 1.0 - 0.25 * voxel) {
+      ++walls;  // on the slab's bottom or on a side wall
+      EXPECT_EQ(model.on_grid_wall[i], 1) << p.transpose() << " normal " << n.transpose();
+    }
+  }
+  EXPECT_GT(tops, 100);
+  EXPECT_GT(cube, 50);
+  EXPECT_GT(walls, 100);
+
+  // Every vertex seen by two photos: the cloud still leaves the walls out.
+  model.seen_by.assign(model.mesh.vertices.size(), {0, 1});
+  model.mesh.colours.assign(model.mesh.vertices.size(), Eigen::Matrix<uint8_t, 3, 1>(128, 128, 128));
+  std::vector<std::vector<uint32_t>> visibility;
+  const std::vector<ColouredPoint> points =
+      SampleMeshPoints(model, 0.25 * voxel, 2, /*seed=*/1, &visibility);
+  ASSERT_GT(points.size(), 1000u);
+  EXPECT_EQ(visibility.size(), points.size());
+  for (const ColouredPoint& point : points) {
+    // Nothing on the bottom or the side walls (z below 8 voxels): points lie on the slab's top
+    // (its edge rounded by smoothing) or on the cube.
+    EXPECT_GT(point.xyz.z(), 6.0 * voxel) << point.xyz.transpose();
+  }
+}
+
 TEST(CarveExport, AnEmptyCarveGivesAnEmptyMesh) {
   const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(4, 80, 60));
   const std::vector<CalibratedView> views = testing::SceneViews(scene);

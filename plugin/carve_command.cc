@@ -195,12 +195,12 @@ CarveRun CarveProject(const CarveRequest& request) {
     run.mesh_refinement = model.refinement;
     run.mesh_small_components_removed = model.small_components_removed;
     run.mesh_grid_wall_vertices = model.grid_wall_vertices;
-    // The cloud: the mesh's vertices that two or more photos see, and which ones, in COLMAP's
+    // The cloud: the mesh's surface that --cloud_min_views or more photos see, and which ones, in COLMAP's
     // visibility format (image indices: positions among the model's images in id order).
     std::vector<std::vector<uint32_t>> visibility;
     const double spacing = exporter::MedianPixelFootprint(views, run.result->volume.grid().Box().center());
     if (!model.mesh.empty() && spacing > 0.0) {
-      points = exporter::SampleMeshPoints(model, spacing, request.options.min_views, /*seed=*/1,
+      points = exporter::SampleMeshPoints(model, spacing, request.cloud_min_views, /*seed=*/1,
                                           &visibility);
     }
     std::vector<image_t> ids;
@@ -446,6 +446,8 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("cloud").Value("cloud.ply")
       .Key("cloud_visibility").Value(request.mesh_kind == "smooth" ? "cloud.ply.vis" : "")
       .Key("cloud_points").Value(static_cast<uint64_t>(run.num_cloud_points))
+      .Key("cloud_min_views").Value(request.mesh_kind == "smooth" ? request.cloud_min_views
+                                                                  : request.options.min_views)
       .Key("mesh").Value("mesh.ply")
       .Key("mesh_kind").Value(request.mesh_kind)
       .Key("mesh_triangles").Value(static_cast<uint64_t>(run.num_mesh_triangles))
@@ -600,6 +602,9 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->AddDefault("mesh_edge_pixels", &request->mesh.edge_pixels,
                      "smooth mesh: split edges longer than this many photo pixels, so colours "
                      "keep the photos' detail (0: no splitting)");
+  parser->AddDefault("cloud_min_views", &request->cloud_min_views,
+                     "smooth mesh: cloud.ply keeps the surface that at least this many photos see "
+                     "(COLMAP's fusion asks 5 by default); the mesh keeps everything");
   parser->AddDefault("mesh_max_faces", &request->mesh_max_faces,
                      "smooth mesh: at most this many triangles, by decimation (0: no budget)");
   parser->AddDefault("mesh_smoothing_iterations", &request->mesh.smoothing_iterations,
@@ -661,6 +666,9 @@ void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
                      std::to_string(request->mesh_max_faces));
   }
   request->mesh.max_triangles = static_cast<int64_t>(request->mesh_max_faces);
+  if (request->cloud_min_views < 1) {
+    throw InputError("--cloud_min_views: must be >= 1, got " + std::to_string(request->cloud_min_views));
+  }
   // --num_threads holds for every stage: loading the photos, carving, meshing, colouring.
   request->mesh.num_threads = request->options.num_threads;
   request->view_options.num_threads = request->options.num_threads;
@@ -767,7 +775,7 @@ int RunCarve(int argc, char** argv) {
       "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more\n"
       "  sparse points   %s\n"
       "  masks           %s\n"
-      "  outputs         %s/cloud.ply (%zu points), mesh.ply (%zu triangles),\n"
+      "  outputs         %s/cloud.ply (%zu points, seen by %d+ photos), mesh.ply (%zu triangles),\n"
       "                  report.json, convergence.csv\n"
       "  open with       meshlab %s/mesh.ply   (or CloudCompare, Open3D, colmap gui)\n",
       run.model_path.c_str(), s.dimensions.x(), s.dimensions.y(), s.dimensions.z(), s.voxel_size,
@@ -778,6 +786,7 @@ int RunCarve(int argc, char** argv) {
       s.threads == 1 ? "thread" : "threads", s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,
       sparse_line.c_str(), mask_line.c_str(), run.output_path.c_str(), run.num_cloud_points,
+      request.mesh_kind == "smooth" ? request.cloud_min_views : request.options.min_views,
       run.num_mesh_triangles, run.output_path.c_str());
   if (s.final_solid == 0 || s.visible_surface == 0) {
     std::printf(

@@ -170,6 +170,9 @@ struct CarveRequest {
   std::string mesh_kind = "smooth";
   exporter::ModelMeshOptions mesh;
   uint64_t mesh_max_faces = 0;  // as given; copied into mesh.max_triangles
+  // With the smooth mesh: cloud.ply keeps the surface that at least this many photos see. Two
+  // photos always find a colour they agree on somewhere; a third is the first check of it.
+  int cloud_min_views = 3;
 };
 
 struct CarveRun {

@@ -771,6 +771,7 @@ TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
   ExpectUserError(base + " --num_threads 0", {"--num_threads", "-1 (every core) or 1 to 1024", "got 0"});
   ExpectUserError(base + " --num_threads 100000", {"--num_threads", "got 100000"});
   ExpectUserError(base + " --mesh_max_faces 2", {"--mesh_", "face budget"});
+  ExpectUserError(base + " --cloud_min_views 0", {"--cloud_min_views", "must be >= 1", "got 0"});
   ExpectUserError(base + " --pattern_threshold 3", {"--pattern_threshold", "[0, 2]", "'3'"});
   ExpectUserError(base + " --consistency median", {"not one of: mean_colour, standard_deviation"});
   ExpectUserError(base + " --method zbuffer", {"not one of: ray, gvc, gvc_ldi"});

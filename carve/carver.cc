@@ -1195,6 +1195,22 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     statistics.peak_memory_bytes = std::max(statistics.peak_memory_bytes, carver->MemoryBytes());
     if (level + 1 < num_levels) add_worker_times(*carver);
   }
+  if (options.repair_silhouettes && statistics.views_with_masks > 0) {
+    Volume repaired = carver->volume();
+    statistics.silhouette_repair = RepairSilhouettes(views, &repaired, options.num_threads);
+    if (statistics.silhouette_repair.restored_voxels > 0) {
+      // The restored voxels are final: a carver over the repaired volume only colours it.
+      CarveOptions colouring = options;
+      colouring.lod_levels = 1;
+      colouring.visual_hull = false;
+      colouring.protect_surface_points = false;
+      colouring.min_component_voxels = 0;
+      statistics.peak_memory_bytes = std::max(statistics.peak_memory_bytes, carver->MemoryBytes());
+      add_worker_times(*carver);
+      carver.reset();
+      carver = std::make_unique<IncrementalCarver>(views, std::move(repaired), colouring);
+    }
+  }
   statistics.carve_seconds = SecondsSince(start);
   statistics.dimensions = carver->volume().grid().dimensions();
   statistics.voxel_size = carver->volume().grid().voxel_size();

@@ -14,6 +14,7 @@
 
 #include "calib/calibrated_view.h"
 #include "carve/consistency.h"
+#include "carve/silhouette_repair.h"
 #include "carve/level_of_detail.h"
 #include "carve/ray_cast_visibility.h"
 #include "carve/surface_evidence.h"
@@ -87,6 +88,9 @@ struct CarveOptions {
   // A voxel seen through a small hole shows the views the hole's rim, not itself: judging it lets
   // one wrong carve drill a tunnel. 0: any pixel counts.
   double min_coverage = 0.0;
+  // After the final level, give back to every masked view's object pixels the model that colour
+  // carving took from their rays (RepairSilhouettes): holes the masks contradict are closed.
+  bool repair_silhouettes = false;
   // Refuse a grid whose carving structures would need more memory than this (GiB).
   double max_memory_gib = 8.0;
   // With ray casting, how Vis(V) is found (see ray_cast_visibility.h); the carving is the same
@@ -193,6 +197,7 @@ struct CarveStatistics {
   int passes = 1;          // GVC: item-buffer renders (passes over the surface); others 1
   int threads = 1;         // threads of the final level's carving
   int views_with_masks = 0;
+  SilhouetteRepairSummary silhouette_repair;  // CarveOptions::repair_silhouettes
   int64_t visual_hull_carved = 0;    // voxels removed by the silhouette pre-carve
   int64_t component_carved = 0;  // small components removed (CarveOptions::min_component_voxels)
   double visual_hull_seconds = 0.0;  // its time (part of set-up)

@@ -151,6 +151,9 @@ CarveRun CarveProject(const CarveRequest& request) {
   run.result = std::make_unique<CarveResult>(
       CarveVolume(views, run.bounds.box, options, progress, request.progress_seconds));
   if (terminal) std::fprintf(stderr, "\n");
+  if (run.result->statistics.silhouette_repair.views > 0) {
+    LOG(INFO) << run.result->statistics.silhouette_repair.Summary();
+  }
   for (const LevelStatistics& level : run.result->statistics.levels) {
     if (!options.auto_threshold) break;
     if (level.threshold_from_data) {
@@ -284,6 +287,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("auto_threshold_quantile").Value(request.options.auto_threshold_quantile)
       .Key("pattern_threshold").Value(request.options.auto_pattern_threshold ? std::string("auto") : std::to_string(request.options.pattern_threshold))
       .Key("protect_surface_points").Value(request.options.protect_surface_points)
+      .Key("repair_silhouettes").Value(request.options.repair_silhouettes)
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
       .Key("min_views").Value(request.options.min_views)
       .Key("min_coverage").Value(request.options.min_coverage)
@@ -370,6 +374,14 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("voxel_size").Value(s.voxel_size)
       .Key("num_voxels").Value(s.num_voxels)
       .Key("views_with_masks").Value(s.views_with_masks)
+      .Key("silhouette_repair").BeginObject()
+          .Key("views").Value(s.silhouette_repair.views)
+          .Key("object_pixels").Value(s.silhouette_repair.object_pixels)
+          .Key("lost_pixels").Value(s.silhouette_repair.lost_pixels)
+          .Key("restored_voxels").Value(s.silhouette_repair.restored_voxels)
+          .Key("outside_hull_pixels").Value(s.silhouette_repair.outside_hull_pixels)
+          .Key("seconds").Value(s.silhouette_repair.seconds)
+          .EndObject()
       .Key("visual_hull_carved").Value(s.visual_hull_carved)
       .Key("component_carved").Value(s.component_carved)
       .Key("visual_hull_seconds").Value(s.visual_hull_seconds)
@@ -525,6 +537,10 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->AddDefault("protect_surface_points", &request->options.protect_surface_points,
                      "never carve a voxel holding a reliable sparse point (track of 2 or more "
                      "photos, error <= 1 px) by colour: stops carving that runs away");
+  parser->AddDefault("repair_silhouettes", &request->options.repair_silhouettes,
+                     "with masks: after carving, give each photo's object pixels back the model "
+                     "that carving took from their rays (a membrane across holes the masks "
+                     "contradict)");
   parser->AddDefault("adaptive_threshold", &request->options.adaptive_threshold,
                      "raise the threshold by this times the voxel's within-view colour spread "
                      "(texture edges); 0: a fixed threshold");

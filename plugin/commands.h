@@ -145,7 +145,7 @@ constexpr int kDefaultMaxImageSize = 2400;
 
 struct CarveRequest {
   // The command line uses every core, automatic levels of detail, removes specks, takes the
-  // threshold from the data and keeps known surface by default.
+  // threshold from the data, keeps known surface and repairs what the masks say by default.
   CarveRequest() {
     view_options.max_image_size = kDefaultMaxImageSize;
     options.num_threads = -1;
@@ -153,6 +153,7 @@ struct CarveRequest {
     options.min_component_voxels = 8;
     options.auto_threshold = true;
     options.protect_surface_points = true;
+    options.repair_silhouettes = true;
   }
   std::string workspace_path;
   std::string input_path;

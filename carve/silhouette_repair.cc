@@ -1,0 +1,166 @@
+#include "carve/silhouette_repair.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <glog/logging.h>
+#include <opencv2/imgproc.hpp>
+
+#include "carve/block_occupancy.h"
+#include "carve/ray_image.h"
+#include "carve/visual_hull.h"
+
+namespace raycarve {
+namespace {
+
+constexpr double kWindowVoxels = 3.0;  // the first window's radius, in projected voxel widths
+constexpr int kMaxWindowPixels = 64;
+constexpr int kMinNeighbours = 5;  // depths around a lost pixel that make a median
+constexpr double kRimVoxels = 1.5;  // the silhouette's rim left alone, in projected voxel widths
+
+std::unique_ptr<RayImage> MakeRays(const CalibratedView& view, const Volume& volume) {
+  const Eigen::Matrix3d world_from_pixel =
+      view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse();
+  const cv::Mat usable = view.valid.empty() ? view.mask : (view.valid & view.mask);
+  auto rays = std::make_unique<RayImage>(volume.grid(), world_from_pixel, view.centre, view.width,
+                                         view.height, usable);
+  const BlockOccupancy blocks(volume);
+  rays->Initialise(volume, &blocks);
+  return rays;
+}
+
+// The median of `values` (reordered); `values` is not empty.
+float Median(std::vector<float>* values) {
+  const size_t middle = values->size() / 2;
+  std::nth_element(values->begin(), values->begin() + middle, values->end());
+  return (*values)[middle];
+}
+
+}  // namespace
+
+std::string SilhouetteRepairSummary::Summary() const {
+  std::ostringstream out;
+  out << "silhouettes: " << lost_pixels << " of " << object_pixels << " object pixels of " << views
+      << " masked views had lost the model to carving (each view after the repairs of those "
+      << "before it); " << restored_voxels
+      << " voxels restored in " << seconds << " s";
+  if (outside_hull_pixels > 0) {
+    out << " (" << outside_hull_pixels << " more object pixels miss the visual hull: masks that "
+        << "disagree)";
+  }
+  return out.str();
+}
+
+SilhouetteRepairSummary RepairSilhouettes(const std::vector<CalibratedView>& views,
+                                          Volume* volume,
+                                          int num_threads) {
+  const auto start = std::chrono::steady_clock::now();
+  SilhouetteRepairSummary summary;
+  const VoxelGrid grid = volume->grid();
+  Volume hull(grid);
+  CarveVisualHull(views, &hull, num_threads);
+  std::vector<uint64_t> solid = volume->solid_bits();
+  const Eigen::AlignedBox3d box = grid.Box();
+  std::vector<float> around;
+  for (const CalibratedView& view : views) {
+    if (view.mask.empty()) continue;
+    ++summary.views;
+    const std::unique_ptr<RayImage> rays = MakeRays(view, *volume);
+    const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
+    const double voxel_pixels = focal * grid.voxel_size() / std::max(view.Depth(box.center()), 1e-9);
+    // Only pixels at least kRimVoxels voxel widths inside the silhouette count as lost: at its
+    // rim a voxel straddles the outline, and carving it is the grid's rounding, not a hole.
+    const int rim = static_cast<int>(std::ceil(kRimVoxels * voxel_pixels));
+    cv::Mat inside;
+    cv::erode(view.mask, inside,
+              cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * rim + 1, 2 * rim + 1)));
+    if (!view.valid.empty()) inside &= view.valid;
+    // Per pixel, the depth of the model's voxel its ray meets (0: none), and the lost pixels.
+    cv::Mat depth = cv::Mat::zeros(view.height, view.width, CV_32F);
+    std::vector<int> lost;
+    for (int p = 0; p < rays->num_pixels(); ++p) {
+      const int64_t voxel = rays->CurrentVoxel(p);
+      if (inside.data[p] != 0) ++summary.object_pixels;
+      if (voxel == RayImage::kNoVoxel) {
+        if (inside.data[p] != 0) lost.push_back(p);
+      } else {
+        depth.at<float>(p / view.width, p % view.width) =
+            static_cast<float>(view.Depth(grid.Centre(grid.Voxel(voxel))));
+      }
+    }
+    if (lost.empty()) continue;
+    const int first_radius = std::max(2, static_cast<int>(std::ceil(kWindowVoxels * voxel_pixels)));
+    int64_t restored = 0;
+    for (int p : lost) {
+      const int row = p / view.width, col = p % view.width;
+      // The depth the surface around the hole has.
+      float target = -1.0f;
+      for (int radius = first_radius; target < 0.0f; radius *= 2) {
+        around.clear();
+        for (int r = std::max(0, row - radius); r <= std::min(view.height - 1, row + radius); ++r) {
+          const float* line = depth.ptr<float>(r);
+          for (int c = std::max(0, col - radius); c <= std::min(view.width - 1, col + radius); ++c) {
+            if (line[c] > 0.0f) around.push_back(line[c]);
+          }
+        }
+        if (static_cast<int>(around.size()) >= kMinNeighbours) target = Median(&around);
+        if (radius >= kMaxWindowPixels) break;
+      }
+      // Along the ray through the grid's box, the hull voxel nearest that depth (the nearest
+      // hull voxel when there is none).
+      const Eigen::Vector3d direction = rays->Direction(p);
+      double t_near = 0.0, t_far = std::numeric_limits<double>::infinity();
+      for (int axis = 0; axis < 3; ++axis) {
+        if (std::abs(direction[axis]) < 1e-15) {
+          if (view.centre[axis] < box.min()[axis] || view.centre[axis] > box.max()[axis]) t_far = -1.0;
+          continue;
+        }
+        double t0 = (box.min()[axis] - view.centre[axis]) / direction[axis];
+        double t1 = (box.max()[axis] - view.centre[axis]) / direction[axis];
+        if (t0 > t1) std::swap(t0, t1);
+        t_near = std::max(t_near, t0);
+        t_far = std::min(t_far, t1);
+      }
+      const double step = 0.25 * grid.voxel_size() / direction.norm();
+      int64_t best = -1;
+      double best_gap = std::numeric_limits<double>::infinity();
+      for (double t = t_near + 0.5 * step; t < t_far; t += step) {
+        const Eigen::Vector3d point = view.centre + t * direction;
+        const Eigen::Vector3i cell = grid.VoxelOf(point);
+        if (!grid.Contains(cell)) continue;
+        const int64_t index = grid.Index(cell);
+        if (!hull.IsSolid(index)) continue;
+        if (target < 0.0f) {
+          best = index;  // no surface around: the hull's nearest voxel
+          break;
+        }
+        const double gap = std::abs(view.Depth(point) - target);
+        if (gap < best_gap) {
+          best_gap = gap;
+          best = index;
+        }
+      }
+      if (best < 0) {
+        ++summary.outside_hull_pixels;  // the masks disagree here: nothing was carved from it
+        continue;
+      }
+      ++summary.lost_pixels;
+      if (((solid[best >> 6] >> (best & 63)) & 1) == 0) {
+        solid[best >> 6] |= uint64_t{1} << (best & 63);
+        ++restored;
+      }
+      // The voxel now stops this ray; its depth serves the lost pixels next to it.
+      depth.at<float>(row, col) = static_cast<float>(view.Depth(grid.Centre(grid.Voxel(best))));
+    }
+    summary.restored_voxels += restored;
+    if (restored > 0) *volume = Volume(grid, solid);
+  }
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace raycarve

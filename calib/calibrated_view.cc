@@ -17,6 +17,10 @@ double CalibratedView::Depth(const Eigen::Vector3d& world) const {
   return (cam_from_world * world).z();
 }
 
+Eigen::Matrix3d CalibratedView::WorldFromPixel() const {
+  return cam_from_world.rotation.toRotationMatrix().transpose() * K.inverse();
+}
+
 CalibratedView MakeCalibratedView(const Camera& camera,
                                   const Image& image,
                                   const cv::Mat& rgb,

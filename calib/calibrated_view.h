@@ -30,6 +30,9 @@ struct CalibratedView {
   Eigen::Vector2d Project(const Eigen::Vector3d& world) const;
   // Depth along the optical axis (camera z) of a world point.
   double Depth(const Eigen::Vector3d& world) const;
+  // Maps homogeneous COLMAP pixel coordinates (x, y, 1) to the world direction of their ray
+  // (R^T K^-1; not normalised: a unit step of camera depth).
+  Eigen::Matrix3d WorldFromPixel() const;
 };
 
 // Builds the view of `image` (seen by `camera`) from its photo `rgb` (CV_8UC3 RGB as decoded)

@@ -42,8 +42,7 @@ RayCastVisibility::RayCastVisibility(const std::vector<CalibratedView>& views,
   }
   auto make_rays = [&](int view) {
     const CalibratedView& v = views[view];
-    const Eigen::Matrix3d world_from_pixel =
-        v.cam_from_world.rotation.toRotationMatrix().transpose() * v.K.inverse();
+    const Eigen::Matrix3d world_from_pixel = v.WorldFromPixel();
     // Rays only where the view holds photo data on the object: background pixels never enter
     // Vis(V) or consistency.
     const cv::Mat usable = v.mask.empty() ? v.valid : (v.valid & v.mask);

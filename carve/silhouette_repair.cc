@@ -22,8 +22,7 @@ constexpr int kMinNeighbours = 5;  // depths around a lost pixel that make a med
 constexpr double kRimVoxels = 1.5;  // the silhouette's rim left alone, in projected voxel widths
 
 std::unique_ptr<RayImage> MakeRays(const CalibratedView& view, const Volume& volume) {
-  const Eigen::Matrix3d world_from_pixel =
-      view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse();
+  const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
   const cv::Mat usable = view.valid.empty() ? view.mask : (view.valid & view.mask);
   auto rays = std::make_unique<RayImage>(volume.grid(), world_from_pixel, view.centre, view.width,
                                          view.height, usable);

@@ -104,8 +104,7 @@ void GatherVoxelPixels(const CalibratedView& view,
   if (footprint.empty()) return;
   const Eigen::Vector3d lo = grid.Corner(voxel, 0);
   const Eigen::Vector3d hi = grid.Corner(voxel, 7);
-  const Eigen::Matrix3d world_from_pixel =
-      view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse();
+  const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
   for (int row = footprint.row_min; row <= footprint.row_max; ++row) {
     const uint8_t* valid = view.valid.empty() ? nullptr : view.valid.ptr<uint8_t>(row);
     const uint8_t* mask = view.mask.empty() ? nullptr : view.mask.ptr<uint8_t>(row);

@@ -58,8 +58,7 @@ VolumeRendering RenderVolume(const Volume& volume,
   rendering.depth = cv::Mat(view.height, view.width, CV_32FC1,
                             cv::Scalar(std::numeric_limits<float>::infinity()));
   const VoxelGrid& grid = volume.grid();
-  const Eigen::Matrix3d world_from_pixel =
-      view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse();
+  const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
   RayImage rays(grid, world_from_pixel, view.centre, view.width, view.height);
   const BlockOccupancy blocks(volume);
   rays.Initialise(volume, &blocks);

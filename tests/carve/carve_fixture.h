@@ -110,7 +110,7 @@ inline std::vector<std::pair<uint32_t, uint32_t>> VisOf(Visibility* visibility, 
 
 inline Eigen::Vector3d PixelDirection(const CalibratedView& view, int pixel) {
   const int row = pixel / view.width, col = pixel % view.width;
-  return view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse() *
+  return view.WorldFromPixel() *
          Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
 }
 

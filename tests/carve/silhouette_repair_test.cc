@@ -17,8 +17,7 @@ namespace raycarve {
 namespace {
 
 std::unique_ptr<RayImage> RaysOf(const CalibratedView& view, const Volume& volume) {
-  const Eigen::Matrix3d world_from_pixel =
-      view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse();
+  const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
   auto rays = std::make_unique<RayImage>(volume.grid(), world_from_pixel, view.centre, view.width,
                                          view.height, view.valid & view.mask);
   rays->Initialise(volume);

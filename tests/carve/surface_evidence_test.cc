@@ -49,8 +49,7 @@ TEST(GatherVoxelPixels, CountsExactlyThePixelsWhoseRayMeetsTheCube) {
       ViewColourStats stats;
       GatherVoxelPixels(view, grid, voxel, &stats);
       int expected = 0;
-      const Eigen::Matrix3d world_from_pixel =
-          view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse();
+      const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
       for (int row = 0; row < view.height; ++row) {
         for (int col = 0; col < view.width; ++col) {
           double t = 0.0;
@@ -175,8 +174,7 @@ TEST(PatchCorrelation, AUniformPatchIsNotTexturedAndAMinorityOfViewsDoesNotVeto)
     for (int row = 0; row < v.height; ++row) {
       for (int col = 0; col < v.width; ++col) {
         // The point of z = 0 this pixel sees.
-        const Eigen::Matrix3d world_from_pixel =
-            v.cam_from_world.rotation.toRotationMatrix().transpose() * v.K.inverse();
+        const Eigen::Matrix3d world_from_pixel = v.WorldFromPixel();
         const Eigen::Vector3d d = world_from_pixel * Eigen::Vector3d(col + 0.5, row + 0.5, 1);
         const Eigen::Vector3d p = v.centre + (-v.centre.z() / d.z()) * d;
         const double value = 128 + 90 * std::sin(40 * p.x()) * std::cos(33 * p.y());

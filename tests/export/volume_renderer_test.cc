@@ -33,7 +33,7 @@ CalibratedView LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& targ
 int64_t FirstSolidByBruteForce(const Volume& volume, const CalibratedView& view, int pixel) {
   const VoxelGrid& grid = volume.grid();
   const Eigen::Vector3d direction =
-      view.cam_from_world.rotation.toRotationMatrix().transpose() * view.K.inverse() *
+      view.WorldFromPixel() *
       Eigen::Vector3d(pixel % view.width + 0.5, pixel / view.width + 0.5, 1.0);
   int64_t best = -1;
   double best_t = 1e300;

@@ -763,6 +763,12 @@ int RunCarve(int argc, char** argv) {
     sparse_line = text;
   }
   const std::string mask_line = MaskSummary(run.mask_photos);
+  std::string silhouette_line;
+  if (s.silhouette_repair.views > 0) {
+    silhouette_line = "  silhouettes     " + std::to_string(s.silhouette_repair.lost_pixels) +
+                      " object pixels of the masks had lost the model to carving; " +
+                      std::to_string(s.silhouette_repair.restored_voxels) + " voxels restored\n";
+  }
   size_t judged_voxels = 0;
   for (const ColouredVoxel& voxel : run.result->surface) {
     judged_voxels += voxel.num_views >= request.options.min_views;
@@ -791,6 +797,7 @@ int RunCarve(int argc, char** argv) {
       "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more\n"
       "  sparse points   %s\n"
       "  masks           %s\n"
+      "%s"
       "  outputs         %s/cloud.ply (%zu points, seen by %d+ photos), mesh.ply (%zu triangles),\n"
       "                  report.json, convergence.csv\n"
       "  open with       meshlab %s/mesh.ply   (or CloudCompare, Open3D, colmap gui)\n",
@@ -801,7 +808,8 @@ int RunCarve(int argc, char** argv) {
       s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds, s.threads,
       s.threads == 1 ? "thread" : "threads", s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,
-      sparse_line.c_str(), mask_line.c_str(), run.output_path.c_str(), run.num_cloud_points,
+      sparse_line.c_str(), mask_line.c_str(), silhouette_line.c_str(), run.output_path.c_str(),
+      run.num_cloud_points,
       request.mesh_kind == "smooth" ? request.cloud_min_views : request.options.min_views,
       run.num_mesh_triangles, run.output_path.c_str());
   if (s.final_solid == 0 || s.visible_surface == 0) {

@@ -4,14 +4,15 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 
-#include <glog/logging.h>
 #include <opencv2/imgproc.hpp>
 
 #include "carve/block_occupancy.h"
 #include "carve/ray_image.h"
 #include "carve/visual_hull.h"
+#include "carve/voxel_grid.h"
 
 namespace raycarve {
 namespace {
@@ -111,18 +112,8 @@ SilhouetteRepairSummary RepairSilhouettes(const std::vector<CalibratedView>& vie
       // Along the ray through the grid's box, the hull voxel nearest that depth (the nearest
       // hull voxel when there is none).
       const Eigen::Vector3d direction = rays->Direction(p);
-      double t_near = 0.0, t_far = std::numeric_limits<double>::infinity();
-      for (int axis = 0; axis < 3; ++axis) {
-        if (std::abs(direction[axis]) < 1e-15) {
-          if (view.centre[axis] < box.min()[axis] || view.centre[axis] > box.max()[axis]) t_far = -1.0;
-          continue;
-        }
-        double t0 = (box.min()[axis] - view.centre[axis]) / direction[axis];
-        double t1 = (box.max()[axis] - view.centre[axis]) / direction[axis];
-        if (t0 > t1) std::swap(t0, t1);
-        t_near = std::max(t_near, t0);
-        t_far = std::min(t_far, t1);
-      }
+      double t_near = 0.0, t_far = 0.0;
+      if (!ClipRayToBox(view.centre, direction, box, &t_near, &t_far)) t_far = -1.0;
       const double step = 0.25 * grid.voxel_size() / direction.norm();
       int64_t best = -1;
       double best_gap = std::numeric_limits<double>::infinity();

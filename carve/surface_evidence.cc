@@ -10,32 +10,6 @@
 #include "carve/patch_correlation.h"
 
 namespace raycarve {
-namespace {
-
-// Whether the ray from `origin` along `direction` meets the box [lo, hi] in front of the origin
-// (slab test).
-bool RayMeetsBox(const Eigen::Vector3d& origin,
-                 const Eigen::Vector3d& direction,
-                 const Eigen::Vector3d& lo,
-                 const Eigen::Vector3d& hi) {
-  double t_near = 0.0;
-  double t_far = std::numeric_limits<double>::infinity();
-  for (int axis = 0; axis < 3; ++axis) {
-    if (direction[axis] == 0.0) {
-      if (origin[axis] < lo[axis] || origin[axis] > hi[axis]) return false;
-      continue;
-    }
-    double t0 = (lo[axis] - origin[axis]) / direction[axis];
-    double t1 = (hi[axis] - origin[axis]) / direction[axis];
-    if (t0 > t1) std::swap(t0, t1);
-    t_near = std::max(t_near, t0);
-    t_far = std::min(t_far, t1);
-    if (t_near > t_far) return false;
-  }
-  return true;
-}
-
-}  // namespace
 
 double ThresholdEstimate::Quantile(const std::vector<double>& values, double q) {
   if (values.empty()) return 0.0;
@@ -102,8 +76,7 @@ void GatherVoxelPixels(const CalibratedView& view,
                        ViewColourStats* stats) {
   const Footprint footprint = ComputeFootprint(view.P, view.width, view.height, grid, voxel);
   if (footprint.empty()) return;
-  const Eigen::Vector3d lo = grid.Corner(voxel, 0);
-  const Eigen::Vector3d hi = grid.Corner(voxel, 7);
+  const Eigen::AlignedBox3d cube(grid.Corner(voxel, 0), grid.Corner(voxel, 7));
   const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
   for (int row = footprint.row_min; row <= footprint.row_max; ++row) {
     const uint8_t* valid = view.valid.empty() ? nullptr : view.valid.ptr<uint8_t>(row);
@@ -112,7 +85,8 @@ void GatherVoxelPixels(const CalibratedView& view,
     for (int col = footprint.col_min; col <= footprint.col_max; ++col) {
       if ((valid != nullptr && valid[col] == 0) || (mask != nullptr && mask[col] == 0)) continue;
       const Eigen::Vector3d direction = world_from_pixel * Eigen::Vector3d(col + 0.5, row + 0.5, 1);
-      if (!RayMeetsBox(view.centre, direction, lo, hi)) continue;
+      double t_near = 0.0, t_far = 0.0;
+      if (!ClipRayToBox(view.centre, direction, cube, &t_near, &t_far)) continue;
       stats->Add(Eigen::Vector3d(rgb[3 * col], rgb[3 * col + 1], rgb[3 * col + 2]));
     }
   }

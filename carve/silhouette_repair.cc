@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 
@@ -39,6 +40,47 @@ float Median(std::vector<float>* values) {
   return (*values)[middle];
 }
 
+bool IsSet(const std::vector<uint64_t>& bits, int64_t index) {
+  return ((bits[index >> 6] >> (index & 63)) & 1) != 0;
+}
+
+// A membrane of one voxel per ray is a staircase whose steps may touch only along an edge. Seen
+// from another photo, or taken by the mesh's iso-surface, such a pair leaves a gap; for each
+// restored voxel and each solid voxel diagonal to it in one of the three axis planes whose two
+// shared face neighbours are both empty, one of those (a hull voxel) is made solid too, and
+// checked in turn. Returns how many voxels that adds.
+int64_t BridgeDiagonalGaps(const VoxelGrid& grid, const Volume& hull,
+                           std::vector<int64_t> restored, std::vector<uint64_t>* solid) {
+  int64_t added = 0;
+  while (!restored.empty()) {
+    const int64_t voxel = restored.back();
+    restored.pop_back();
+    const Eigen::Vector3i cell = grid.Voxel(voxel);
+    for (int u = 0; u < 3; ++u) {
+      for (int w = u + 1; w < 3; ++w) {
+        for (int su = -1; su <= 1; su += 2) {
+          for (int sw = -1; sw <= 1; sw += 2) {
+            Eigen::Vector3i diagonal = cell, first = cell, second = cell;
+            diagonal[u] += su;
+            diagonal[w] += sw;
+            first[u] += su;
+            second[w] += sw;
+            if (!grid.Contains(diagonal)) continue;  // then first and second are inside too
+            const int64_t d = grid.Index(diagonal), a = grid.Index(first), b = grid.Index(second);
+            if (!IsSet(*solid, d) || IsSet(*solid, a) || IsSet(*solid, b)) continue;
+            const int64_t bridge = hull.IsSolid(a) ? a : (hull.IsSolid(b) ? b : -1);
+            if (bridge < 0) continue;
+            (*solid)[bridge >> 6] |= uint64_t{1} << (bridge & 63);
+            restored.push_back(bridge);
+            ++added;
+          }
+        }
+      }
+    }
+  }
+  return added;
+}
+
 }  // namespace
 
 std::string SilhouetteRepairSummary::Summary() const {
@@ -46,7 +88,8 @@ std::string SilhouetteRepairSummary::Summary() const {
   out << "silhouettes: " << lost_pixels << " of " << object_pixels << " object pixels of " << views
       << " masked views had lost the model to carving (each view after the repairs of those "
       << "before it); " << restored_voxels
-      << " voxels restored in " << seconds << " s";
+      << " voxels restored (" << bridging_voxels << " of them bridging diagonal steps) in "
+      << seconds << " s";
   if (outside_hull_pixels > 0) {
     out << " (" << outside_hull_pixels << " more object pixels miss the visual hull: masks that "
         << "disagree)";
@@ -94,6 +137,7 @@ SilhouetteRepairSummary RepairSilhouettes(const std::vector<CalibratedView>& vie
     if (lost.empty()) continue;
     const int first_radius = std::max(2, static_cast<int>(std::ceil(kWindowVoxels * voxel_pixels)));
     int64_t restored = 0;
+    std::vector<int64_t> restored_here;
     for (int p : lost) {
       const int row = p / view.width, col = p % view.width;
       // The depth the surface around the hole has.
@@ -138,13 +182,17 @@ SilhouetteRepairSummary RepairSilhouettes(const std::vector<CalibratedView>& vie
         continue;
       }
       ++summary.lost_pixels;
-      if (((solid[best >> 6] >> (best & 63)) & 1) == 0) {
+      if (!IsSet(solid, best)) {
         solid[best >> 6] |= uint64_t{1} << (best & 63);
         ++restored;
+        restored_here.push_back(best);
       }
       // The voxel now stops this ray; its depth serves the lost pixels next to it.
       depth.at<float>(row, col) = static_cast<float>(view.Depth(grid.Centre(grid.Voxel(best))));
     }
+    const int64_t bridging = BridgeDiagonalGaps(grid, hull, std::move(restored_here), &solid);
+    summary.bridging_voxels += bridging;
+    restored += bridging;
     summary.restored_voxels += restored;
     if (restored > 0) *volume = Volume(grid, solid);
   }

@@ -379,6 +379,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
           .Key("object_pixels").Value(s.silhouette_repair.object_pixels)
           .Key("lost_pixels").Value(s.silhouette_repair.lost_pixels)
           .Key("restored_voxels").Value(s.silhouette_repair.restored_voxels)
+          .Key("bridging_voxels").Value(s.silhouette_repair.bridging_voxels)
           .Key("outside_hull_pixels").Value(s.silhouette_repair.outside_hull_pixels)
           .Key("seconds").Value(s.silhouette_repair.seconds)
           .EndObject()

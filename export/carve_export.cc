@@ -126,6 +126,10 @@ bool ModelMeshOptions::IsValid(std::string* reason) const {
     *reason = "mesh refinement passes must be >= 0";
     return false;
   }
+  if (!(refine_converged_voxels >= 0.0) || !std::isfinite(refine_converged_voxels)) {
+    *reason = "mesh refinement convergence (voxels) must be a number >= 0";
+    return false;
+  }
   return true;
 }
 
@@ -168,6 +172,7 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   if (model.mesh.empty()) return model;
   MeshRefinementOptions refinement;
   refinement.passes = options.refine_passes;
+  refinement.converged_offset = options.refine_converged_voxels * grid.voxel_size();
   refinement.search_range = grid.voxel_size();
   refinement.patch_radius = 0.5 * grid.voxel_size();
   refinement.depth_tolerance = grid.voxel_size();

@@ -41,6 +41,10 @@ bool MeshRefinementOptions::IsValid(std::string* reason) const {
     *reason = "mesh refinement needs steps_per_side >= 1, min_views >= 2, smoothing_passes >= 0, max_views >= min_views";
     return false;
   }
+  if (!(converged_offset >= 0.0)) {
+    *reason = "mesh refinement converged_offset must be >= 0";
+    return false;
+  }
   if (!(min_gain > 0.0 && min_gain <= 1.0)) {
     *reason = "mesh refinement min_gain must lie in (0, 1]";
     return false;
@@ -51,10 +55,12 @@ bool MeshRefinementOptions::IsValid(std::string* reason) const {
 std::string MeshRefinementSummary::Summary() const {
   char text[256];
   std::snprintf(text, sizeof(text),
-                "mesh refinement: %lld of %lld vertices judged, %lld moved; mean offset %.3g "
-                "(|%.3g|) along the normals, in %.2f s",
-                static_cast<long long>(judged), static_cast<long long>(vertices),
-                static_cast<long long>(moved), mean_offset, mean_abs_offset, seconds);
+                "mesh refinement: %d passes; in the last %lld of %lld vertices judged, %lld "
+                "moved (mean |offset| %.3g); mean offset per pass %.3g (|%.3g|) along the "
+                "normals, in %.2f s",
+                passes, static_cast<long long>(judged), static_cast<long long>(vertices),
+                static_cast<long long>(moved), last_mean_abs_offset, mean_offset,
+                mean_abs_offset, seconds);
   return text;
 }
 
@@ -187,16 +193,23 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
       }
       offsets.swap(smoothed);
     }
+    double pass_abs_sum = 0.0;
     for (size_t i = 0; i < n; ++i) {
       mesh->vertices[i] += offsets[i] * mesh->normals[i];
       offset_sum += offsets[i];
-      abs_offset_sum += std::abs(offsets[i]);
+      pass_abs_sum += std::abs(offsets[i]);
     }
+    abs_offset_sum += pass_abs_sum;
     ComputeVertexNormals(mesh);
+    summary.passes = pass + 1;
+    summary.last_mean_abs_offset = n > 0 ? pass_abs_sum / static_cast<double>(n) : 0.0;
+    VLOG(1) << "mesh refinement pass " << pass + 1 << ": " << summary.judged << " judged, "
+            << summary.moved << " moved, mean |offset| " << summary.last_mean_abs_offset;
+    if (summary.last_mean_abs_offset < options.converged_offset) break;
   }
-  if (options.passes > 0 && n > 0) {
-    summary.mean_offset = offset_sum / (static_cast<double>(n) * options.passes);
-    summary.mean_abs_offset = abs_offset_sum / (static_cast<double>(n) * options.passes);
+  if (summary.passes > 0 && n > 0) {
+    summary.mean_offset = offset_sum / (static_cast<double>(n) * summary.passes);
+    summary.mean_abs_offset = abs_offset_sum / (static_cast<double>(n) * summary.passes);
   }
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;

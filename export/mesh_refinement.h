@@ -21,8 +21,13 @@ namespace exporter {
 // photos' mean. The vertex's offset is the cheapest one where that is clearly better than staying
 // (below `min_gain` x the cost of staying), else 0; offsets are then averaged over each vertex's
 // neighbours (smoothing passes) before the vertices move, and normals are recomputed.
+// Passes go on until one moves the mesh's vertices by less than `converged_offset` on average
+// (each pass moves a vertex by at most `search_range`, and the surface the carve leaves can lie
+// several voxels out where the photos agree above it, the more voxels the finer the grid), or
+// until `passes` have run.
 struct MeshRefinementOptions {
-  int passes = 2;                   // search and move passes
+  int passes = 4;                   // search and move passes at most
+  double converged_offset = 0.0;    // world units; a pass moving the vertices less on average is the last (0: run every pass)
   double search_range = 0.0;        // world units either side; must be > 0 (about a voxel)
   int steps_per_side = 4;           // offsets tried on each side of 0
   double patch_radius = 0.0;        // world units from the centre to the 4 tangent samples (> 0)
@@ -41,6 +46,8 @@ struct MeshRefinementSummary {
   int64_t vertices = 0;
   int64_t judged = 0;     // seen by min_views photos, in the last pass
   int64_t moved = 0;      // given a non-zero offset before smoothing, in the last pass
+  int passes = 0;         // passes run
+  double last_mean_abs_offset = 0.0;  // over all vertices, in the last pass
   double mean_offset = 0.0;  // signed, along the normal (negative: inwards), over all passes
   double mean_abs_offset = 0.0;
   double seconds = 0.0;

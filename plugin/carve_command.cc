@@ -482,6 +482,10 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
         .Key("max_faces").Value(static_cast<int64_t>(request.mesh.max_triangles))
         .Key("smoothing_iterations").Value(request.mesh.smoothing_iterations)
         .Key("refine_passes").Value(request.mesh.refine_passes)
+        .Key("refine_converged_voxels").Value(request.mesh.refine_converged_voxels)
+        .Key("refinement_passes").Value(run.mesh_refinement.passes)
+        .Key("refinement_last_mean_abs_offset_voxels")
+        .Value(run.mesh_refinement.last_mean_abs_offset / run.result->volume.grid().voxel_size())
         .Key("refinement_vertices_moved").Value(run.mesh_refinement.moved)
         .Key("refinement_mean_abs_offset_voxels")
         .Value(run.mesh_refinement.mean_abs_offset / run.result->volume.grid().voxel_size())
@@ -627,8 +631,11 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->AddDefault("mesh_smoothing_iterations", &request->mesh.smoothing_iterations,
                      "smooth mesh: windowed-sinc smoothing passes (0: the stair-stepped surface)");
   parser->AddDefault("mesh_refine_passes", &request->mesh.refine_passes,
-                     "smooth mesh: passes moving vertices along their normals (up to a voxel) to "
-                     "where the photos agree best (0: none)");
+                     "smooth mesh: at most this many passes moving vertices along their normals "
+                     "(up to a voxel each) to where the photos agree best (0: none)");
+  parser->AddDefault("mesh_refine_converged", &request->mesh.refine_converged_voxels,
+                     "smooth mesh: the refinement stops after a pass that moves the vertices by "
+                     "less than this many voxels on average (0: run every pass)");
   AddBoundsFlags(parser, &request->bounds);
 }
 

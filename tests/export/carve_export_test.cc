@@ -204,6 +204,57 @@ TEST(CarveExport, TheSmoothMeshIsClosedAndNearerTheTruthAndItsPhotoColoursBeatVo
   EXPECT_LT(mesh_error, 0.9 * voxel_error);
 }
 
+TEST(CarveExport, RefinementPassesStopWhenTheMeshStopsMoving) {
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(8, 320, 240));
+  const std::vector<CalibratedView> views = testing::SceneViews(scene, /*with_masks=*/true);
+  CarveOptions carve;
+  carve.resolution = 64;
+  const CarveResult result = CarveVolume(views, scene.object_box, carve);
+  const double voxel = result.volume.grid().voxel_size();
+  ModelMeshOptions options;
+  options.refine_passes = 0;
+  const ModelMesh unrefined = MeshCarvedModel(result, views, options);
+  ASSERT_FALSE(unrefined.mesh.empty());
+  EXPECT_EQ(unrefined.refinement.passes, 0);
+
+  MeshRefinementOptions refinement;
+  refinement.search_range = voxel;
+  refinement.patch_radius = 0.5 * voxel;
+  refinement.depth_tolerance = voxel;
+  refinement.voxel_size = voxel;
+  auto refine = [&](int passes, double converged_voxels) {
+    refinement.passes = passes;
+    refinement.converged_offset = converged_voxels * voxel;
+    TriangleMesh mesh = unrefined.mesh;
+    const MeshRefinementSummary summary = RefineMeshFromPhotos(views, refinement, &mesh);
+    return std::make_pair(summary, mesh);
+  };
+  auto mean_truth_distance = [voxel](const TriangleMesh& mesh) {
+    double sum = 0.0;
+    for (const Eigen::Vector3f& v : mesh.vertices) sum += TrueSurfaceDistance(v.cast<double>());
+    return sum / mesh.vertices.size() / voxel;
+  };
+  // No convergence test: every pass runs. A tolerance no pass can reach below: one pass.
+  const auto [every, every_mesh] = refine(6, 0.0);
+  EXPECT_EQ(every.passes, 6);
+  const auto [one, one_mesh] = refine(6, 1e9);
+  EXPECT_EQ(one.passes, 1);
+  EXPECT_GE(one.last_mean_abs_offset, 0.0);
+  // The default tolerance (0.1 voxel): the passes stop once a pass moved the mesh less than that
+  // on average, and the mesh ends nearer the truth than after one pass.
+  const auto [converged, converged_mesh] = refine(20, 0.1);
+  std::cout << "passes to converge " << converged.passes << ", last mean |offset| "
+            << converged.last_mean_abs_offset / voxel << " voxels; mean distance to the truth "
+            << "(voxels): unrefined " << mean_truth_distance(unrefined.mesh) << ", one pass "
+            << mean_truth_distance(one_mesh) << ", converged "
+            << mean_truth_distance(converged_mesh) << "\n";
+  EXPECT_GT(converged.passes, 1);
+  EXPECT_LT(converged.passes, 20);
+  EXPECT_LT(converged.last_mean_abs_offset, 0.1 * voxel);
+  EXPECT_LT(mean_truth_distance(converged_mesh), mean_truth_distance(one_mesh));
+  EXPECT_LT(mean_truth_distance(one_mesh), mean_truth_distance(unrefined.mesh));
+}
+
 TEST(CarveExport, TheGridsWallsAreMarkedAndLeftOutOfTheCloud) {
   // A slab filling the grid's lower third, as a ground running on beyond the volume's box: its
   // top is surface, its sides and bottom are where the box cuts it. A cube floats above it.

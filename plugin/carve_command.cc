@@ -17,6 +17,7 @@
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
+#include "calib/model_writer.h"
 #include "calib/view_reader.h"
 #include "carve/carver.h"
 #include "export/carve_export.h"
@@ -90,6 +91,34 @@ CarveRun CarveProject(const CarveRequest& request) {
                        ": already holds files that raycarve did not write (no report.json beside "
                        "it); carve would write its masks there: give another --output_path (or "
                        "--mask_path " + masks_folder.string() + " to carve with them)");
+    }
+  }
+  // The output folder doubles as a COLMAP dense workspace, whose meshers read the sparse model
+  // from sparse/: written there unless an input is or holds that folder, or it holds files that
+  // no earlier carve wrote (no report.json beside it).
+  {
+    namespace fs = std::filesystem;
+    const fs::path sparse_folder = fs::weakly_canonical(fs::path(run.output_path) / "sparse");
+    auto within = [](const fs::path& inner, const fs::path& outer) {
+      const auto [outer_end, unused] =
+          std::mismatch(outer.begin(), outer.end(), inner.begin(), inner.end());
+      return outer_end == outer.end();
+    };
+    for (const auto& [path, what] : inputs) {
+      const fs::path input = fs::weakly_canonical(path);
+      if (within(input, sparse_folder) || within(sparse_folder, input)) {
+        run.dense_sparse_skipped = "the " + what + " (" + path + ") is there";
+      }
+    }
+    std::error_code ignored;
+    if (run.dense_sparse_skipped.empty() && fs::is_directory(sparse_folder) &&
+        !fs::is_empty(sparse_folder, ignored) &&
+        !fs::exists(fs::path(run.output_path) / "report.json")) {
+      run.dense_sparse_skipped = "it holds files that raycarve did not write";
+    }
+    if (!run.dense_sparse_skipped.empty()) {
+      LOG(INFO) << sparse_folder.string() << ": not written (" << run.dense_sparse_skipped
+                << "); COLMAP's delaunay_mesher needs the sparse model there";
     }
   }
   // Every output is written to a staging folder and moved into place together at the end,
@@ -219,6 +248,21 @@ CarveRun CarveProject(const CarveRequest& request) {
     }
     exporter::WritePointCloudPly(points, (out / "cloud.ply").string());
     exporter::WritePointVisibility(visibility, (out / "cloud.ply.vis").string());
+    // COLMAP's dense workspace names, for its meshers: the same files under a second name (hard
+    // links; copies where the file system has none), and the sparse model they index.
+    for (const char* name : {"cloud.ply", "cloud.ply.vis"}) {
+      const std::filesystem::path from = out / name;
+      const std::filesystem::path to = out / (std::string("fused") + (name + 5));
+      std::filesystem::create_hard_link(from, to, error);
+      if (error) {
+        error.clear();
+        std::filesystem::copy_file(from, to, std::filesystem::copy_options::overwrite_existing, error);
+        if (error) throw InputError(to.string() + ": cannot write: " + error.message());
+      }
+    }
+    if (run.dense_sparse_skipped.empty()) {
+      WriteModel(project.reconstruction, (out / "sparse").string(), ModelFormat::kBinary);
+    }
     run.stage_seconds.emplace_back("export", SecondsSince(stage));
   }
   run.num_cloud_points = points.size();
@@ -458,6 +502,14 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
   json.Key("outputs").BeginObject()
       .Key("cloud").Value("cloud.ply")
       .Key("cloud_visibility").Value(request.mesh_kind == "smooth" ? "cloud.ply.vis" : "")
+      .Key("dense_workspace").Value(request.mesh_kind == "smooth" && run.dense_sparse_skipped.empty())
+      .Key("dense_workspace_note")
+      .Value(request.mesh_kind != "smooth"
+                 ? std::string("--mesh voxels: no visibility, no dense workspace")
+                 : run.dense_sparse_skipped.empty()
+                       ? std::string("fused.ply and fused.ply.vis (cloud.ply and cloud.ply.vis "
+                                     "under COLMAP's names) and the sparse model in sparse/")
+                       : "sparse/ not written: " + run.dense_sparse_skipped)
       .Key("cloud_points").Value(static_cast<uint64_t>(run.num_cloud_points))
       .Key("cloud_min_views").Value(request.mesh_kind == "smooth" ? request.cloud_min_views
                                                                   : request.options.min_views)
@@ -833,9 +885,17 @@ int RunCarve(int argc, char** argv) {
     // COLMAP's Poisson trim of 10 suits its own fused clouds of megapixel photos; a cloud of one
     // point per pixel of smaller photos is thinner, and trim 10 leaves nothing (measured on the
     // demo: densities 3.9-9.3, 0 vertices at trim 10, 556k at 5).
-    std::printf("  COLMAP mesher   colmap poisson_mesher --input_path %s/cloud.ply --output_path "
+    std::printf("  COLMAP mesher   colmap poisson_mesher --input_path %s/fused.ply --output_path "
                 "%s/poisson.ply --PoissonMeshing.trim 5\n",
                 run.output_path.c_str(), run.output_path.c_str());
+    if (run.dense_sparse_skipped.empty()) {
+      std::printf("                  (the output is a COLMAP dense workspace: fused.ply, fused.ply.vis, "
+                  "sparse/; colmap delaunay_mesher --input_path %s --input_type dense, where "
+                  "COLMAP has CGAL)\n",
+                  run.output_path.c_str());
+    } else {
+      std::printf("                  (sparse/ not written: %s)\n", run.dense_sparse_skipped.c_str());
+    }
   }
   if (request.mesh_kind == "smooth" && run.num_mesh_triangles > 0) {
     const exporter::MeshColouringSummary& c = run.mesh_colouring;

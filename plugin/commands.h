@@ -197,6 +197,10 @@ struct CarveRun {
   exporter::MeshRefinementSummary mesh_refinement;
   int64_t mesh_small_components_removed = 0;
   int64_t mesh_grid_wall_vertices = 0;  // on the grid's wall: left out of the cloud
+  // The output folder as a COLMAP dense workspace: fused.ply and fused.ply.vis (links to
+  // cloud.ply and cloud.ply.vis) and the sparse model in sparse/. Empty when sparse/ was written;
+  // otherwise why it was not (an input there, or a folder raycarve did not write).
+  std::string dense_sparse_skipped;
   // The model's sparse points inside the grid against the cloud (accuracy: their 90% distance).
   bool has_sparse = false;
   exporter::CloudComparison sparse;

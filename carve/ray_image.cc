@@ -1,5 +1,7 @@
 #include "carve/ray_image.h"
 
+#include <thread>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -100,12 +102,33 @@ void RayImage::InitialiseRay(int pixel) {
   keys_[pixel] = Key(voxel);
 }
 
-void RayImage::Initialise(const Volume& volume, const BlockOccupancy* blocks) {
+void RayImage::Initialise(const Volume& volume, const BlockOccupancy* blocks, int num_threads) {
   CHECK(volume.grid().dimensions() == grid_.dimensions());
   CHECK(blocks == nullptr ||
         (blocks->dimensions().array() ==
          (grid_.dimensions().array() + (BlockOccupancy::kSize - 1)) / BlockOccupancy::kSize)
             .all());
+  if (blocks != nullptr && num_threads > 1) {
+    // Each ray writes only its own key; the arrivals, shared bits, are marked after the join.
+    const int pixels = num_pixels();
+    const int per_thread = (pixels + num_threads - 1) / num_threads;
+    std::vector<std::thread> workers;
+    for (int t = 0; t < num_threads; ++t) {
+      const int begin = t * per_thread, end = std::min(pixels, begin + per_thread);
+      if (begin >= end) break;
+      workers.emplace_back([this, &volume, blocks, begin, end]() {
+        for (int pixel = begin; pixel < end; ++pixel) {
+          InitialiseRay(pixel);
+          if (keys_[pixel] != kInactive) keys_[pixel] = FirstSolid(pixel, volume, *blocks);
+        }
+      });
+    }
+    for (std::thread& worker : workers) worker.join();
+    for (int pixel = 0; pixel < pixels; ++pixel) {
+      if (keys_[pixel] != kInactive) MarkArrival(grid_.Index(Unpack(keys_[pixel])));
+    }
+    return;
+  }
   for (int pixel = 0; pixel < num_pixels(); ++pixel) {
     InitialiseRay(pixel);
     if (keys_[pixel] == kInactive) continue;

@@ -52,7 +52,9 @@ class RayImage {
   // gone). With `blocks` (made from `volume`), empty blocks are crossed a block at a time: the
   // same voxels (up to rays through exact block edges, which may start in either voxel they
   // touch), at a fraction of the steps where much of the volume is empty.
-  void Initialise(const Volume& volume, const BlockOccupancy* blocks = nullptr);
+  // With `blocks`, `num_threads` > 1 splits the pixels among that many threads (the same rays).
+  void Initialise(const Volume& volume, const BlockOccupancy* blocks = nullptr,
+                  int num_threads = 1);
 
   int64_t CurrentVoxel(int pixel) const {
     const uint32_t key = keys_[pixel];

@@ -12,6 +12,7 @@
 
 #include "carve/block_occupancy.h"
 #include "carve/ray_image.h"
+#include "carve/view_workers.h"
 #include "carve/visual_hull.h"
 #include "carve/voxel_grid.h"
 
@@ -23,13 +24,13 @@ constexpr int kMaxWindowPixels = 64;
 constexpr int kMinNeighbours = 5;  // depths around a lost pixel that make a median
 constexpr double kRimVoxels = 1.5;  // the silhouette's rim left alone, in projected voxel widths
 
-std::unique_ptr<RayImage> MakeRays(const CalibratedView& view, const Volume& volume) {
+std::unique_ptr<RayImage> MakeRays(const CalibratedView& view, const Volume& volume,
+                                   const BlockOccupancy& blocks, int num_threads) {
   const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
   const cv::Mat usable = view.valid.empty() ? view.mask : (view.valid & view.mask);
   auto rays = std::make_unique<RayImage>(volume.grid(), world_from_pixel, view.centre, view.width,
                                          view.height, usable);
-  const BlockOccupancy blocks(volume);
-  rays->Initialise(volume, &blocks);
+  rays->Initialise(volume, &blocks, num_threads);
   return rays;
 }
 
@@ -108,10 +109,13 @@ SilhouetteRepairSummary RepairSilhouettes(const std::vector<CalibratedView>& vie
   std::vector<uint64_t> solid = volume->solid_bits();
   const Eigen::AlignedBox3d box = grid.Box();
   std::vector<float> around;
+  const int threads = std::max(1, std::min(ResolveNumThreads(num_threads), 64));
+  // Remade only when a view restored voxels.
+  std::unique_ptr<BlockOccupancy> blocks = std::make_unique<BlockOccupancy>(*volume);
   for (const CalibratedView& view : views) {
     if (view.mask.empty()) continue;
     ++summary.views;
-    const std::unique_ptr<RayImage> rays = MakeRays(view, *volume);
+    const std::unique_ptr<RayImage> rays = MakeRays(view, *volume, *blocks, threads);
     const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
     const double voxel_pixels = focal * grid.voxel_size() / std::max(view.Depth(box.center()), 1e-9);
     // Only pixels at least kRimVoxels voxel widths inside the silhouette count as lost: at its
@@ -194,7 +198,10 @@ SilhouetteRepairSummary RepairSilhouettes(const std::vector<CalibratedView>& vie
     summary.bridging_voxels += bridging;
     restored += bridging;
     summary.restored_voxels += restored;
-    if (restored > 0) *volume = Volume(grid, solid);
+    if (restored > 0) {
+      *volume = Volume(grid, solid);
+      blocks = std::make_unique<BlockOccupancy>(*volume);
+    }
   }
   summary.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -8,13 +8,11 @@
 #include <sstream>
 
 #include <glog/logging.h>
-#include <pcl/PolygonMesh.h>
-#include <pcl/conversions.h>
-#include <pcl/io/ply_io.h>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
 
 #include "calib/input_error.h"
+#include "export/ply_reader.h"
 #include "export/point_cloud_io.h"
 
 namespace raycarve {
@@ -134,45 +132,21 @@ double MedianNeighbourSpacing(const std::vector<Eigen::Vector3f>& points) {
 
 std::vector<Eigen::Vector3f> ReadComparablePoints(const std::string& path, int mesh_samples) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": file not found");
-  if (CheckPlyHeader(path) == 0) throw InputError(path + ": no points to compare");
-  pcl::PolygonMesh mesh;
-  if (pcl::io::loadPLYFile(path, mesh) != 0) {
-    throw InputError(path + ": PCL could not read it as a PLY point cloud or mesh");
-  }
-  pcl::PointCloud<pcl::PointXYZ> vertices;
-  pcl::fromPCLPointCloud2(mesh.cloud, vertices);
+  const PlyData data = ReadPly(path);  // non-finite coordinates and bad faces refused by name
+  if (data.xyz.empty()) throw InputError(path + ": no points to compare");
   std::vector<Eigen::Vector3f> points;
-  // PCL's k-d tree aborts on a non-finite point: such a file is refused by name.
-  for (size_t i = 0; i < vertices.size(); ++i) {
-    const pcl::PointXYZ& p = vertices[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      throw InputError(path + ": vertex " + std::to_string(i) +
-                       " has a non-finite coordinate (NaN or infinity)");
-    }
-  }
-  if (mesh.polygons.empty()) {
-    for (const pcl::PointXYZ& p : vertices) points.emplace_back(p.x, p.y, p.z);
+  if (data.triangles.empty()) {
+    points = data.xyz;
   } else {
     std::vector<std::array<Eigen::Vector3f, 3>> triangles;
     std::vector<double> cumulative_area;
     double total = 0.0;
-    for (const pcl::Vertices& polygon : mesh.polygons) {
-      for (size_t k = 2; k < polygon.vertices.size(); ++k) {
-        std::array<Eigen::Vector3f, 3> triangle;
-        const pcl::index_t corners[3] = {polygon.vertices[0], polygon.vertices[k - 1],
-                                         polygon.vertices[k]};
-        for (int c = 0; c < 3; ++c) {
-          if (corners[c] < 0 || static_cast<size_t>(corners[c]) >= vertices.size()) {
-            throw InputError(path + ": a face refers to vertex " + std::to_string(corners[c]) +
-                             " of " + std::to_string(vertices.size()));
-          }
-          const pcl::PointXYZ& p = vertices[corners[c]];
-          triangle[c] = Eigen::Vector3f(p.x, p.y, p.z);
-        }
-        total += 0.5 * (triangle[1] - triangle[0]).cross(triangle[2] - triangle[0]).norm();
-        triangles.push_back(triangle);
-        cumulative_area.push_back(total);
-      }
+    for (const Eigen::Vector3i& corners : data.triangles) {
+      const std::array<Eigen::Vector3f, 3> triangle = {data.xyz[corners[0]], data.xyz[corners[1]],
+                                                      data.xyz[corners[2]]};
+      total += 0.5 * (triangle[1] - triangle[0]).cross(triangle[2] - triangle[0]).norm();
+      triangles.push_back(triangle);
+      cumulative_area.push_back(total);
     }
     if (!(total > 0.0)) throw InputError(path + ": the mesh has no surface area to sample");
     std::mt19937 random(12345);

@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include "export/ply_reader.h"
+
 namespace raycarve {
 namespace exporter {
 
@@ -32,16 +34,10 @@ inline Eigen::Matrix<uint8_t, 3, 1> ToRgb(const Eigen::Vector3f& colour) {
 // temporary name and renamed; throws InputError naming the path on failure.
 void WritePointCloudPly(const std::vector<ColouredPoint>& points, const std::string& path);
 
-// Checks a PLY file's header against the file before any reader sizes a buffer from it: "ply",
-// a known format, elements whose counts fit in the bytes the file holds (binary: each record's
-// fixed-size properties, lists counted as empty; ASCII: two characters per value), a vertex
-// element with x, y and z, and no obj_info grid (num_cols x num_rows) larger than the vertex
-// count. Returns the vertex count. Throws InputError naming the path and the field otherwise.
-uint64_t CheckPlyHeader(const std::string& path);
-
 // Reads a PLY point cloud (COLMAP's fused.ply, raycarve's own, or any PLY with x y z and
-// optionally normals and colours) through PCL. Throws InputError naming the path when the file
-// is missing or PCL cannot parse it.
+// optionally normals and colours; faces are ignored) through ReadPly. Missing normals and
+// colours are zero. Throws InputError naming the path and the field when the file is missing or
+// malformed.
 std::vector<ColouredPoint> ReadPointCloudPly(const std::string& path);
 
 }  // namespace exporter

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <utility>
 #include <fstream>
 #include <numeric>
 #include <unordered_map>
@@ -31,6 +32,7 @@
 
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
+#include "export/ply_reader.h"
 #include "export/point_cloud_io.h"
 
 // A mesh vertex as the PLY holds it: position, normal, colour (PCL packs red, green and blue into
@@ -360,42 +362,16 @@ MeshTopology AnalyseTopology(const TriangleMesh& mesh) {
 
 TriangleMesh ReadMeshOrCloudPly(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": file not found");
-  if (CheckPlyHeader(path) == 0) throw InputError(path + ": no vertices to draw");
-  pcl::PolygonMesh polygon_mesh;
-  const pcl::console::VERBOSITY_LEVEL verbosity = pcl::console::getVerbosityLevel();
-  pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
-  const int status = pcl::io::loadPLYFile(path, polygon_mesh);
-  pcl::console::setVerbosityLevel(verbosity);
-  if (status != 0) throw InputError(path + ": PCL could not read it as a PLY mesh or point cloud");
-  bool has_colour = false;
-  for (const pcl::PCLPointField& field : polygon_mesh.cloud.fields) {
-    has_colour = has_colour || field.name == "rgb" || field.name == "rgba";
-  }
-  pcl::PointCloud<pcl::PointXYZRGB> vertices;
-  pcl::fromPCLPointCloud2(polygon_mesh.cloud, vertices);
-  if (vertices.empty()) throw InputError(path + ": no vertices to draw");
+  PlyData data = ReadPly(path);  // non-finite coordinates and bad faces refused by name
+  if (data.xyz.empty()) throw InputError(path + ": no vertices to draw");
   TriangleMesh mesh;
-  mesh.vertices.reserve(vertices.size());
-  mesh.colours.reserve(vertices.size());
-  for (size_t i = 0; i < vertices.size(); ++i) {
-    const pcl::PointXYZRGB& p = vertices[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      throw InputError(path + ": vertex " + std::to_string(i) + " has a non-finite coordinate");
-    }
-    mesh.vertices.emplace_back(p.x, p.y, p.z);
-    mesh.colours.emplace_back(has_colour ? p.r : 128, has_colour ? p.g : 128, has_colour ? p.b : 128);
+  mesh.vertices = std::move(data.xyz);
+  if (data.rgb.empty()) {
+    mesh.colours.assign(mesh.vertices.size(), Eigen::Matrix<uint8_t, 3, 1>::Constant(128));
+  } else {
+    mesh.colours = std::move(data.rgb);
   }
-  for (const pcl::Vertices& polygon : polygon_mesh.polygons) {
-    for (const pcl::index_t index : polygon.vertices) {
-      if (index < 0 || static_cast<size_t>(index) >= vertices.size()) {
-        throw InputError(path + ": a face refers to vertex " + std::to_string(index) + " of " +
-                         std::to_string(vertices.size()));
-      }
-    }
-    for (size_t k = 2; k < polygon.vertices.size(); ++k) {
-      mesh.triangles.emplace_back(polygon.vertices[0], polygon.vertices[k - 1], polygon.vertices[k]);
-    }
-  }
+  mesh.triangles = std::move(data.triangles);
   ComputeVertexNormals(&mesh);
   return mesh;
 }

@@ -804,7 +804,9 @@ int RunCarve(int argc, char** argv) {
       "ray-cast visibility, and writes cloud.ply (points with normals and colours, laid out like "
       "COLMAP's fused.ply, sampled on the mesh about one point per photo pixel) with "
       "cloud.ply.vis (the images that see each point, COLMAP's fused.ply.vis format), mesh.ply "
-      "(a smooth welded surface coloured from the photos), report.json and convergence.csv.");
+      "(a smooth welded surface coloured from the photos), report.json and convergence.csv; "
+      "fused.ply, fused.ply.vis and sparse/ make the output folder a COLMAP dense workspace for "
+      "its meshers.");
   AddCarveFlags(&parser, &request, &text);
   if (!parser.Parse(argc, argv)) return 0;
   ApplyCarveFlags(text, &request);

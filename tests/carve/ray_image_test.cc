@@ -180,10 +180,14 @@ TEST(RayImage, CrossingEmptyBlocksReachesTheSameFirstSolidVoxelsAsSteppingEveryV
     world_from_pixel.col(2) = forward - 20.0 * right / 25.0 - 15.0 * down / 25.0;
     RayImage every_voxel(grid, world_from_pixel, centre, 40, 30);
     RayImage by_blocks(grid, world_from_pixel, centre, 40, 30);
+    RayImage threaded(grid, world_from_pixel, centre, 40, 30);
     every_voxel.Initialise(volume);
     by_blocks.Initialise(volume, &blocks);
+    threaded.Initialise(volume, &blocks, 1 + trial % 4);  // the pixels split among threads
     for (int pixel = 0; pixel < 40 * 30; ++pixel) {
       ASSERT_EQ(by_blocks.CurrentVoxel(pixel), every_voxel.CurrentVoxel(pixel))
+          << "trial " << trial << " pixel " << pixel;
+      ASSERT_EQ(threaded.CurrentVoxel(pixel), by_blocks.CurrentVoxel(pixel))
           << "trial " << trial << " pixel " << pixel;
       hits += every_voxel.CurrentVoxel(pixel) != RayImage::kNoVoxel;
       ++rays_compared;
@@ -208,7 +212,7 @@ TEST(RayImage, ArrivalBitsSayExactlyWhichSolidVoxelsSomeRayEndsIn) {
                               20.0 * world_from_pixel.col(0) - 15.0 * world_from_pixel.col(1);
     RayImage rays(grid, world_from_pixel, Eigen::Vector3d(3, 0.1, 0.2), 40, 30);
     ASSERT_TRUE(rays.HasArrivalBits());  // 5,083 voxels, 1,200 pixels
-    rays.Initialise(volume, trial < 3 ? nullptr : &blocks);
+    rays.Initialise(volume, trial < 3 ? nullptr : &blocks, trial == 5 ? 2 : 1);
     // Carve the voxel of a random ray, step every ray that ended there, and compare the bits of
     // every solid voxel with the rays.
     for (int carving = 0; carving < 300; ++carving) {

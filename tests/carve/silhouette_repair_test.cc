@@ -133,6 +133,11 @@ TEST_F(SilhouetteRepair, ClosesATunnelWithAMembraneNearTheSurroundingSurface) {
   EXPECT_GT(summary.lost_pixels, 0);
   EXPECT_GT(summary.restored_voxels, 0);
   EXPECT_EQ(volume.num_solid(), before.num_solid() + summary.restored_voxels);
+  // The rays split among threads: the same repair.
+  Volume threaded = before;
+  const SilhouetteRepairSummary threaded_summary = RepairSilhouettes(views_, &threaded, 3);
+  EXPECT_EQ(threaded.solid_bits(), volume.solid_bits());
+  EXPECT_EQ(threaded_summary.lost_pixels, summary.lost_pixels);
   // Only added, only where the tunnel took the hull.
   for (int64_t index = 0; index < grid.num_voxels(); ++index) {
     if (before.IsSolid(index)) {

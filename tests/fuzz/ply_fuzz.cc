@@ -1,4 +1,4 @@
-// The PLY readers (PCL behind CheckPlyHeader), then what compare and holdout --model do next:
+// The PLY readers (raycarve's own ReadPly), then what compare and holdout --model do next:
 // nearest neighbours over the points, and the mesh's topology.
 #include <filesystem>
 #include <fstream>
@@ -12,7 +12,7 @@
 #include "tests/fuzz/fuzz_target.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  // PCL reads files only: one per process, rewritten for every input.
+  // The readers take files: one per process, rewritten for every input.
   static const std::string path = (std::filesystem::temp_directory_path() /
                                    ("raycarve_ply_fuzz_" + std::to_string(getpid()) + ".ply"))
                                       .string();

@@ -25,6 +25,7 @@ echo "  model_info.json                       cameras, images, points and the ca
 echo "  carve/cloud.ply                       coloured points with normals sampled on the mesh (COLMAP fused.ply layout)"
 echo "  carve/cloud.ply.vis                   the images that see each point (COLMAP fused.ply.vis format)"
 echo "  carve/mesh.ply                        smooth welded mesh, coloured from the photos"
+echo "  carve/fused.ply, fused.ply.vis, sparse/  the same cloud under COLMAP's dense-workspace names, and the model"
 echo "  carve/report.json, convergence.csv    statistics, timings per stage, carving curve"
 echo "  carve/compare.json                    accuracy, completeness, F-score against truth.ply"
 echo "Open the PLY files in MeshLab, CloudCompare or Open3D (e.g. meshlab $out/carve/mesh.ply)."

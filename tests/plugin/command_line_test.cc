@@ -432,6 +432,23 @@ TEST_F(CommandLine, CalibrateWritesViewsAndAReportWithExactReprojection) {
     EXPECT_TRUE(fs::is_regular_file(out + "/undistorted/" + name)) << name;
     EXPECT_TRUE(fs::is_regular_file(out + "/masks/" + name + ".png")) << name;
   }
+  // The outputs arrive as a set: no staging folder or temporary file is left, and a second run
+  // into the same folder (report.json beside its folders) replaces them.
+  for (const auto& entry : fs::recursive_directory_iterator(out)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_EQ(name.find(".raycarve-partial"), std::string::npos) << entry.path();
+    EXPECT_EQ(name.find(".tmp."), std::string::npos) << entry.path();
+  }
+  ASSERT_EQ(Run("calibrate --workspace_path " + Project() + " --output_path " + out, &output), 0)
+      << output;
+  // A folder whose masks/ a user put there (no report.json beside it) is not written into.
+  const std::string user = *root_ + "/calibration_user";
+  fs::create_directories(user + "/masks");
+  testing::WriteFile(user + "/masks/view001.png.png", "the user's mask");
+  ExpectUserError("calibrate --workspace_path " + Project() + " --output_path " + user,
+                  {user + "/masks", "did not write"});
+  EXPECT_EQ(testing::ReadFileBytes(user + "/masks/view001.png.png"), "the user's mask");
+  EXPECT_FALSE(fs::exists(user + "/undistorted"));
   ASSERT_EQ(Run("model_info --input_path " + Project() + "/sparse/0 --format json", &output), 0);
   EXPECT_NE(output.find("\"bounds\""), std::string::npos) << output;
   EXPECT_EQ(JsonNumber(output, "num_points"), JsonNumber(output, "count"));

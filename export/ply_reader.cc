@@ -75,6 +75,13 @@ PlyHeader ParsePlyHeader(const std::string& path) {
                          "' has no valid count ('" + count + "')");
       }
       element.element.count = std::stoull(count);
+      // Found by fuzzing: a second vertex element gave vertices without the first's colours.
+      for (const Element& earlier : elements) {
+        if ((element.element.name == "vertex" || element.element.name == "face") &&
+            earlier.element.name == element.element.name) {
+          throw InputError(path + ": PLY element '" + element.element.name + "' appears twice");
+        }
+      }
       elements.push_back(element);
     } else if (keyword == "property") {
       if (elements.empty()) throw InputError(path + ": PLY property before any element");
@@ -374,6 +381,9 @@ PlyData ReadPly(const std::string& path) {
       if (colours) data.rgb.push_back(rgb);
     }
   }
+  // One vertex element (ParsePlyHeader): every vertex has its normal and colour, or none does.
+  if (data.normals.size() != data.xyz.size()) data.normals.clear();
+  if (data.rgb.size() != data.xyz.size()) data.rgb.clear();
   return data;
 }
 

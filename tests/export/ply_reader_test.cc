@@ -178,6 +178,11 @@ TEST(PlyReader, RefusesBodiesThatLieWithTheFileAndTheValueNamed) {
   ExpectRefused("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
                 "property float z\nend_header\n1.5 2.5 3.5\n4 5\n",
                 "ends inside vertex 1's z");
+  // Two vertex elements (found by fuzzing: the second one's vertices had no colours).
+  ExpectRefused("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                "property float z\nproperty uchar red\nelement vertex 1\nproperty float x\n"
+                "property float y\nproperty float z\nend_header\n1 2 3 4\n5 6 7\n",
+                "element 'vertex' appears twice");
   // A list whose count is a float.
   ExpectRefused("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
                 "property float z\nelement face 0\nproperty list float int vertex_indices\n"

@@ -13,7 +13,7 @@ set +e
   -artifact_prefix="$scratch/artifacts/" "$scratch" > "$scratch/log" 2>&1
 status=$?
 set -e
-{ grep -E "^#[0-9]+[[:space:]]+(DONE|INITED)|ERROR|SUMMARY|Done [0-9]+ runs" "$scratch/log" || true; } | tail -5
+{ grep -aE "^#[0-9]+[[:space:]]+(DONE|INITED)|ERROR|SUMMARY|Done [0-9]+ runs" "$scratch/log" || true; } | tail -5
 [ "$status" -ne 0 ] && tail -40 "$scratch/log"
 if [ "$status" -ne 0 ]; then
   echo "fuzz target failed (exit $status); inputs:" && ls -la "$scratch/artifacts"

@@ -14,6 +14,7 @@
 #include "calib/model_writer.h"
 #include "plugin/commands.h"
 #include "plugin/json_writer.h"
+#include "plugin/option_parser.h"
 
 namespace raycarve {
 namespace {
@@ -85,9 +86,23 @@ Bounds ResolveBounds(const Reconstruction& reconstruction,
   return ComputeBounds(reconstruction, flags.options, source);
 }
 
+namespace {
+// No output replaces an option file that was read (--project_path).
+void CheckNotAnOptionFile(const std::string& output_path) {
+  if (output_path.empty()) return;
+  for (const std::string& file : OptionFilesRead()) {
+    if (std::filesystem::weakly_canonical(output_path) == std::filesystem::weakly_canonical(file)) {
+      throw InputError(output_path + ": the output is the option file (--project_path " + file +
+                       "); raycarve never overwrites its input, choose another --output_path");
+    }
+  }
+}
+}  // namespace
+
 void CheckOutputDoesNotOverwrite(const std::string& output_path,
                                  const std::string& input_path,
                                  const std::string& what) {
+  CheckNotAnOptionFile(output_path);
   if (output_path.empty() || input_path.empty()) return;
   if (std::filesystem::weakly_canonical(output_path) ==
       std::filesystem::weakly_canonical(input_path)) {
@@ -99,6 +114,7 @@ void CheckOutputDoesNotOverwrite(const std::string& output_path,
 void CheckOutputFileOutside(const std::string& output_file,
                             const std::string& input_path,
                             const std::string& what) {
+  CheckNotAnOptionFile(output_file);
   if (output_file.empty() || input_path.empty()) return;
   namespace fs = std::filesystem;
   const fs::path output = fs::weakly_canonical(output_file);

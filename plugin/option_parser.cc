@@ -100,7 +100,17 @@ void OptionParser::Assign(Option* option, const std::string& value) {
   option->set = true;
 }
 
+namespace {
+std::vector<std::string>& MutableOptionFilesRead() {
+  static std::vector<std::string> files;
+  return files;
+}
+}  // namespace
+
+const std::vector<std::string>& OptionFilesRead() { return MutableOptionFilesRead(); }
+
 void OptionParser::ReadProjectFile(const std::string& path) {
+  MutableOptionFilesRead().push_back(path);
   std::error_code error;
   const uintmax_t size = std::filesystem::file_size(path, error);
   if (error || !std::filesystem::is_regular_file(path)) {

@@ -17,6 +17,9 @@ namespace raycarve {
 // Parse throws InputError on an unknown option, a missing value, a value that does not parse as
 // the option's type or is not among its allowed values, or a missing required option. `--help`
 // makes Parse return false after printing the help to stdout.
+// The option files (--project_path) this process has read: inputs that no output may replace.
+const std::vector<std::string>& OptionFilesRead();
+
 class OptionParser {
  public:
   OptionParser(std::string command, std::string description);

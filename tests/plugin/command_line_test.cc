@@ -305,6 +305,17 @@ TEST_F(CommandLine, NoOutputLandsInAnInputOrOutsideItsFolder) {
   ExpectUserError("check_background --input " + cloud + " --workspace_path " + project +
                       " --mask_path " + project + "/masks --output_path " + cloud,
                   {"is the input cloud"});
+  // An option file given as --project_path is an input too.
+  const std::string ini = project + "/options.ini";
+  testing::WriteFile(ini, "[raycarve]\n");
+  ExpectUserError("model_info --input_path " + project + "/sparse/0 --project_path " + ini +
+                      " --output_path " + ini,
+                  {"is the option file"});
+  ExpectUserError("check_background --input " + cloud + " --workspace_path " + project +
+                      " --mask_path " + project + "/masks --project_path " + ini +
+                      " --output_path " + ini,
+                  {"is the option file"});
+  EXPECT_EQ(testing::ReadFileBytes(ini), "[raycarve]\n");
 
   // calibrate writing undistorted photos into the photo folder they come from.
   fs::copy(project + "/images", project + "/undistorted", fs::copy_options::recursive);

@@ -9,6 +9,7 @@
 
 #include <glog/logging.h>
 
+#include "carve/free_space.h"
 #include "carve/item_buffer_visibility.h"
 #include "carve/layered_depth_visibility.h"
 #include "carve/patch_correlation.h"
@@ -189,12 +190,18 @@ VoxelGrid CheckedGrid(const std::vector<CalibratedView>& views,
   return VoxelGrid(box, options.resolution);
 }
 
-// The starting volume less the visual hull's outside, when asked and masked.
-Volume WithVisualHull(const std::vector<CalibratedView>& views,
-                      Volume volume,
-                      const CarveOptions& options,
-                      VisualHullStatistics* statistics) {
-  if (options.visual_hull) *statistics = CarveVisualHull(views, &volume, options.num_threads);
+// The starting volume less the visual hull's outside (when asked and masked) and less the
+// sparse points' sight lines (when asked).
+Volume PreCarved(const std::vector<CalibratedView>& views,
+                 Volume volume,
+                 const CarveOptions& options,
+                 VisualHullStatistics* hull,
+                 FreeSpaceStatistics* free_space) {
+  if (options.visual_hull) *hull = CarveVisualHull(views, &volume, options.num_threads);
+  if (options.free_space_margin_voxels > 0.0 && !options.surface_points.empty()) {
+    *free_space = CarveFreeSpace(views, options.surface_points, options.free_space_margin_voxels,
+                                 &volume, options.num_threads);
+  }
   return volume;
 }
 
@@ -209,6 +216,14 @@ int ImageFactor(const std::vector<CalibratedView>& views, int level_resolution, 
 }
 
 }  // namespace
+
+std::string CarveStatistics::FreeSpaceSummary() const {
+  std::ostringstream text;
+  text << "free space: " << free_space_sight_lines << " sight lines from the photos to the sparse "
+       << "points they saw carved " << free_space_carved << " voxels (" << free_space_level0_carved
+       << " at the first level) in " << free_space_seconds << " s";
+  return text.str();
+}
 
 std::string CarveMethodToString(CarveMethod method) {
   switch (method) {
@@ -431,7 +446,7 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                                      const CarveOptions& options,
                                      const VisibilityFactory& factory)
     : views_(views),
-      volume_(WithVisualHull(views, std::move(start), options, &visual_hull_)),
+      volume_(PreCarved(views, std::move(start), options, &visual_hull_, &free_space_)),
       workers_(static_cast<int>(views.size()),
                options.method == CarveMethod::kRay ? options.num_threads : 1),
       visibility_(factory ? factory(views, volume_)
@@ -1065,7 +1080,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   Clock::time_point start;  // when the first level's carving began
   double next_report = progress_interval_seconds;
   double next_sample = 0.0;
-  int64_t hull_carved = 0;  // the first level's visual hull, in final voxels
+  int64_t pre_carved = 0;  // the first level's visual hull, in final voxels
   std::unique_ptr<IncrementalCarver> carver;
   std::vector<CalibratedView> reduced_views;  // the photos of a coarse level, when reduced
   auto add_worker_times = [&statistics](const IncrementalCarver& level_carver) {
@@ -1144,8 +1159,11 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       statistics.views_with_masks = carver->visual_hull().views_with_masks;
       statistics.visual_hull_carved = carver->visual_hull().carved;
       statistics.visual_hull_seconds = carver->visual_hull().seconds;
+      statistics.free_space_level0_carved = carver->free_space().carved;
       statistics.setup_seconds = SecondsSince(level_start);
-      hull_carved = std::min(final_grid.num_voxels(), carver->visual_hull().carved * scale);
+      // The curve leaves out what the visual hull carved (the sparse points' sight lines are its
+      // first value).
+      pre_carved = std::min(final_grid.num_voxels(), carver->visual_hull().carved * scale);
       if (options.decision == CarveDecision::kReprojection) {
         statistics.reprojection_error_before = carver->MeanReprojectionError();
       }
@@ -1155,7 +1173,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       const int64_t removed = std::max<int64_t>(
           0, final_grid.num_voxels() - std::min(final_grid.num_voxels(),
                                                 carver->volume().num_solid() * scale));
-      statistics.curve.push_back({seconds, std::max<int64_t>(0, removed - hull_carved),
+      statistics.curve.push_back({seconds, std::max<int64_t>(0, removed - pre_carved),
                                   statistics.evaluated + carver->evaluated()});
     };
     sample(SecondsSince(start));
@@ -1183,7 +1201,12 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       }
     }
     sample(SecondsSince(start));
-    level_statistics.carved = carver->carved() + carver->visual_hull().carved;
+    level_statistics.carved =
+        carver->carved() + carver->visual_hull().carved + carver->free_space().carved;
+    level_statistics.free_space_carved = carver->free_space().carved;
+    statistics.free_space_carved += carver->free_space().carved;
+    statistics.free_space_sight_lines = carver->free_space().sight_lines;
+    statistics.free_space_seconds += carver->free_space().seconds;
     level_statistics.evaluated = carver->evaluated();
     level_statistics.protected_kept = carver->protected_kept();
     level_statistics.final_solid = carver->volume().num_solid();
@@ -1203,6 +1226,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       CarveOptions colouring = options;
       colouring.lod_levels = 1;
       colouring.visual_hull = false;
+      colouring.free_space_margin_voxels = 0.0;
       colouring.protect_surface_points = false;
       colouring.min_component_voxels = 0;
       statistics.peak_memory_bytes = std::max(statistics.peak_memory_bytes, carver->MemoryBytes());

@@ -20,6 +20,7 @@
 #include "carve/surface_evidence.h"
 #include "carve/view_workers.h"
 #include "carve/voxel_colour_sums.h"
+#include "carve/free_space.h"
 #include "carve/visual_hull.h"
 #include "carve/volume.h"
 
@@ -169,6 +170,10 @@ struct CarveOptions {
   // the removal of small components still carve them): known surface stops carving that runs
   // away through one wrong carve.
   bool protect_surface_points = false;
+  // Free space from the sparse points (> 0): a surface point seen by a view was seen across
+  // empty space, so the voxels on the sight line from the view's centre to the point are carved
+  // before colouring, up to this many voxels short of the point. 0: off.
+  double free_space_margin_voxels = 0.0;
 
   bool IsValid(std::string* reason) const;
 };
@@ -199,6 +204,14 @@ struct CarveStatistics {
   int views_with_masks = 0;
   SilhouetteRepairSummary silhouette_repair;  // CarveOptions::repair_silhouettes
   int64_t visual_hull_carved = 0;    // voxels removed by the silhouette pre-carve
+  // Voxels removed by the sparse points' sight lines (CarveOptions::free_space_margin_voxels),
+  // summed over the levels (each level's own voxels), and at the first level; the sight lines
+  // that crossed the grid; the time (part of set-up).
+  int64_t free_space_carved = 0;
+  int64_t free_space_level0_carved = 0;
+  int64_t free_space_sight_lines = 0;
+  double free_space_seconds = 0.0;
+  std::string FreeSpaceSummary() const;  // one line for the log
   int64_t component_carved = 0;  // small components removed (CarveOptions::min_component_voxels)
   double visual_hull_seconds = 0.0;  // its time (part of set-up)
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
@@ -289,6 +302,7 @@ class IncrementalCarver {
 
   const Volume& volume() const { return volume_; }
   const VisualHullStatistics& visual_hull() const { return visual_hull_; }
+  const FreeSpaceStatistics& free_space() const { return free_space_; }
   Volume* mutable_volume() { return &volume_; }
   Visibility& visibility() { return *visibility_; }
   // The ray-cast visibility, or nullptr with another method.
@@ -369,6 +383,7 @@ class IncrementalCarver {
 
   const std::vector<CalibratedView>& views_;
   VisualHullStatistics visual_hull_;  // declared before volume_: filled while volume_ is built
+  FreeSpaceStatistics free_space_;    // likewise
   Volume volume_;
   ViewWorkers workers_;  // declared before visibility_, which uses it to set up rays
   std::unique_ptr<Visibility> visibility_;

@@ -27,7 +27,8 @@ struct LevelStatistics {
   int64_t protected_kept = 0;  // evaluations that kept a protected voxel found inconsistent
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   int64_t start_solid = 0;  // solid voxels when the level began (after refinement and hull)
-  int64_t carved = 0;
+  int64_t carved = 0;            // by every means: hull, sight lines, colour, specks
+  int64_t free_space_carved = 0; // of them, by the sparse points' sight lines (level start)
   int64_t evaluated = 0;
   int64_t final_solid = 0;
   double seconds = 0.0;        // set-up (rays) and carving

@@ -170,16 +170,26 @@ CarveRun CarveProject(const CarveRequest& request) {
   };
   CarveOptions options = request.options;
   options.surface_points = project.surface_points;
-  if (options.auto_threshold || options.protect_surface_points) {
+  if (options.auto_threshold || options.protect_surface_points ||
+      options.free_space_margin_voxels > 0.0) {
+    std::vector<std::string> uses;
+    if (options.auto_threshold) uses.push_back("choose the threshold");
+    if (options.protect_surface_points) uses.push_back("protect their voxels");
+    if (options.free_space_margin_voxels > 0.0) uses.push_back("carve their sight lines");
+    std::string joined;
+    for (size_t u = 0; u < uses.size(); ++u) {
+      joined += (u == 0 ? " " : (u + 1 == uses.size() ? " and " : ", ")) + uses[u];
+    }
     LOG(INFO) << project.surface_points.size() << " reliable sparse points (seen by "
               << kMinSurfaceTrack << "+ photos, error <= " << kMaxSurfaceError
-              << " px) in the volume" << (options.auto_threshold ? " choose the threshold" : "")
-              << (options.auto_threshold && options.protect_surface_points ? " and" : "")
-              << (options.protect_surface_points ? " protect their voxels" : "");
+              << " px) in the volume" << joined;
   }
   run.result = std::make_unique<CarveResult>(
       CarveVolume(views, run.bounds.box, options, progress, request.progress_seconds));
   if (terminal) std::fprintf(stderr, "\n");
+  if (run.result->statistics.free_space_sight_lines > 0) {
+    LOG(INFO) << run.result->statistics.FreeSpaceSummary();
+  }
   if (run.result->statistics.silhouette_repair.views > 0) {
     LOG(INFO) << run.result->statistics.silhouette_repair.Summary();
   }
@@ -331,6 +341,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("auto_threshold_quantile").Value(request.options.auto_threshold_quantile)
       .Key("pattern_threshold").Value(request.options.auto_pattern_threshold ? std::string("auto") : std::to_string(request.options.pattern_threshold))
       .Key("protect_surface_points").Value(request.options.protect_surface_points)
+      .Key("free_space_margin").Value(request.options.free_space_margin_voxels)
       .Key("repair_silhouettes").Value(request.options.repair_silhouettes)
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
       .Key("min_views").Value(request.options.min_views)
@@ -428,6 +439,13 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
           .Key("seconds").Value(s.silhouette_repair.seconds)
           .EndObject()
       .Key("visual_hull_carved").Value(s.visual_hull_carved)
+      .Key("free_space").BeginObject()
+          .Key("margin_voxels").Value(request.options.free_space_margin_voxels)
+          .Key("sight_lines").Value(s.free_space_sight_lines)
+          .Key("voxels").Value(s.free_space_carved)
+          .Key("voxels_first_level").Value(s.free_space_level0_carved)
+          .Key("seconds").Value(s.free_space_seconds)
+          .EndObject()
       .Key("component_carved").Value(s.component_carved)
       .Key("visual_hull_seconds").Value(s.visual_hull_seconds)
       .Key("initial_surface").Value(s.initial_surface)
@@ -454,6 +472,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
                                                 static_cast<double>(level.dimensions.y()),
                                                 static_cast<double>(level.dimensions.z())})
         .Key("image_factor").Value(level.image_factor)
+        .Key("free_space_carved").Value(level.free_space_carved)
         .Key("threshold").Value(level.threshold);
     const bool patterns = request.options.consistency == ConsistencyMethod::kPatchCorrelation;
     if (patterns) json.Key("pattern_threshold").Value(level.pattern_threshold);
@@ -594,6 +613,9 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->AddDefault("protect_surface_points", &request->options.protect_surface_points,
                      "never carve a voxel holding a reliable sparse point (track of 2 or more "
                      "photos, error <= 1 px) by colour: stops carving that runs away");
+  parser->AddDefault("free_space_margin", &request->options.free_space_margin_voxels,
+                     "carve the sight lines from each photo to the reliable sparse points it saw "
+                     "(empty space), stopping this many voxels short of the point; 0: off");
   parser->AddDefault("repair_silhouettes", &request->options.repair_silhouettes,
                      "with masks: after carving, give each photo's object pixels back the model "
                      "that carving took from their rays (a membrane across holes the masks "
@@ -851,8 +873,8 @@ int RunCarve(int argc, char** argv) {
   std::printf(
       "\ncarved %s\n"
       "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
-      "  carved          %lld voxels (%lld by the visual hull of %d masked views, %lld in specks),"
-      " %lld evaluations\n"
+      "  carved          %lld voxels (%lld by the visual hull of %d masked views, %lld by the "
+      "sparse points' sight lines, %lld in specks), %lld evaluations\n"
       "  levels          %zu (%s)\n"
       "  convergence     %.2f s (+ %.2f s set-up) on %d %s, carving structures' peak %.1f MiB\n"
       "  process memory  %.1f MiB at its peak (resident: photos, views, grid, mesh)\n"
@@ -866,6 +888,7 @@ int RunCarve(int argc, char** argv) {
       run.model_path.c_str(), s.dimensions.x(), s.dimensions.y(), s.dimensions.z(), s.voxel_size,
       static_cast<long long>(s.num_voxels), static_cast<long long>(s.carved),
       static_cast<long long>(s.visual_hull_carved), s.views_with_masks,
+      static_cast<long long>(s.free_space_level0_carved),
       static_cast<long long>(s.component_carved), static_cast<long long>(s.evaluated),
       s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds, s.threads,
       s.threads == 1 ? "thread" : "threads", s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),

@@ -143,9 +143,13 @@ constexpr double kFallbackPatternThreshold = 0.5;
 // (kBytesPerPhotoPixel), within a 24 GiB machine.
 constexpr int kDefaultMaxImageSize = 2400;
 
+// carve's --free_space_margin default (voxels short of the point where a sight line stops).
+constexpr double kDefaultFreeSpaceMarginVoxels = 2.0;
+
 struct CarveRequest {
   // The command line uses every core, automatic levels of detail, removes specks, takes the
-  // threshold from the data, keeps known surface and repairs what the masks say by default.
+  // threshold from the data, keeps known surface, carves the sparse points' sight lines and
+  // repairs what the masks say by default.
   CarveRequest() {
     view_options.max_image_size = kDefaultMaxImageSize;
     options.num_threads = -1;
@@ -153,6 +157,7 @@ struct CarveRequest {
     options.min_component_voxels = 8;
     options.auto_threshold = true;
     options.protect_surface_points = true;
+    options.free_space_margin_voxels = kDefaultFreeSpaceMarginVoxels;
     options.repair_silhouettes = true;
   }
   std::string workspace_path;

@@ -132,6 +132,9 @@ int RunHoldout(int argc, char** argv) {
     LOG(INFO) << "carving with " << training.size() << " views, holding out " << held_out.size();
     options.surface_points = SurfacePointsOf(project.reconstruction, training, project.bounds.box);
     result = std::make_unique<CarveResult>(CarveVolume(training, project.bounds.box, options));
+    if (result->statistics.free_space_sight_lines > 0) {
+      LOG(INFO) << result->statistics.FreeSpaceSummary();
+    }
     if (result->statistics.silhouette_repair.views > 0) {
       LOG(INFO) << result->statistics.silhouette_repair.Summary();
     }

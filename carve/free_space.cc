@@ -1,0 +1,144 @@
+#include "carve/free_space.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include "carve/view_workers.h"
+
+namespace raycarve {
+namespace {
+
+// A sight line's stop lies at most this many margins from its point along the line.
+constexpr double kMaxSlant = 4.0;
+
+}  // namespace
+
+void SegmentVoxels(const VoxelGrid& grid,
+                   const Eigen::Vector3d& from,
+                   const Eigen::Vector3d& to,
+                   std::vector<int64_t>* voxels) {
+  const Eigen::Vector3d delta = to - from;
+  const double length = delta.norm();
+  if (!(length > 0.0)) return;
+  const Eigen::Vector3d direction = delta / length;
+  double t_near = 0.0, t_far = 0.0;
+  if (!ClipRayToBox(from, direction, grid.Box(), &t_near, &t_far)) return;
+  t_near = std::max(t_near, 0.0);
+  t_far = std::min(t_far, length);
+  if (!(t_near <= t_far)) return;
+  const double size = grid.voxel_size();
+  const Eigen::Vector3i& n = grid.dimensions();
+  // Start inside the box (a hair past the entry, which lies on its faces).
+  const Eigen::Vector3d entry = from + t_near * direction;
+  Eigen::Vector3i voxel = grid.VoxelOf(entry);
+  voxel = voxel.cwiseMax(0).cwiseMin(n - Eigen::Vector3i::Ones());
+  // Amanatides-Woo: per axis, the ray parameter at which the segment leaves the current voxel
+  // along that axis, and the parameter one voxel takes.
+  Eigen::Vector3i step;
+  Eigen::Vector3d t_max, t_delta;
+  for (int a = 0; a < 3; ++a) {
+    if (direction[a] > 0.0) {
+      step[a] = 1;
+      const double boundary = grid.origin()[a] + (voxel[a] + 1) * size;
+      t_max[a] = (boundary - from[a]) / direction[a];
+      t_delta[a] = size / direction[a];
+    } else if (direction[a] < 0.0) {
+      step[a] = -1;
+      const double boundary = grid.origin()[a] + voxel[a] * size;
+      t_max[a] = (boundary - from[a]) / direction[a];
+      t_delta[a] = -size / direction[a];
+    } else {
+      step[a] = 0;
+      t_max[a] = std::numeric_limits<double>::infinity();
+      t_delta[a] = std::numeric_limits<double>::infinity();
+    }
+  }
+  while (true) {
+    voxels->push_back(grid.Index(voxel));
+    int a = 0;
+    if (t_max[1] < t_max[a]) a = 1;
+    if (t_max[2] < t_max[a]) a = 2;
+    if (t_max[a] > t_far) break;
+    voxel[a] += step[a];
+    if (voxel[a] < 0 || voxel[a] >= n[a]) break;
+    t_max[a] += t_delta[a];
+  }
+}
+
+FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
+                                   const std::vector<SurfacePoint>& points,
+                                   double margin_voxels,
+                                   Volume* volume,
+                                   int num_threads) {
+  const auto start = std::chrono::steady_clock::now();
+  FreeSpaceStatistics statistics;
+  const VoxelGrid& grid = volume->grid();
+  const double margin = margin_voxels * grid.voxel_size();
+  const int threads = std::max(1, std::min<int>(ResolveNumThreads(num_threads), 64));
+  // Per thread: a bit per voxel that some sight line passed through while solid.
+  const size_t words = static_cast<size_t>((grid.num_voxels() + 63) / 64);
+  std::vector<std::vector<uint64_t>> passed(threads);
+  std::vector<int64_t> lines(threads, 0);
+  auto find = [&](int thread) {
+    std::vector<uint64_t>& bits = passed[thread];
+    bits.assign(words, 0);
+    std::vector<int64_t> voxels;
+    for (size_t p = thread; p < points.size(); p += threads) {
+      const SurfacePoint& point = points[p];
+      // The side of the surface the point was seen from: the mean direction to its views (on a
+      // ring of cameras around a plane, its normal).
+      Eigen::Vector3d facing = Eigen::Vector3d::Zero();
+      for (int v : point.views) facing += (views[v].centre - point.xyz).normalized();
+      if (!(facing.norm() > 0.0)) continue;
+      facing.normalize();
+      for (int v : point.views) {
+        const Eigen::Vector3d& centre = views[v].centre;
+        const Eigen::Vector3d to_point = point.xyz - centre;
+        const double length = to_point.norm();
+        // The line stops `margin` above that plane (at most kMaxSlant margins along the line):
+        // a line that meets the surface at a slant would otherwise cut the surface beside the
+        // point.
+        const double rise = -to_point.dot(facing) / length;
+        if (!(rise > 0.0)) continue;
+        const double stop = margin / std::max(rise, 1.0 / kMaxSlant);
+        if (!(length > stop)) continue;
+        voxels.clear();
+        SegmentVoxels(grid, centre, centre + (1.0 - stop / length) * to_point, &voxels);
+        if (!voxels.empty()) ++lines[thread];
+        for (int64_t index : voxels) {
+          if (volume->IsSolid(index)) bits[index >> 6] |= uint64_t{1} << (index & 63);
+        }
+      }
+    }
+  };
+  std::vector<std::thread> workers;
+  for (int thread = 1; thread < threads; ++thread) workers.emplace_back(find, thread);
+  find(0);
+  for (std::thread& worker : workers) worker.join();
+  // A voxel holding a point stays: a sight line that meets it passes the surface at a slant
+  // (or one of the two points is wrong).
+  std::vector<uint64_t> keep(words, 0);
+  for (int64_t index : SurfacePointVoxels(grid, points)) keep[index >> 6] |= uint64_t{1} << (index & 63);
+  std::vector<int64_t> exposed;
+  for (size_t w = 0; w < words; ++w) {
+    uint64_t word = 0;
+    for (int thread = 0; thread < threads; ++thread) word |= passed[thread][w];
+    word &= ~keep[w];
+    while (word != 0) {
+      const int bit = __builtin_ctzll(word);
+      word &= word - 1;
+      exposed.clear();
+      volume->Carve(static_cast<int64_t>(w) * 64 + bit, &exposed);
+      ++statistics.carved;
+    }
+  }
+  for (int64_t count : lines) statistics.sight_lines += count;
+  statistics.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return statistics;
+}
+
+}  // namespace raycarve

@@ -1,0 +1,42 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "calib/calibrated_view.h"
+#include "carve/surface_evidence.h"
+#include "carve/volume.h"
+
+namespace raycarve {
+
+struct FreeSpaceStatistics {
+  int64_t sight_lines = 0;  // (point, view) pairs whose sight line crosses the grid
+  int64_t carved = 0;       // solid voxels carved
+  double seconds = 0.0;
+};
+
+// Empty space from the sparse points: a view that observed a surface point saw it across empty
+// space, so every voxel that the segment from the view's centre to the point passes through is
+// carved, up to where the segment comes within `margin_voxels` voxel widths of the surface at the
+// point. The surface's side is taken to face the mean direction from the point to its views (on
+// a ring of cameras around a plane, its normal): a line at a slant to it stops farther from the
+// point (margin / sin(slant), at most 4 margins), since it passes close over the surface beside
+// the point; a view behind that plane draws no line. A voxel holding any of the points is never
+// carved. Only solid voxels are carved; `points`' views index `views`. The voxels are found on
+// `num_threads` threads (< 1: one per hardware thread) and carved in index order: the result does
+// not depend on the count. Cost: one step per voxel a sight line passes (Amanatides-Woo).
+FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
+                                   const std::vector<SurfacePoint>& points,
+                                   double margin_voxels,
+                                   Volume* volume,
+                                   int num_threads = 1);
+
+// The voxels of `grid` that the segment from `from` to `to` passes through, in order (a voxel
+// whose closed cube the segment only touches at an edge or corner may or may not be listed),
+// clipped to the grid's box. Appended to `voxels` as linear indices.
+void SegmentVoxels(const VoxelGrid& grid,
+                   const Eigen::Vector3d& from,
+                   const Eigen::Vector3d& to,
+                   std::vector<int64_t>* voxels);
+
+}  // namespace raycarve

@@ -6,6 +6,7 @@
 #include <deque>
 #include <limits>
 #include <sstream>
+#include <unordered_map>
 
 #include <glog/logging.h>
 
@@ -222,6 +223,14 @@ std::string CarveStatistics::FreeSpaceSummary() const {
   text << "free space: " << free_space_sight_lines << " sight lines from the photos to the sparse "
        << "points they saw carved " << free_space_carved << " voxels (" << free_space_level0_carved
        << " at the first level) in " << free_space_seconds << " s";
+  return text.str();
+}
+
+std::string CarveStatistics::FloaterSummary() const {
+  std::ostringstream text;
+  text << "floaters: " << unsupported_components << " pieces of the model without a sparse point ("
+       << unsupported_component_carved << " voxels; the largest was expected to hold "
+       << unsupported_largest_expected << " at the model's density) carved";
   return text.str();
 }
 
@@ -966,6 +975,98 @@ int64_t IncrementalCarver::RemoveSmallComponents(int64_t min_voxels) {
   return static_cast<int64_t>(small.size());
 }
 
+int64_t IncrementalCarver::RemoveUnsupportedComponents(const std::vector<SurfacePoint>& points,
+                                                       double min_expected,
+                                                       int64_t* components,
+                                                       double* largest_expected) {
+  const VoxelGrid& grid = volume_.grid();
+  const Eigen::Vector3i& n = grid.dimensions();
+  const size_t words = static_cast<size_t>((grid.num_voxels() + 63) / 64);
+  const auto test = [](const std::vector<uint64_t>& bits, int64_t i) {
+    return ((bits[i >> 6] >> (i & 63)) & 1) != 0;
+  };
+  // The voxels within one voxel of a point, and which points each is near.
+  std::vector<uint64_t> near_point(words, 0);
+  std::unordered_map<int64_t, std::vector<int>> points_near;
+  for (size_t p = 0; p < points.size(); ++p) {
+    const Eigen::Vector3i centre = grid.VoxelOf(points[p].xyz);
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Eigen::Vector3i voxel = centre + Eigen::Vector3i(dx, dy, dz);
+          if (!grid.Contains(voxel)) continue;
+          const int64_t i = grid.Index(voxel);
+          near_point[i >> 6] |= uint64_t{1} << (i & 63);
+          points_near[i].push_back(static_cast<int>(p));
+        }
+      }
+    }
+  }
+  struct Component {
+    std::vector<int64_t> voxels;
+    int64_t surface = 0;
+    int64_t supported = 0;  // points claimed (each by the first component found beside it)
+  };
+  std::vector<Component> found;
+  std::vector<uint8_t> claimed(points.size(), 0);
+  std::vector<uint64_t> seen(words, 0);
+  for (int64_t start = 0; start < grid.num_voxels(); ++start) {
+    if (!volume_.IsSolid(start) || test(seen, start)) continue;
+    seen[start >> 6] |= uint64_t{1} << (start & 63);
+    Component component;
+    component.voxels.assign(1, start);
+    for (size_t k = 0; k < component.voxels.size(); ++k) {
+      const int64_t index = component.voxels[k];
+      component.surface += volume_.IsSurface(index);
+      if (test(near_point, index)) {
+        for (int p : points_near[index]) {
+          if (claimed[p]) continue;
+          claimed[p] = 1;
+          ++component.supported;
+        }
+      }
+      const Eigen::Vector3i voxel = grid.Voxel(index);
+      for (int dz = -1; dz <= 1; ++dz) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Eigen::Vector3i next = voxel + Eigen::Vector3i(dx, dy, dz);
+            if ((next.array() < 0).any() || (next.array() >= n.array()).any()) continue;
+            const int64_t i = grid.Index(next);
+            if (volume_.IsSolid(i) && !test(seen, i)) {
+              seen[i >> 6] |= uint64_t{1} << (i & 63);
+              component.voxels.push_back(i);
+            }
+          }
+        }
+      }
+    }
+    found.push_back(std::move(component));
+  }
+  int64_t supported = 0, supported_surface = 0, largest = 0;
+  for (const Component& c : found) {
+    largest = std::max(largest, c.surface);
+    if (c.supported == 0) continue;
+    supported += c.supported;
+    supported_surface += c.surface;
+  }
+  int64_t carved = 0, removed = 0;
+  double most_expected = 0.0;
+  if (supported_surface > 0) {
+    const double density = static_cast<double>(supported) / supported_surface;
+    for (const Component& c : found) {
+      const double expected = density * c.surface;
+      if (c.supported > 0 || expected < min_expected || 4 * c.surface >= largest) continue;
+      ++removed;
+      most_expected = std::max(most_expected, expected);
+      for (int64_t voxel : c.voxels) CarveAndQueue(voxel);
+      carved += static_cast<int64_t>(c.voxels.size());
+    }
+  }
+  if (components != nullptr) *components = removed;
+  if (largest_expected != nullptr) *largest_expected = most_expected;
+  return carved;
+}
+
 std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
   std::vector<ColouredVoxel> surface;
   double error = 0.0;
@@ -1200,6 +1301,20 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       while (carver->Step()) {
       }
     }
+    if (level + 1 == num_levels && options.unsupported_component_points > 0.0 &&
+        !options.surface_points.empty()) {
+      int64_t components = 0;
+      double expected = 0.0;
+      const int64_t removed = carver->RemoveUnsupportedComponents(
+          options.surface_points, options.unsupported_component_points, &components, &expected);
+      if (removed > 0) {
+        statistics.unsupported_components = components;
+        statistics.unsupported_component_carved = removed;
+        statistics.unsupported_largest_expected = expected;
+        while (carver->Step()) {
+        }
+      }
+    }
     sample(SecondsSince(start));
     level_statistics.carved =
         carver->carved() + carver->visual_hull().carved + carver->free_space().carved;
@@ -1229,6 +1344,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       colouring.free_space_margin_voxels = 0.0;
       colouring.protect_surface_points = false;
       colouring.min_component_voxels = 0;
+      colouring.unsupported_component_points = 0.0;
       statistics.peak_memory_bytes = std::max(statistics.peak_memory_bytes, carver->MemoryBytes());
       add_worker_times(*carver);
       carver.reset();

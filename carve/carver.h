@@ -124,6 +124,11 @@ struct CarveOptions {
   // fewer voxels than this (specks in empty space whose pixels agree by chance), then carry on
   // carving from what they hid; repeated while any is found (at most 4 rounds). 0: keep all.
   int min_component_voxels = 0;
+  // After that: carve every 26-connected component that holds none of surface_points (within a
+  // voxel) where the density of the points on the model's surface predicts at least this many,
+  // and whose surface is below a quarter of the largest component's: hull leftovers floating
+  // beside the object, which no photo saw texture on. 0: keep all.
+  double unsupported_component_points = 0.0;
   // With levels of detail: a level whose voxels are 2^k times the final ones judges with
   // threshold x lod_threshold_scale^k. A coarse voxel straddles more texture edges and spans more
   // depth, so its views' mean colours disagree more even on the true surface; at the final
@@ -212,7 +217,13 @@ struct CarveStatistics {
   int64_t free_space_sight_lines = 0;
   double free_space_seconds = 0.0;
   std::string FreeSpaceSummary() const;  // one line for the log
+  std::string FloaterSummary() const;    // likewise, for the components without sparse points
   int64_t component_carved = 0;  // small components removed (CarveOptions::min_component_voxels)
+  // Components removed for holding no sparse point (CarveOptions::unsupported_component_points):
+  // how many, their voxels, and the points they were expected to hold (the largest).
+  int64_t unsupported_components = 0;
+  int64_t unsupported_component_carved = 0;
+  double unsupported_largest_expected = 0.0;
   double visual_hull_seconds = 0.0;  // its time (part of set-up)
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   double voxel_size = 0.0;
@@ -294,6 +305,18 @@ class IncrementalCarver {
   // (the rays that ended in it step on and the voxels they reach are queued), so Step carries on
   // from there. Returns the voxels carved. Cost: one pass over the solid voxels.
   int64_t RemoveSmallComponents(int64_t min_voxels);
+
+  // Carves every 26-connected component that no point of `points` lies in or beside (within one
+  // voxel) although the model's density of such points (points per surface voxel, over the
+  // components that hold any) predicts at least `min_expected` on its surface voxels, and whose
+  // surface voxels are fewer than a quarter of the largest component's. Carved as
+  // RemoveSmallComponents carves. Returns the voxels carved; `components` and `largest_expected`
+  // (may be null) get how many components went and the most points one of them was expected to
+  // hold. Cost: one pass over the solid voxels.
+  int64_t RemoveUnsupportedComponents(const std::vector<SurfacePoint>& points,
+                                      double min_expected,
+                                      int64_t* components,
+                                      double* largest_expected);
 
   // Colours every surface voxel from its current visible pixels (and measures the mean
   // reprojection error, surface_reprojection_error()).

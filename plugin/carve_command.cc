@@ -190,6 +190,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   if (run.result->statistics.free_space_sight_lines > 0) {
     LOG(INFO) << run.result->statistics.FreeSpaceSummary();
   }
+  if (run.result->statistics.unsupported_components > 0) LOG(INFO) << run.result->statistics.FloaterSummary();
   if (run.result->statistics.silhouette_repair.views > 0) {
     LOG(INFO) << run.result->statistics.silhouette_repair.Summary();
   }
@@ -342,6 +343,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("pattern_threshold").Value(request.options.auto_pattern_threshold ? std::string("auto") : std::to_string(request.options.pattern_threshold))
       .Key("protect_surface_points").Value(request.options.protect_surface_points)
       .Key("free_space_margin").Value(request.options.free_space_margin_voxels)
+      .Key("floater_expected_points").Value(request.options.unsupported_component_points)
       .Key("repair_silhouettes").Value(request.options.repair_silhouettes)
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
       .Key("min_views").Value(request.options.min_views)
@@ -447,6 +449,11 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
           .Key("seconds").Value(s.free_space_seconds)
           .EndObject()
       .Key("component_carved").Value(s.component_carved)
+      .Key("floaters").BeginObject()
+          .Key("pieces").Value(s.unsupported_components)
+          .Key("voxels").Value(s.unsupported_component_carved)
+          .Key("largest_expected_points").Value(s.unsupported_largest_expected)
+          .EndObject()
       .Key("visual_hull_seconds").Value(s.visual_hull_seconds)
       .Key("initial_surface").Value(s.initial_surface)
       .Key("carved").Value(s.carved)
@@ -616,6 +623,10 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->AddDefault("free_space_margin", &request->options.free_space_margin_voxels,
                      "carve the sight lines from each photo to the reliable sparse points it saw "
                      "(empty space), stopping this many voxels short of the point; 0: off");
+  parser->AddDefault("floater_expected_points", &request->options.unsupported_component_points,
+                     "carve a piece of the model (26-connected, under a quarter of the largest) "
+                     "that holds no reliable sparse point where the points' density on the model "
+                     "predicts at least this many; 0: keep every piece");
   parser->AddDefault("repair_silhouettes", &request->options.repair_silhouettes,
                      "with masks: after carving, give each photo's object pixels back the model "
                      "that carving took from their rays (a membrane across holes the masks "
@@ -874,7 +885,8 @@ int RunCarve(int argc, char** argv) {
       "\ncarved %s\n"
       "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
       "  carved          %lld voxels (%lld by the visual hull of %d masked views, %lld by the "
-      "sparse points' sight lines, %lld in specks), %lld evaluations\n"
+      "sparse points' sight lines, %lld in specks, %lld in %lld floaters without sparse points), "
+      "%lld evaluations\n"
       "  levels          %zu (%s)\n"
       "  convergence     %.2f s (+ %.2f s set-up) on %d %s, carving structures' peak %.1f MiB\n"
       "  process memory  %.1f MiB at its peak (resident: photos, views, grid, mesh)\n"
@@ -889,7 +901,9 @@ int RunCarve(int argc, char** argv) {
       static_cast<long long>(s.num_voxels), static_cast<long long>(s.carved),
       static_cast<long long>(s.visual_hull_carved), s.views_with_masks,
       static_cast<long long>(s.free_space_level0_carved),
-      static_cast<long long>(s.component_carved), static_cast<long long>(s.evaluated),
+      static_cast<long long>(s.component_carved),
+      static_cast<long long>(s.unsupported_component_carved),
+      static_cast<long long>(s.unsupported_components), static_cast<long long>(s.evaluated),
       s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds, s.threads,
       s.threads == 1 ? "thread" : "threads", s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,

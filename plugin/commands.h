@@ -145,6 +145,9 @@ constexpr int kDefaultMaxImageSize = 2400;
 
 // carve's --free_space_margin default (voxels short of the point where a sight line stops).
 constexpr double kDefaultFreeSpaceMarginVoxels = 2.0;
+// carve's --floater_expected_points default: a piece with no sparse point goes where three were
+// expected (a Poisson count of mean 3 is 0 one time in 20).
+constexpr double kDefaultFloaterExpectedPoints = 3.0;
 
 struct CarveRequest {
   // The command line uses every core, automatic levels of detail, removes specks, takes the
@@ -158,6 +161,7 @@ struct CarveRequest {
     options.auto_threshold = true;
     options.protect_surface_points = true;
     options.free_space_margin_voxels = kDefaultFreeSpaceMarginVoxels;
+    options.unsupported_component_points = kDefaultFloaterExpectedPoints;
     options.repair_silhouettes = true;
   }
   std::string workspace_path;

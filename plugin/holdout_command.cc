@@ -135,6 +135,7 @@ int RunHoldout(int argc, char** argv) {
     if (result->statistics.free_space_sight_lines > 0) {
       LOG(INFO) << result->statistics.FreeSpaceSummary();
     }
+    if (result->statistics.unsupported_components > 0) LOG(INFO) << result->statistics.FloaterSummary();
     if (result->statistics.silhouette_repair.views > 0) {
       LOG(INFO) << result->statistics.silhouette_repair.Summary();
     }

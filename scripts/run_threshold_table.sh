@@ -4,7 +4,8 @@
 # surface) of each Middlebury set through both COLMAP models, and of the paper's generated scene
 # (14 views of 800x600, as the paper's experiment), at RESOLUTIONS, with the command's defaults,
 # --threshold 30, --threshold 60 and silhouettes only (--threshold 1000000 --consistency
-# mean_colour: nothing is carved by colour). Prints a Markdown table; writes out/threshold_table/table.json.
+# mean_colour --free_space_margin 0 --floater_expected_points 0: the visual hull alone, nothing carved
+# by colour, by the sparse points' sight lines or as floaters). Prints a Markdown table; writes out/threshold_table/table.json.
 # Usage: scripts/run_threshold_table.sh [RESOLUTIONS]   (default "128 256"; data: $RAYCARVE_DATA_DIR or ../shared/data)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,7 +17,7 @@ mkdir -p "$out"
 # shellcheck source=scripts/holdout_projects.sh
 source scripts/holdout_projects.sh
 holdout_projects
-configs=("defaults|" "threshold 30|--threshold 30" "threshold 60|--threshold 60" "silhouettes only|--threshold 1000000 --consistency mean_colour")
+configs=("defaults|" "threshold 30|--threshold 30" "threshold 60|--threshold 60" "silhouettes only|--threshold 1000000 --consistency mean_colour --free_space_margin 0 --floater_expected_points 0")
 echo "| set | model | voxels | options | held-out PSNR | silhouette IoU | thresholds (coarse to fine) | carve s |"
 echo "|---|---|---:|---|---:|---:|---|---:|"
 rows=()

@@ -392,6 +392,71 @@ TEST(IncrementalCarver, SmallComponentsAreCarvedAndTheirRaysStepOn) {
   EXPECT_GT(carver.evaluated(), 0);
 }
 
+// Pieces without sparse points: a slab with points on its top, two 3x3x3 cubes above it (one
+// holding a point, one none) and a lone voxel with none. At the slab's density (a point on every
+// fourth column of two layers, all of them surface: 1 per 8 surface voxels) a cube of 26
+// surface voxels should hold about 3.3: the bare cube goes, the one with a point stays, the lone
+// voxel (expected 0.13) stays, and so does the slab.
+TEST(IncrementalCarver, PiecesWithoutTheSparsePointsTheirSizePredictsAreCarved) {
+  const SyntheticScene scene = Scene(6, 120, 90);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  const VoxelGrid grid(scene.object_box, 24);
+  std::vector<uint64_t> bits((grid.num_voxels() + 63) / 64, 0);
+  const auto set = [&](int x, int y, int z) {
+    const int64_t i = grid.Index(Eigen::Vector3i(x, y, z));
+    bits[i >> 6] |= uint64_t{1} << (i & 63);
+  };
+  const Eigen::Vector3i& n = grid.dimensions();
+  std::vector<SurfacePoint> points;
+  for (int y = 0; y < n.y(); ++y) {
+    for (int x = 0; x < n.x(); ++x) {
+      set(x, y, 0), set(x, y, 1);
+      // A point on every fourth column's top (the slab's surface is its top, bottom and rim).
+      if (x % 2 == 0 && y % 2 == 0) {
+        SurfacePoint point;
+        point.xyz = grid.Centre(Eigen::Vector3i(x, y, 1));
+        points.push_back(point);
+      }
+    }
+  }
+  for (int z = 5; z < 8; ++z) {
+    for (int y = 4; y < 7; ++y) {
+      for (int x = 4; x < 7; ++x) set(x, y, z), set(x + 10, y + 10, z);
+    }
+  }
+  SurfacePoint on_cube;
+  on_cube.xyz = grid.Centre(Eigen::Vector3i(15, 15, 8));  // just above the second cube
+  points.push_back(on_cube);
+  set(20, 4, 6);
+  IncrementalCarver carver(views, Volume(grid, std::move(bits)), Options(24, 30.0));
+  const int64_t solid = carver.volume().num_solid();
+  int64_t components = 0;
+  double expected = 0.0;
+  // Asking for more points than the bare cube should hold keeps it.
+  EXPECT_EQ(carver.RemoveUnsupportedComponents(points, 100.0, &components, &expected), 0);
+  EXPECT_EQ(components, 0);
+  EXPECT_EQ(carver.RemoveUnsupportedComponents(points, 3.0, &components, &expected), 27);
+  EXPECT_EQ(components, 1);
+  EXPECT_GT(expected, 3.0);
+  EXPECT_LT(expected, 10.0);
+  EXPECT_EQ(carver.volume().num_solid(), solid - 27);
+  EXPECT_FALSE(carver.volume().IsSolid(Eigen::Vector3i(5, 5, 6)));
+  EXPECT_TRUE(carver.volume().IsSolid(Eigen::Vector3i(15, 15, 6)));
+  EXPECT_TRUE(carver.volume().IsSolid(Eigen::Vector3i(20, 4, 6)));
+  // The slab holds the points; without any point at all nothing is judged.
+  EXPECT_EQ(carver.RemoveUnsupportedComponents({}, 3.0, &components, &expected), 0);
+  // Rays that ended in the carved cube stepped on; the carving carries on from there.
+  for (int view = 0; view < static_cast<int>(views.size()); ++view) {
+    const RayImage& rays = carver.ray_visibility()->rays(view);
+    for (int pixel = 0; pixel < rays.num_pixels(); ++pixel) {
+      const int64_t voxel = rays.CurrentVoxel(pixel);
+      ASSERT_TRUE(voxel == RayImage::kNoVoxel || carver.volume().IsSolid(voxel)) << pixel;
+    }
+  }
+  while (carver.Step()) {
+  }
+}
+
 TEST(CarveVolume, LevelsOfDetailAndEvidenceOrderReachPhotoConsistentVolumesOfTheFinalGrid) {
   const SyntheticScene scene = Scene(6, 160, 120);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);

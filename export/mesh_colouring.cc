@@ -25,25 +25,6 @@ struct Sample {
   float weight;
 };
 
-// Bilinear sample of an RGB image at a COLMAP pixel position (pixel centres at +0.5); false
-// outside the image's centres.
-bool SampleBilinear(const cv::Mat& image, const Eigen::Vector2d& pixel, Eigen::Vector3f* colour) {
-  const double u = pixel.x() - 0.5, v = pixel.y() - 0.5;
-  if (!(u >= 0.0 && v >= 0.0 && u <= image.cols - 1 && v <= image.rows - 1)) return false;
-  const int c0 = std::min(static_cast<int>(u), image.cols - 2 < 0 ? 0 : image.cols - 2);
-  const int r0 = std::min(static_cast<int>(v), image.rows - 2 < 0 ? 0 : image.rows - 2);
-  const int c1 = std::min(c0 + 1, image.cols - 1), r1 = std::min(r0 + 1, image.rows - 1);
-  const float fu = static_cast<float>(u - c0), fv = static_cast<float>(v - r0);
-  const cv::Vec3b& p00 = image.at<cv::Vec3b>(r0, c0);
-  const cv::Vec3b& p01 = image.at<cv::Vec3b>(r0, c1);
-  const cv::Vec3b& p10 = image.at<cv::Vec3b>(r1, c0);
-  const cv::Vec3b& p11 = image.at<cv::Vec3b>(r1, c1);
-  for (int k = 0; k < 3; ++k) {
-    (*colour)[k] = (1 - fv) * ((1 - fu) * p00[k] + fu * p01[k]) + fv * ((1 - fu) * p10[k] + fu * p11[k]);
-  }
-  return true;
-}
-
 float WeightedMedian(std::vector<std::pair<float, float>>* values) {
   std::sort(values->begin(), values->end());
   float total = 0.0f;
@@ -80,15 +61,6 @@ Eigen::Vector3f RobustColour(const std::vector<Sample>& samples, double outlier_
 }
 
 }  // namespace
-
-bool SamplePhoto(const CalibratedView& view, const Eigen::Vector2d& pixel, Eigen::Vector3f* colour) {
-  const int col = static_cast<int>(std::floor(pixel.x()));
-  const int row = static_cast<int>(std::floor(pixel.y()));
-  if (col < 0 || row < 0 || col >= view.width || row >= view.height) return false;
-  if (view.valid.at<uint8_t>(row, col) == 0) return false;
-  if (!view.mask.empty() && view.mask.at<uint8_t>(row, col) == 0) return false;
-  return SampleBilinear(view.image, pixel, colour);
-}
 
 std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<CalibratedView>& views,
                                                              const TriangleMesh& mesh,

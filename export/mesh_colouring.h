@@ -1,5 +1,7 @@
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -59,9 +61,38 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
                                                              double rim_voxels = 1.0,
                                                              int num_threads = 0);
 
+// Bilinear sample of an RGB image (CV_8UC3) at a COLMAP pixel position (pixel centres at +0.5);
+// false outside the image's centres. (Inline: the mesh refinement calls it tens of millions of
+// times.)
+inline bool SampleBilinear(const cv::Mat& image, const Eigen::Vector2d& pixel, Eigen::Vector3f* colour) {
+  const double u = pixel.x() - 0.5, v = pixel.y() - 0.5;
+  if (!(u >= 0.0 && v >= 0.0 && u <= image.cols - 1 && v <= image.rows - 1)) return false;
+  const int c0 = std::min(static_cast<int>(u), image.cols - 2 < 0 ? 0 : image.cols - 2);
+  const int r0 = std::min(static_cast<int>(v), image.rows - 2 < 0 ? 0 : image.rows - 2);
+  const int c1 = std::min(c0 + 1, image.cols - 1), r1 = std::min(r0 + 1, image.rows - 1);
+  const float fu = static_cast<float>(u - c0), fv = static_cast<float>(v - r0);
+  const cv::Vec3b& p00 = image.at<cv::Vec3b>(r0, c0);
+  const cv::Vec3b& p01 = image.at<cv::Vec3b>(r0, c1);
+  const cv::Vec3b& p10 = image.at<cv::Vec3b>(r1, c0);
+  const cv::Vec3b& p11 = image.at<cv::Vec3b>(r1, c1);
+  for (int k = 0; k < 3; ++k) {
+    (*colour)[k] = (1 - fv) * ((1 - fu) * p00[k] + fu * p01[k]) + fv * ((1 - fu) * p10[k] + fu * p11[k]);
+  }
+  return true;
+}
+
+
 // The colour of `view`'s photo at a COLMAP pixel position, bilinear between pixel centres; false
 // where the position is outside the photo's data (invalid pixels) or, with a mask, off the object.
-bool SamplePhoto(const CalibratedView& view, const Eigen::Vector2d& pixel, Eigen::Vector3f* colour);
+inline bool SamplePhoto(const CalibratedView& view, const Eigen::Vector2d& pixel, Eigen::Vector3f* colour) {
+  const int col = static_cast<int>(std::floor(pixel.x()));
+  const int row = static_cast<int>(std::floor(pixel.y()));
+  if (col < 0 || row < 0 || col >= view.width || row >= view.height) return false;
+  if (view.valid.at<uint8_t>(row, col) == 0) return false;
+  if (!view.mask.empty() && view.mask.at<uint8_t>(row, col) == 0) return false;
+  return SampleBilinear(view.image, pixel, colour);
+}
+
 
 // Colours every vertex of `mesh` from the photos at their own resolution: in each view the mesh
 // is drawn with a depth buffer (RenderMesh) to find the vertices the view sees; each seen vertex

@@ -881,12 +881,16 @@ int RunCarve(int argc, char** argv) {
     }
     level_line += text;
   }
+  std::string floater_text;
+  if (s.unsupported_components > 0) {
+    floater_text = ", " + std::to_string(s.unsupported_component_carved) + " in " +
+                   std::to_string(s.unsupported_components) + " floaters without sparse points";
+  }
   std::printf(
       "\ncarved %s\n"
       "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
       "  carved          %lld voxels (%lld by the visual hull of %d masked views, %lld by the "
-      "sparse points' sight lines, %lld in specks, %lld in %lld floaters without sparse points), "
-      "%lld evaluations\n"
+      "sparse points' sight lines, %lld in specks%s), %lld evaluations\n"
       "  levels          %zu (%s)\n"
       "  convergence     %.2f s (+ %.2f s set-up) on %d %s, carving structures' peak %.1f MiB\n"
       "  process memory  %.1f MiB at its peak (resident: photos, views, grid, mesh)\n"
@@ -901,9 +905,8 @@ int RunCarve(int argc, char** argv) {
       static_cast<long long>(s.num_voxels), static_cast<long long>(s.carved),
       static_cast<long long>(s.visual_hull_carved), s.views_with_masks,
       static_cast<long long>(s.free_space_level0_carved),
-      static_cast<long long>(s.component_carved),
-      static_cast<long long>(s.unsupported_component_carved),
-      static_cast<long long>(s.unsupported_components), static_cast<long long>(s.evaluated),
+      static_cast<long long>(s.component_carved), floater_text.c_str(),
+      static_cast<long long>(s.evaluated),
       s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds, s.threads,
       s.threads == 1 ? "thread" : "threads", s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,

@@ -1177,7 +1177,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   Clock::time_point start;  // when the first level's carving began
   double next_report = progress_interval_seconds;
   double next_sample = 0.0;
-  int64_t pre_carved = 0;  // the first level's visual hull, in final voxels
+  int64_t hull_carved = 0;  // the first level's visual hull, in final voxels
   std::unique_ptr<IncrementalCarver> carver;
   std::vector<CalibratedView> reduced_views;  // the photos of a coarse level, when reduced
   auto add_worker_times = [&statistics](const IncrementalCarver& level_carver) {
@@ -1258,9 +1258,9 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       statistics.visual_hull_seconds = carver->visual_hull().seconds;
       statistics.free_space_level0_carved = carver->free_space().carved;
       statistics.setup_seconds = SecondsSince(level_start);
-      // The curve leaves out what the visual hull carved (the sparse points' sight lines are its
-      // first value).
-      pre_carved = std::min(final_grid.num_voxels(), carver->visual_hull().carved * scale);
+      // The curve leaves out what the visual hull carved; the sparse points' sight lines are in
+      // its first value.
+      hull_carved = std::min(final_grid.num_voxels(), carver->visual_hull().carved * scale);
       if (options.decision == CarveDecision::kReprojection) {
         statistics.reprojection_error_before = carver->MeanReprojectionError();
       }
@@ -1270,7 +1270,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       const int64_t removed = std::max<int64_t>(
           0, final_grid.num_voxels() - std::min(final_grid.num_voxels(),
                                                 carver->volume().num_solid() * scale));
-      statistics.curve.push_back({seconds, std::max<int64_t>(0, removed - pre_carved),
+      statistics.curve.push_back({seconds, std::max<int64_t>(0, removed - hull_carved),
                                   statistics.evaluated + carver->evaluated()});
     };
     sample(SecondsSince(start));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -122,6 +123,10 @@ bool ModelMeshOptions::IsValid(std::string* reason) const {
     *reason = "mesh minimum component size must be >= 0";
     return false;
   }
+  if (final_smoothing_iterations < 0) {
+    *reason = "mesh final smoothing iterations must be >= 0";
+    return false;
+  }
   if (refine_passes < 0) {
     *reason = "mesh refinement passes must be >= 0";
     return false;
@@ -150,6 +155,19 @@ std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid&
     }
   }
   return on_wall;
+}
+
+std::string FinalSmoothingSummary(const ModelMesh& model, const ModelMeshOptions& options) {
+  if (options.final_smoothing_iterations == 0 || model.refinement.passes == 0) {
+    return "mesh final smoothing: none";
+  }
+  char text[200];
+  std::snprintf(text, sizeof(text),
+                "mesh final smoothing: %d passes, applied by the share the photos leave open "
+                "(mean %.0f%%); vertices moved %.3g on average",
+                options.final_smoothing_iterations, 100.0 * (1.0 - model.refinement.mean_pinned),
+                model.final_smoothing_mean_move);
+  return text;
 }
 
 ModelMesh MeshCarvedModel(const CarveResult& result,
@@ -181,6 +199,20 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   refinement.num_threads = options.num_threads;
   if (refinement.passes > 0) {
     model.refinement = RefineMeshFromPhotos(views, refinement, &model.mesh);
+    if (options.final_smoothing_iterations > 0) {
+      // Smoothed where the photos leave the position open, kept where they pin it.
+      TriangleMesh smooth = model.mesh;
+      SmoothMesh(options.final_smoothing_iterations, geometry.smoothing_pass_band, &smooth);
+      double moved = 0.0;
+      for (size_t i = 0; i < model.mesh.vertices.size(); ++i) {
+        const float open = 1.0f - model.refinement.pinned[i];
+        const Eigen::Vector3f step = open * (smooth.vertices[i] - model.mesh.vertices[i]);
+        model.mesh.vertices[i] += step;
+        moved += step.norm();
+      }
+      model.final_smoothing_mean_move = moved / static_cast<double>(model.mesh.vertices.size());
+      ComputeVertexNormals(&model.mesh);
+    }
   }
   MeshColouringOptions colouring;
   colouring.min_views = options.min_views;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
 
 #include <glog/logging.h>
 
@@ -23,6 +24,15 @@ void TangentBasis(const Eigen::Vector3d& n, Eigen::Vector3d* u, Eigen::Vector3d*
       std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
   *u = n.cross(helper).normalized();
   *w = n.cross(*u);
+}
+
+// How firmly the costs of the offsets tried place a vertex (MeshRefinementSummary::pinned).
+float PinnedShare(double cost_sum, int costs, double best_cost, int best_terms) {
+  if (costs < 3 || best_terms < 1 || !(best_cost >= 0.0) || !std::isfinite(cost_sum)) return 0.0f;
+  const double mean_cost = cost_sum / costs;
+  const double standard_error = std::max(best_cost, 1e-9) * std::sqrt(2.0 / best_terms);
+  const double z = (mean_cost - best_cost) / standard_error;
+  return static_cast<float>(std::clamp((z - 1.0) / 2.0, 0.0, 1.0));
 }
 
 }  // namespace
@@ -57,10 +67,10 @@ std::string MeshRefinementSummary::Summary() const {
   std::snprintf(text, sizeof(text),
                 "mesh refinement: %d passes; in the last %lld of %lld vertices judged, %lld "
                 "moved (mean |offset| %.3g); mean offset per pass %.3g (|%.3g|) along the "
-                "normals, in %.2f s",
+                "normals; pinned by the photos %.0f%% (mean); in %.2f s",
                 passes, static_cast<long long>(judged), static_cast<long long>(vertices),
                 static_cast<long long>(moved), last_mean_abs_offset, mean_offset,
-                mean_abs_offset, seconds);
+                mean_abs_offset, 100.0 * mean_pinned, seconds);
   return text;
 }
 
@@ -91,6 +101,7 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
         options.num_threads);
     std::vector<float> offsets(n, 0.0f);
     std::vector<uint8_t> judged(n, 0), moved(n, 0);
+    summary.pinned.assign(n, 0.0f);
     const int threads = options.num_threads > 0 ? options.num_threads : ResolveNumThreads(-1);
     ParallelRanges(n, threads, /*min_per_thread=*/1024, [&](size_t begin, size_t end) {
     std::vector<Eigen::Vector3f> patch(static_cast<size_t>(kPatchSamples) * views.size());
@@ -115,6 +126,8 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
           Eigen::Vector3d::Zero(), options.patch_radius * u, -options.patch_radius * u,
           options.patch_radius * w, -options.patch_radius * w};
       double best_cost = std::numeric_limits<double>::infinity(), stay_cost = best_cost;
+      double cost_sum = 0.0;
+      int costs = 0, best_terms = 0;
       int best = options.steps_per_side;
       // A silhouette's rim holds the surface where the mask says: no moving inwards there.
       const int first_step = on_rim[i] ? options.steps_per_side : 0;
@@ -166,11 +179,15 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
         if (terms == 0) continue;
         cost /= terms;
         if (s == options.steps_per_side) stay_cost = cost;
+        cost_sum += cost;
+        ++costs;
         if (cost < best_cost) {
+          best_terms = terms;
           best_cost = cost;
           best = s;
         }
       }
+      summary.pinned[i] = PinnedShare(cost_sum, costs, best_cost, best_terms);
       if (best != options.steps_per_side && std::isfinite(stay_cost) &&
           best_cost < options.min_gain * stay_cost) {
         offsets[i] = static_cast<float>((best - options.steps_per_side) * step);
@@ -206,6 +223,21 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
     VLOG(1) << "mesh refinement pass " << pass + 1 << ": " << summary.judged << " judged, "
             << summary.moved << " moved, mean |offset| " << summary.last_mean_abs_offset;
     if (summary.last_mean_abs_offset < options.converged_offset) break;
+  }
+  if (!summary.pinned.empty()) {
+    // Averaged over neighbours as the offsets are: a blend that changes from vertex to vertex
+    // would make bumps of its own.
+    for (int s = 0; s < options.smoothing_passes; ++s) {
+      std::vector<float> smoothed(n);
+      for (size_t i = 0; i < n; ++i) {
+        double sum = summary.pinned[i];
+        for (int j : neighbours[i]) sum += summary.pinned[j];
+        smoothed[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
+      }
+      summary.pinned.swap(smoothed);
+    }
+    summary.mean_pinned =
+        std::accumulate(summary.pinned.begin(), summary.pinned.end(), 0.0) / static_cast<double>(n);
   }
   if (summary.passes > 0 && n > 0) {
     summary.mean_offset = offset_sum / (static_cast<double>(n) * summary.passes);

@@ -51,6 +51,16 @@ struct MeshRefinementSummary {
   double mean_offset = 0.0;  // signed, along the normal (negative: inwards), over all passes
   double mean_abs_offset = 0.0;
   double seconds = 0.0;
+  // Per vertex, from the last pass: how firmly the photos place it along its normal, 0-1. The
+  // cost at an offset is a mean of `m` squared colour deviations, so by chance alone it varies
+  // by about cost * sqrt(2 / m) (a sample variance's standard error). z is the margin by which
+  // the best offset's cost lies below the mean cost over the offsets tried, in those units:
+  // pinned = (z - 1) / 2 clamped to [0, 1], so a minimum within one standard error is noise (0)
+  // and one three or more below is the photos' (1); then averaged over neighbours as the
+  // offsets are (`smoothing_passes`), so that it changes smoothly over the mesh. Plain surfaces
+  // (the same colour at every offset) and vertices fewer than min_views photos see get 0.
+  std::vector<float> pinned;
+  double mean_pinned = 0.0;
   std::string Summary() const;
 };
 

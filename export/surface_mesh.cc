@@ -10,6 +10,7 @@
 #include <numeric>
 #include <unordered_map>
 
+#include <glog/logging.h>
 #include <pcl/PolygonMesh.h>
 #include <pcl/console/print.h>
 #include <pcl/conversions.h>
@@ -231,6 +232,45 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
   result.vertices = static_cast<int64_t>(mesh.vertices.size());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return mesh;
+}
+
+void SmoothMesh(int iterations, double pass_band, TriangleMesh* mesh) {
+  CHECK(iterations >= 0 && pass_band > 0.0 && pass_band <= 2.0);
+  if (iterations == 0 || mesh->triangles.empty()) return;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh->vertices.size()));
+  for (size_t i = 0; i < mesh->vertices.size(); ++i) {
+    const Eigen::Vector3f& v = mesh->vertices[i];
+    points->SetPoint(static_cast<vtkIdType>(i), v.x(), v.y(), v.z());
+  }
+  vtkNew<vtkCellArray> cells;
+  for (const Eigen::Vector3i& t : mesh->triangles) {
+    const vtkIdType ids[3] = {t[0], t[1], t[2]};
+    cells->InsertNextCell(3, ids);
+  }
+  vtkNew<vtkPolyData> poly;
+  poly->SetPoints(points);
+  poly->SetPolys(cells);
+  vtkNew<vtkWindowedSincPolyDataFilter> smoother;
+  smoother->SetInputData(poly);
+  smoother->SetNumberOfIterations(iterations);
+  smoother->SetPassBand(pass_band);
+  smoother->BoundarySmoothingOff();
+  smoother->FeatureEdgeSmoothingOff();
+  smoother->NonManifoldSmoothingOn();
+  smoother->NormalizeCoordinatesOn();
+  smoother->Update();
+  vtkPoints* smoothed = smoother->GetOutput()->GetPoints();
+  // The filter moves points and keeps their order.
+  CHECK(smoothed != nullptr &&
+        smoothed->GetNumberOfPoints() == static_cast<vtkIdType>(mesh->vertices.size()));
+  for (size_t i = 0; i < mesh->vertices.size(); ++i) {
+    double p[3];
+    smoothed->GetPoint(static_cast<vtkIdType>(i), p);
+    mesh->vertices[i] = Eigen::Vector3d(p[0], p[1], p[2]).cast<float>();
+  }
+  ComputeVertexNormals(mesh);
 }
 
 void ComputeVertexNormals(TriangleMesh* mesh) {

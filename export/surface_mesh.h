@@ -56,6 +56,11 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
                              const SurfaceMeshOptions& options,
                              SurfaceMeshSummary* summary = nullptr);
 
+// Windowed-sinc smoothing (as MeshSolidVoxels smooths the iso-surface) of an existing mesh's
+// vertices: `iterations` passes at `pass_band` (0-2; smaller smooths more). Vertices and
+// triangles keep their indices and count; normals are recomputed; colours are kept.
+void SmoothMesh(int iterations, double pass_band, TriangleMesh* mesh);
+
 // Sets every vertex normal to the area-weighted mean of its triangles' normals (the winding's
 // side), normalised; a vertex in no triangle of non-zero area keeps a zero normal.
 void ComputeVertexNormals(TriangleMesh* mesh);

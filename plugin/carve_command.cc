@@ -226,6 +226,7 @@ CarveRun CarveProject(const CarveRequest& request) {
     LOG(INFO) << model.geometry.Summary();
     if (!model.mesh.empty()) {
       LOG(INFO) << model.refinement.Summary();
+      LOG(INFO) << exporter::FinalSmoothingSummary(model, request.mesh);
       LOG(INFO) << model.colouring.Summary();
     }
     run.stage_seconds.emplace_back("mesh", SecondsSince(stage));
@@ -236,6 +237,7 @@ CarveRun CarveProject(const CarveRequest& request) {
     run.num_mesh_vertices = model.mesh.vertices.size();
     run.mesh_colouring = model.colouring;
     run.mesh_refinement = model.refinement;
+    run.mesh_final_smoothing_mean_move = model.final_smoothing_mean_move;
     run.mesh_small_components_removed = model.small_components_removed;
     run.mesh_grid_wall_vertices = model.grid_wall_vertices;
     // The cloud: the mesh's surface that --cloud_min_views or more photos see, and which ones, in COLMAP's
@@ -567,6 +569,10 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
         .Key("refinement_vertices_moved").Value(run.mesh_refinement.moved)
         .Key("refinement_mean_abs_offset_voxels")
         .Value(run.mesh_refinement.mean_abs_offset / run.result->volume.grid().voxel_size())
+        .Key("refinement_mean_pinned").Value(run.mesh_refinement.mean_pinned)
+        .Key("final_smoothing_iterations").Value(request.mesh.final_smoothing_iterations)
+        .Key("final_smoothing_mean_move_voxels")
+        .Value(run.mesh_final_smoothing_mean_move / run.result->volume.grid().voxel_size())
         .Key("vertices_coloured_from_photos").Value(c.from_photos)
         .Key("vertices_coloured_from_neighbours").Value(c.from_neighbours)
         .Key("vertices_uncoloured").Value(c.uncoloured)
@@ -718,6 +724,11 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->AddDefault("mesh_refine_passes", &request->mesh.refine_passes,
                      "smooth mesh: at most this many passes moving vertices along their normals "
                      "(up to a voxel each) to where the photos agree best (0: none)");
+  parser->AddDefault("mesh_final_smoothing", &request->mesh.final_smoothing_iterations,
+                     "smooth mesh: after refinement, windowed-sinc passes that smooth each vertex "
+                     "by the share the photos leave open (none where a clear cost minimum pins "
+                     "it; all over plain surfaces and where fewer than two photos see it); 0: "
+                     "none");
   parser->AddDefault("mesh_refine_converged", &request->mesh.refine_converged_voxels,
                      "smooth mesh: the refinement stops after a pass that moves the vertices by "
                      "less than this many voxels on average (0: run every pass)");

@@ -159,6 +159,7 @@ int RunHoldout(int argc, char** argv) {
       model = exporter::MeshCarvedModel(*result, training, request.mesh);
       LOG(INFO) << model.geometry.Summary();
       if (!model.mesh.empty()) LOG(INFO) << model.refinement.Summary();
+      if (!model.mesh.empty()) LOG(INFO) << exporter::FinalSmoothingSummary(model, request.mesh);
       if (!model.mesh.empty()) LOG(INFO) << model.colouring.Summary();
     }
   }

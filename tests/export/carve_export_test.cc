@@ -255,6 +255,65 @@ TEST(CarveExport, RefinementPassesStopWhenTheMeshStopsMoving) {
   EXPECT_LT(mean_truth_distance(one_mesh), mean_truth_distance(unrefined.mesh));
 }
 
+// Mean distance (voxels) from each vertex to the centroid of its neighbours: the mesh's bumps.
+double MeanRoughness(const TriangleMesh& mesh, double voxel) {
+  std::vector<Eigen::Vector3d> sum(mesh.vertices.size(), Eigen::Vector3d::Zero());
+  std::vector<int> count(mesh.vertices.size(), 0);
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      sum[t[k]] += mesh.vertices[t[(k + 1) % 3]].cast<double>();
+      ++count[t[k]];
+    }
+  }
+  double total = 0.0;
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    if (count[i] > 0) total += (mesh.vertices[i].cast<double>() - sum[i] / count[i]).norm();
+  }
+  return total / mesh.vertices.size() / voxel;
+}
+
+TEST(CarveExport, FinalSmoothingKeepsWhatThePhotosPinAndSmoothsThePlain) {
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(8, 320, 240));
+  const std::vector<CalibratedView> textured = testing::SceneViews(scene, /*with_masks=*/true);
+  CarveOptions carve;
+  carve.resolution = 64;
+  const CarveResult result = CarveVolume(textured, scene.object_box, carve);
+  const double voxel = result.volume.grid().voxel_size();
+  // The same cameras and silhouettes, every object pixel one grey: nothing to place a vertex by.
+  std::vector<CalibratedView> plain = textured;
+  for (CalibratedView& view : plain) {
+    view.image = cv::Mat(view.image.size(), view.image.type(), cv::Scalar(150, 150, 150));
+  }
+  ModelMeshOptions unsmoothed;
+  unsmoothed.final_smoothing_iterations = 0;
+  for (const bool is_plain : {false, true}) {
+    const std::vector<CalibratedView>& views = is_plain ? plain : textured;
+    const ModelMesh before = MeshCarvedModel(result, views, unsmoothed);
+    const ModelMesh after = MeshCarvedModel(result, views, ModelMeshOptions());
+    ASSERT_FALSE(after.mesh.empty());
+    ASSERT_EQ(after.refinement.pinned.size(), after.mesh.vertices.size());
+    for (float pinned : after.refinement.pinned) {
+      ASSERT_GE(pinned, 0.0f);
+      ASSERT_LE(pinned, 1.0f);
+    }
+    EXPECT_TRUE(AnalyseTopology(after.mesh).IsClosedManifold());
+    const double rough_before = MeanRoughness(before.mesh, voxel);
+    const double rough_after = MeanRoughness(after.mesh, voxel);
+    std::cout << (is_plain ? "plain" : "textured") << " photos: pinned " << after.refinement.mean_pinned
+              << ", final smoothing moved " << after.final_smoothing_mean_move / voxel
+              << " voxels on average; roughness " << rough_before << " -> " << rough_after
+              << " voxels\n";
+    EXPECT_LT(rough_after, rough_before);
+    if (is_plain) {
+      // Every offset costs the same: nothing pins a vertex, and the whole mesh is smoothed.
+      EXPECT_LT(after.refinement.mean_pinned, 0.01);
+      EXPECT_LT(rough_after, 0.8 * rough_before);
+    } else {
+      EXPECT_GT(after.refinement.mean_pinned, 0.3);
+    }
+  }
+}
+
 TEST(CarveExport, TheGridsWallsAreMarkedAndLeftOutOfTheCloud) {
   // A slab filling the grid's lower third, as a ground running on beyond the volume's box: its
   // top is surface, its sides and bottom are where the box cuts it. A cube floats above it.

@@ -83,7 +83,8 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
                  [&](size_t first, size_t last) {
     for (size_t v = first; v < last; ++v) {
       const CalibratedView& view = views[v];
-      const Rendering drawn = RenderMesh(shape, view);
+      // The mesh is closed (MeshSolidVoxels) and the cameras outside it: front faces suffice.
+      const Rendering drawn = RenderMesh(shape, view, /*front_faces_only=*/true);
       // Distance (pixels) from each object pixel to the nearest background pixel.
       cv::Mat to_background;
       if (on_rim != nullptr && !view.mask.empty() && voxel_size > 0.0) {

@@ -47,7 +47,9 @@ struct VertexSighting {
   uint32_t view = 0;
   float facing = 0.0f;
 };
-// Per vertex, the views that see it, in increasing view order. Needs mesh.normals.
+// Per vertex, the views that see it, in increasing view order. Needs mesh.normals, and a closed
+// mesh wound as MeshSolidVoxels winds it, seen from outside: the depth buffer is drawn from the
+// front faces alone (RenderMesh's front_faces_only).
 // `on_rim`, when given, gets per vertex whether it lies on a silhouette's rim: in some view with
 // a mask it is not hidden (at most depth_tolerance behind the mesh's depth, facing or not) and
 // projects onto an object pixel within `rim_voxels` voxel widths (`voxel_size`, projected at

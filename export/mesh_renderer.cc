@@ -7,7 +7,7 @@
 namespace raycarve {
 namespace exporter {
 
-Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view) {
+Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view, bool front_faces_only) {
   Rendering rendering;
   rendering.image = cv::Mat(view.height, view.width, CV_8UC3, cv::Scalar::all(0));
   rendering.silhouette = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
@@ -42,6 +42,9 @@ Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view) {
     if (row_min > row_max) continue;
     const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
     if (!(std::abs(area) > 1e-12)) continue;
+    // Pixels run right and down as the camera's x and y, so a triangle whose outward side faces
+    // the camera (its normal towards the camera, -z) winds clockwise on the screen: area < 0.
+    if (front_faces_only && area > 0.0) continue;
     const double inverse_area = 1.0 / area;
     // Barycentric weights of (x, y), screen space: w0 = e0 + x * dx0 + y * dy0, likewise w1;
     // w2 = 1 - w0 - w1.

@@ -12,8 +12,13 @@ namespace exporter {
 // a triangle's projection, takes the depth of the nearest such triangle along the optical axis,
 // and the perspective-correct blend of its vertices' colours (grey 128 where the mesh has none).
 // Triangles with a vertex at or behind the camera plane are skipped. Both sides are drawn, so a
-// mesh's inside never shows through a hole. Cost: the triangles' projected area.
-Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view);
+// mesh's inside never shows through a hole, unless `front_faces_only`: then triangles whose
+// winding (counter-clockwise seen from outside, as MeshSolidVoxels makes them) faces away from
+// the camera are skipped. For a closed mesh and a camera outside it that gives the same depth
+// buffer in about half the time: the first surface a ray meets is one it enters, which faces
+// the camera. Cost: the triangles' projected area.
+Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view,
+                     bool front_faces_only = false);
 
 }  // namespace exporter
 }  // namespace raycarve

@@ -84,6 +84,59 @@ TEST(RenderMesh, TrianglesReachingBehindTheCameraAreSkipped) {
   EXPECT_EQ(cv::countNonZero(rendering.silhouette), 0);
 }
 
+TEST(RenderMesh, FrontFacesAloneGiveAClosedMeshsDepthBuffer) {
+  // A smoothed ball with a dent and a knob (a concave region and a second silhouette), as
+  // MeshSolidVoxels makes it: closed, counter-clockwise seen from outside.
+  const VoxelGrid grid(Eigen::AlignedBox3d(Eigen::Vector3d::Constant(-1), Eigen::Vector3d::Constant(1)), 40);
+  std::vector<uint64_t> bits((grid.num_voxels() + 63) / 64, 0);
+  for (int64_t i = 0; i < grid.num_voxels(); ++i) {
+    const Eigen::Vector3d p = grid.Centre(grid.Voxel(i));
+    const bool ball = p.norm() <= 0.6 && (p - Eigen::Vector3d(0.0, 0.0, -0.6)).norm() > 0.25;
+    const bool knob = (p - Eigen::Vector3d(0.55, -0.4, -0.3)).norm() <= 0.2;
+    if (ball || knob) bits[i / 64] |= uint64_t{1} << (i % 64);
+  }
+  const TriangleMesh mesh = MeshSolidVoxels(Volume(grid, std::move(bits)), SurfaceMeshOptions());
+  ASSERT_GT(mesh.triangles.size(), 1000u);
+  // Views from several sides, each at distance 3 looking at the origin.
+  int pixels = 0, differing = 0;
+  for (const Eigen::Vector3d& centre :
+       {Eigen::Vector3d(0, 0, -3), Eigen::Vector3d(2.1, 0.5, -2.1), Eigen::Vector3d(0, -3, 0.2),
+        Eigen::Vector3d(-2.5, 1.0, 1.3)}) {
+    CalibratedView view = Straight();
+    view.width = 160;
+    view.height = 120;
+    view.K << 120, 0, 80, 0, 120, 60, 0, 0, 1;
+    const Eigen::Vector3d forward = -centre.normalized();
+    const Eigen::Vector3d right = forward.cross(Eigen::Vector3d(0.3, 1, 0.1)).normalized();
+    const Eigen::Vector3d down = forward.cross(right);
+    Eigen::Matrix3d rotation;
+    rotation << right.transpose(), down.transpose(), forward.transpose();
+    view.cam_from_world.rotation = Eigen::Quaterniond(rotation);
+    view.cam_from_world.translation = -rotation * centre;
+    view.centre = centre;
+    view.P = view.K * view.cam_from_world.ToMatrix();
+    const Rendering both = RenderMesh(mesh, view);
+    const Rendering front = RenderMesh(mesh, view, /*front_faces_only=*/true);
+    ASSERT_GT(cv::countNonZero(both.silhouette), 1000);
+    for (int row = 0; row < view.height; ++row) {
+      for (int col = 0; col < view.width; ++col) {
+        ++pixels;
+        differing += both.depth.at<float>(row, col) != front.depth.at<float>(row, col);
+      }
+    }
+  }
+  EXPECT_EQ(differing, 0) << "of " << pixels << " pixels";
+  // A triangle turned away from the camera is drawn only with both sides.
+  const CalibratedView view = Straight();
+  TriangleMesh facing;
+  facing.vertices = {Unproject(view, 10, 5, 4), Unproject(view, 30, 5, 4), Unproject(view, 20, 25, 4)};
+  facing.triangles = {{0, 2, 1}};  // clockwise on the screen: its normal points to the camera
+  EXPECT_GT(cv::countNonZero(RenderMesh(facing, view, true).silhouette), 0);
+  facing.triangles = {{0, 1, 2}};
+  EXPECT_EQ(cv::countNonZero(RenderMesh(facing, view, true).silhouette), 0);
+  EXPECT_GT(cv::countNonZero(RenderMesh(facing, view).silhouette), 0);
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

@@ -8,11 +8,6 @@
 
 namespace raycarve {
 
-Eigen::Vector2d CalibratedView::Project(const Eigen::Vector3d& world) const {
-  const Eigen::Vector3d projected = P * world.homogeneous();
-  return projected.hnormalized();
-}
-
 double CalibratedView::Depth(const Eigen::Vector3d& world) const {
   return (cam_from_world * world).z();
 }

@@ -27,7 +27,10 @@ struct CalibratedView {
   cv::Mat mask;   // CV_8UC1, 255 on the object and 0 on background; empty when no mask is known
 
   // Pixel (COLMAP convention) of a world point; meaningless for points with Depth() <= 0.
-  Eigen::Vector2d Project(const Eigen::Vector3d& world) const;
+  // (Inline: the mesh's refinement projects tens of millions of points.)
+  Eigen::Vector2d Project(const Eigen::Vector3d& world) const {
+    return (P * world.homogeneous()).hnormalized();
+  }
   // Depth along the optical axis (camera z) of a world point.
   double Depth(const Eigen::Vector3d& world) const;
   // Maps homogeneous COLMAP pixel coordinates (x, y, 1) to the world direction of their ray

@@ -60,7 +60,7 @@ struct ModelMeshOptions {
   // 1 - MeshRefinementSummary::pinned. Where the photos place a vertex (texture, a clear cost
   // minimum) it stays; over plain surfaces and where too few photos see it, the voxels' bumps
   // the carve left are smoothed out. 0: none. Held-out PSNR of the mesh at 128 voxels, defaults
-  // otherwise: +0.10 to +0.60 dB on the six Middlebury models; on the generated scenes the
+  // otherwise: +0.09 to +0.58 dB on the six Middlebury models; on the generated scenes the
   // objects' precision rises at 128 voxels and falls at 256 (docs/mesh.md).
   int final_smoothing_iterations = 40;
   // Pieces of the iso-surface with fewer vertices than this go before refinement: specks, and

@@ -164,7 +164,7 @@ TEST(RescaledCamera, APointProjectsToItsPixelScaledForEveryModel) {
     const Camera half = RescaledCamera(camera, 2000, 1500);
     EXPECT_EQ(half.width, 2000u);
     EXPECT_EQ(half.height, 1500u);
-    for (const Eigen::Vector2d normalized :
+    for (const Eigen::Vector2d& normalized :
          {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(0.21, -0.13), Eigen::Vector2d(-0.4, 0.3)}) {
       const Eigen::Vector2d full = camera.ImgFromCam(normalized);
       const Eigen::Vector2d reduced = half.ImgFromCam(normalized);

@@ -36,7 +36,9 @@ TEST(SegmentVoxels, ListsEveryVoxelTheSegmentPassesThroughAndNoOther) {
     for (size_t i = 0; i < listed.size(); ++i) {
       const Eigen::Vector3i voxel = grid.Voxel(listed[i]);
       EXPECT_TRUE(SegmentMeetsVoxel(grid, voxel, a, b, 1e-9 * grid.voxel_size()));
-      if (i > 0) EXPECT_EQ((voxel - grid.Voxel(listed[i - 1])).cwiseAbs().sum(), 1);
+      if (i > 0) {
+        EXPECT_EQ((voxel - grid.Voxel(listed[i - 1])).cwiseAbs().sum(), 1);
+      }
     }
     // Every point sampled along the segment inside the grid lies in a listed voxel.
     for (int s = 0; s <= 2000; ++s) {

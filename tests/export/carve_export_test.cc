@@ -204,12 +204,25 @@ TEST(CarveExport, TheSmoothMeshIsClosedAndNearerTheTruthAndItsPhotoColoursBeatVo
   EXPECT_LT(mesh_error, 0.9 * voxel_error);
 }
 
-TEST(CarveExport, RefinementPassesStopWhenTheMeshStopsMoving) {
+// The generated scene in 8 views of 320x240 with its masks, carved at 64 voxels (the library's
+// defaults otherwise).
+struct MaskedCarve {
+  std::vector<CalibratedView> views;
+  CarveResult result;
+};
+MaskedCarve CarveMaskedScene() {
   const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(8, 320, 240));
-  const std::vector<CalibratedView> views = testing::SceneViews(scene, /*with_masks=*/true);
+  std::vector<CalibratedView> views = testing::SceneViews(scene, /*with_masks=*/true);
   CarveOptions carve;
   carve.resolution = 64;
-  const CarveResult result = CarveVolume(views, scene.object_box, carve);
+  CarveResult result = CarveVolume(views, scene.object_box, carve);
+  return MaskedCarve{std::move(views), std::move(result)};
+}
+
+TEST(CarveExport, RefinementPassesStopWhenTheMeshStopsMoving) {
+  const MaskedCarve carved = CarveMaskedScene();
+  const std::vector<CalibratedView>& views = carved.views;
+  const CarveResult& result = carved.result;
   const double voxel = result.volume.grid().voxel_size();
   ModelMeshOptions options;
   options.refine_passes = 0;
@@ -273,11 +286,9 @@ double MeanRoughness(const TriangleMesh& mesh, double voxel) {
 }
 
 TEST(CarveExport, FinalSmoothingKeepsWhatThePhotosPinAndSmoothsThePlain) {
-  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(8, 320, 240));
-  const std::vector<CalibratedView> textured = testing::SceneViews(scene, /*with_masks=*/true);
-  CarveOptions carve;
-  carve.resolution = 64;
-  const CarveResult result = CarveVolume(textured, scene.object_box, carve);
+  const MaskedCarve carved = CarveMaskedScene();
+  const std::vector<CalibratedView>& textured = carved.views;
+  const CarveResult& result = carved.result;
   const double voxel = result.volume.grid().voxel_size();
   // The same cameras and silhouettes, every object pixel one grey: nothing to place a vertex by.
   std::vector<CalibratedView> plain = textured;

@@ -26,6 +26,22 @@ void TangentBasis(const Eigen::Vector3d& n, Eigen::Vector3d* u, Eigen::Vector3d*
   *w = n.cross(*u);
 }
 
+// `passes` times, each value becomes the mean of itself and its neighbours' (a vertex listed once
+// per triangle edge it shares).
+void AverageOverNeighbours(const std::vector<std::vector<int>>& neighbours, int passes,
+                           std::vector<float>* values) {
+  const size_t n = values->size();
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<float> averaged(n);
+    for (size_t i = 0; i < n; ++i) {
+      double sum = (*values)[i];
+      for (int j : neighbours[i]) sum += (*values)[j];
+      averaged[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
+    }
+    values->swap(averaged);
+  }
+}
+
 // How firmly the costs of the offsets tried place a vertex (MeshRefinementSummary::pinned).
 float PinnedShare(double cost_sum, int costs, double best_cost, int best_terms) {
   if (costs < 3 || best_terms < 1 || !(best_cost >= 0.0) || !std::isfinite(cost_sum)) return 0.0f;
@@ -201,15 +217,7 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
     });
     summary.judged = std::count(judged.begin(), judged.end(), 1);
     summary.moved = std::count(moved.begin(), moved.end(), 1);
-    for (int s = 0; s < options.smoothing_passes; ++s) {
-      std::vector<float> smoothed(n);
-      for (size_t i = 0; i < n; ++i) {
-        double sum = offsets[i];
-        for (int j : neighbours[i]) sum += offsets[j];
-        smoothed[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
-      }
-      offsets.swap(smoothed);
-    }
+    AverageOverNeighbours(neighbours, options.smoothing_passes, &offsets);
     double pass_abs_sum = 0.0;
     for (size_t i = 0; i < n; ++i) {
       mesh->vertices[i] += offsets[i] * mesh->normals[i];
@@ -227,15 +235,7 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
   if (!summary.pinned.empty()) {
     // Averaged over neighbours as the offsets are: a blend that changes from vertex to vertex
     // would make bumps of its own.
-    for (int s = 0; s < options.smoothing_passes; ++s) {
-      std::vector<float> smoothed(n);
-      for (size_t i = 0; i < n; ++i) {
-        double sum = summary.pinned[i];
-        for (int j : neighbours[i]) sum += summary.pinned[j];
-        smoothed[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
-      }
-      summary.pinned.swap(smoothed);
-    }
+    AverageOverNeighbours(neighbours, options.smoothing_passes, &summary.pinned);
     summary.mean_pinned =
         std::accumulate(summary.pinned.begin(), summary.pinned.end(), 0.0) / static_cast<double>(n);
   }

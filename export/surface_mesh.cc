@@ -85,6 +85,21 @@ TriangleMesh FromPolyData(vtkPolyData* poly) {
   return mesh;
 }
 
+// VTK's windowed-sinc smoothing of a triangle surface, as every mesh here is smoothed: interior
+// vertices only move, feature edges are not held, non-manifold vertices are smoothed too.
+vtkSmartPointer<vtkPolyData> WindowedSinc(vtkPolyData* surface, int iterations, double pass_band) {
+  vtkNew<vtkWindowedSincPolyDataFilter> smoother;
+  smoother->SetInputData(surface);
+  smoother->SetNumberOfIterations(iterations);
+  smoother->SetPassBand(pass_band);
+  smoother->BoundarySmoothingOff();
+  smoother->FeatureEdgeSmoothingOff();
+  smoother->NonManifoldSmoothingOn();
+  smoother->NormalizeCoordinatesOn();
+  smoother->Update();
+  return smoother->GetOutput();
+}
+
 }  // namespace
 
 bool SurfaceMeshOptions::IsValid(std::string* reason) const {
@@ -162,16 +177,7 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
   result.iso_surface_triangles = surface->GetNumberOfPolys();
 
   if (options.smoothing_iterations > 0) {
-    vtkNew<vtkWindowedSincPolyDataFilter> smoother;
-    smoother->SetInputData(surface);
-    smoother->SetNumberOfIterations(options.smoothing_iterations);
-    smoother->SetPassBand(options.smoothing_pass_band);
-    smoother->BoundarySmoothingOff();
-    smoother->FeatureEdgeSmoothingOff();
-    smoother->NonManifoldSmoothingOn();
-    smoother->NormalizeCoordinatesOn();
-    smoother->Update();
-    surface = smoother->GetOutput();
+    surface = WindowedSinc(surface, options.smoothing_iterations, options.smoothing_pass_band);
   }
 
   if (options.max_edge_length > 0.0) {
@@ -252,16 +258,8 @@ void SmoothMesh(int iterations, double pass_band, TriangleMesh* mesh) {
   vtkNew<vtkPolyData> poly;
   poly->SetPoints(points);
   poly->SetPolys(cells);
-  vtkNew<vtkWindowedSincPolyDataFilter> smoother;
-  smoother->SetInputData(poly);
-  smoother->SetNumberOfIterations(iterations);
-  smoother->SetPassBand(pass_band);
-  smoother->BoundarySmoothingOff();
-  smoother->FeatureEdgeSmoothingOff();
-  smoother->NonManifoldSmoothingOn();
-  smoother->NormalizeCoordinatesOn();
-  smoother->Update();
-  vtkPoints* smoothed = smoother->GetOutput()->GetPoints();
+  const vtkSmartPointer<vtkPolyData> output = WindowedSinc(poly, iterations, pass_band);
+  vtkPoints* smoothed = output->GetPoints();
   // The filter moves points and keeps their order.
   CHECK(smoothed != nullptr &&
         smoothed->GetNumberOfPoints() == static_cast<vtkIdType>(mesh->vertices.size()));

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <numeric>
 #include <sstream>
 #include <unordered_map>
 
@@ -35,8 +36,10 @@ constexpr double kBytesPerLayeredPixel = 4.0 + 4 * 12.0;
 // Solid, surface and in-queue bits, plus a generous byte for the CVSVL's entries.
 constexpr double kBytesPerVoxel = 3.0 / 8.0 + 1.0;
 constexpr double kBytesPerListedVoxel = kBytesPerVoxel + 4.0;
-// Batched carving: voxels a group claims at once for judging (see ClaimItems).
+// Batched carving: voxels a group claims at once for judging (see ClaimItems), and the tasks
+// between two sortings of the views by their cost (SortViewsByCost).
 constexpr int kClaimChunk = 8;
+constexpr int kSortTasks = 64;
 
 int64_t ElapsedNanoseconds(Clock::time_point since) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - since).count();
@@ -493,7 +496,8 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
   if (batched_) {
     view_buffers_.resize(views.size());
     view_claimed_ = std::make_unique<std::atomic<uint8_t>[]>(views.size());
-    for (int view = 0; view < static_cast<int>(views.size()); ++view) claim_order_.push_back(view);
+    claim_order_.resize(views.size());
+    std::iota(claim_order_.begin(), claim_order_.end(), 0);
   }
   if (options.incremental_statistics) {
     CHECK(ray_visibility_ != nullptr) << "incremental statistics need ray casting";
@@ -726,7 +730,6 @@ void IncrementalCarver::FormBatch(Batch* batch) {
     }
     batch->Add(voxel, volume_.grid());
   }
-  batch->views.resize(batch->entries.size() * views_.size());
 }
 
 void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* finding,
@@ -736,41 +739,48 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
     ViewBuffers& buffers = view_buffers_[view];
     if (carving != nullptr) {
       const std::vector<PixelRef>& vis = buffers.vis[carving_slot];
+      const std::vector<Span>& spans = buffers.spans[carving_slot];
       buffers.reached.clear();
+      buffers.reached_spans.clear();
       for (int k : batch_carved_) {
-        BatchView& at = carving->At(view, k);
-        at.reached_begin = buffers.reached.size();
-        ray_visibility_->AdvanceRays(vis.data() + at.vis_begin, vis.data() + at.vis_end,
+        const size_t begin = buffers.reached.size();
+        ray_visibility_->AdvanceRays(vis.data() + spans[k].begin, vis.data() + spans[k].end,
                                      &buffers.reached);
-        at.reached_end = at.reached_begin + KeepFirstOccurrences(
-            buffers.reached.data() + at.reached_begin, buffers.reached.size() - at.reached_begin);
-        buffers.reached.resize(at.reached_end);
+        const size_t kept =
+            KeepFirstOccurrences(buffers.reached.data() + begin, buffers.reached.size() - begin);
+        buffers.reached.resize(begin + kept);
+        buffers.reached_spans.push_back(
+            {static_cast<uint32_t>(begin), static_cast<uint32_t>(begin + kept)});
       }
     }
     if (finding != nullptr) {
       std::vector<PixelRef>& vis = buffers.vis[finding_slot];
+      std::vector<Span>& spans = buffers.spans[finding_slot];
+      std::vector<BatchHit>& hits = buffers.hits[finding_slot];
       vis.clear();
-      const size_t num_entries = finding->entries.size();
-      BatchView* views = finding->views.data() + static_cast<size_t>(view) * num_entries;
-      for (size_t k = 0; k < num_entries; ++k) {
-        BatchView& at = views[k];
-        at.vis_begin = vis.size();
+      hits.clear();
+      const int num_entries = static_cast<int>(finding->entries.size());
+      spans.resize(num_entries);
+      for (int k = 0; k < num_entries; ++k) {
+        Span& span = spans[k];
+        span.begin = static_cast<uint32_t>(vis.size());
         ray_visibility_->ComputeVisInView(finding->entries[k].coordinates, view, &vis);
-        at.vis_end = vis.size();
-        at.stats.count = 0;  // most views see none of a voxel: the rest stays as it was
-        if (at.vis_end == at.vis_begin) continue;
-        at.stats = ViewColourStats();
-        at.stats.view = view;
-        for (size_t p = at.vis_begin; p < at.vis_end; ++p) at.stats.Add(PixelColour(vis[p]));
+        span.end = static_cast<uint32_t>(vis.size());
+        if (span.end == span.begin) continue;  // most views see none of a voxel
+        BatchHit& hit = hits.emplace_back();
+        hit.k = k;
+        hit.stats.view = view;
+        for (uint32_t p = span.begin; p < span.end; ++p) hit.stats.Add(PixelColour(vis[p]));
       }
     }
     buffers.nanoseconds += ElapsedNanoseconds(start);
   };
   ClaimViews(workers_, claim_order_, view_claimed_.get(), work);
-  SortViewsByCost();
+  if (++tasks_since_sort_ >= kSortTasks) SortViewsByCost();
 }
 
 void IncrementalCarver::SortViewsByCost() {
+  tasks_since_sort_ = 0;
   std::stable_sort(claim_order_.begin(), claim_order_.end(), [this](int a, int b) {
     return view_buffers_[a].nanoseconds > view_buffers_[b].nanoseconds;
   });
@@ -779,38 +789,61 @@ void IncrementalCarver::SortViewsByCost() {
 
 void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
   const int num_views = static_cast<int>(views_.size());
-  auto judge = [&](int k, int group) {
+  // Judges entries [first, last): each view's hits, in batch order, are walked alongside.
+  auto judge = [&](int first, int last, int group) {
     std::vector<ViewColourStats>& stats = groups_[group].stats;
-    stats.clear();
-    BatchEntry& entry = batch->entries[k];
-    entry.num_pixels = 0;
+    std::vector<const BatchHit*>& next = groups_[group].next_hit;
+    next.resize(num_views);
     for (int view = 0; view < num_views; ++view) {
-      const BatchView& at = batch->At(view, k);
-      if (at.stats.count == 0) continue;
-      stats.push_back(at.stats);
-      entry.num_pixels += at.stats.count;
+      const std::vector<BatchHit>& hits = view_buffers_[view].hits[slot];
+      next[view] = hits.data() + (std::lower_bound(hits.begin(), hits.end(), first,
+                                                   [](const BatchHit& h, int key) {
+                                                     return h.k < key;
+                                                   }) -
+                                  hits.begin());
     }
-    entry.consistency = Judge(entry.voxel, stats);
-    entry.carve = !entry.consistency.consistent;
-    entry.kept_protected = false;
-    if (entry.carve && (IsProtected(entry.voxel) || BehindKnownSurface(entry.voxel, stats))) {
-      entry.carve = false;
-      entry.kept_protected = true;
-    }
-    if (colouring) {
-      // The pixels' distance to the voxel's colour, summed view by view in pixel order.
-      double error = 0.0;
+    for (int k = first; k < last; ++k) {
+      stats.clear();
+      BatchEntry& entry = batch->entries[k];
+      entry.num_pixels = 0;
       for (int view = 0; view < num_views; ++view) {
-        const BatchView& at = batch->At(view, k);
-        const std::vector<PixelRef>& vis = view_buffers_[view].vis[slot];
-        for (size_t p = at.vis_begin; p < at.vis_end; ++p) {
-          error += (PixelColour(vis[p]) - entry.consistency.colour).norm();
-        }
+        const std::vector<BatchHit>& hits = view_buffers_[view].hits[slot];
+        const BatchHit* hit = next[view];
+        if (hit == hits.data() + hits.size() || hit->k != k) continue;
+        stats.push_back(hit->stats);
+        entry.num_pixels += hit->stats.count;
+        ++next[view];
       }
-      entry.reprojection_error = error;
+      entry.consistency = Judge(entry.voxel, stats);
+      entry.carve = !entry.consistency.consistent;
+      entry.kept_protected = false;
+      if (entry.carve && (IsProtected(entry.voxel) || BehindKnownSurface(entry.voxel, stats))) {
+        entry.carve = false;
+        entry.kept_protected = true;
+      }
+      if (colouring) {
+        // The pixels' distance to the voxel's colour, summed view by view in pixel order.
+        double error = 0.0;
+        for (int view = 0; view < num_views; ++view) {
+          const ViewBuffers& buffers = view_buffers_[view];
+          const Span& span = buffers.spans[slot][k];
+          for (uint32_t p = span.begin; p < span.end; ++p) {
+            error += (PixelColour(buffers.vis[slot][p]) - entry.consistency.colour).norm();
+          }
+        }
+        entry.reprojection_error = error;
+      }
     }
   };
-  ClaimItems(workers_, static_cast<int>(batch->entries.size()), kClaimChunk, judge);
+  const int count = static_cast<int>(batch->entries.size());
+  if (!colouring && !patterns_) {
+    judge(0, count, 0);
+    return;
+  }
+  const int chunks = (count + kClaimChunk - 1) / kClaimChunk;
+  ClaimItems(workers_, chunks, 1, [&](int chunk, int group) {
+    judge(chunk * kClaimChunk, std::min(count, (chunk + 1) * kClaimChunk), group);
+  });
 }
 
 void IncrementalCarver::ReturnPendingBatch() {
@@ -857,11 +890,11 @@ bool IncrementalCarver::StepBatch() {
   }
   // Queued carved voxel by carved voxel, view by view: the same for any number of groups.
   const int num_views = static_cast<int>(views_.size());
-  for (int k : batch_carved_) {
+  for (size_t j = 0; j < batch_carved_.size(); ++j) {
     for (int view = 0; view < num_views; ++view) {
-      const BatchView& at = current.At(view, k);
-      const std::vector<int64_t>& reached = view_buffers_[view].reached;
-      for (size_t p = at.reached_begin; p < at.reached_end; ++p) Enqueue(reached[p]);
+      const ViewBuffers& buffers = view_buffers_[view];
+      const Span& span = buffers.reached_spans[j];
+      for (uint32_t p = span.begin; p < span.end; ++p) Enqueue(buffers.reached[p]);
     }
   }
   max_queue_ = std::max(max_queue_, queue_size() + next.entries.size());
@@ -1086,7 +1119,6 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
       for (size_t i = first; i < std::min(voxels.size(), first + kChunk); ++i) {
         chunk.Add(voxels[i], volume_.grid());
       }
-      chunk.views.resize(chunk.entries.size() * views_.size());
       RunViewTask(nullptr, 0, &chunk, current_);
       JudgeEntries(&chunk, current_, /*colouring=*/true);
       for (const BatchEntry& entry : chunk.entries) {

@@ -395,9 +395,11 @@ class IncrementalCarver {
 
   // Per group of views, its own buffers (on cache lines of their own): what its views gave, one
   // after another, with where each view's part ends.
+  struct BatchHit;
   struct alignas(64) GroupBuffers {
     std::vector<PixelRef> vis;
     std::vector<ViewColourStats> stats;
+    std::vector<const BatchHit*> next_hit;  // JudgeEntries: per view, its next hit
     std::vector<int64_t> changed;
     std::vector<size_t> vis_end;
     std::vector<size_t> stats_end;
@@ -426,29 +428,38 @@ class IncrementalCarver {
     double reprojection_error = 0.0;  // ColourSurface: summed |pixel - colour| over Vis
     int num_pixels = 0;               // |Vis|
   };
-  // Per view and voxel of a batch (view x batch size + index in the batch): where its pixels there
-  // lie in the view's buffers (Vis, then the voxels their rays reached), and their statistics
-  // (count 0: none).
-  struct BatchView {
-    ViewColourStats stats;
-    size_t vis_begin = 0, vis_end = 0;
-    size_t reached_begin = 0, reached_end = 0;
-  };
   struct Batch {
     std::vector<BatchEntry> entries;
-    std::vector<BatchView> views;
     void Add(int64_t voxel, const VoxelGrid& grid) {
       entries.emplace_back();
       entries.back().voxel = voxel;
       entries.back().coordinates = grid.Voxel(voxel);
     }
-    BatchView& At(int view, size_t k) { return views[static_cast<size_t>(view) * entries.size() + k]; }
   };
-  // Per view: the Vis pixels of the two batches in flight (the one being carved and the next),
-  // the voxels its rays reached, and the time it took in the last task.
+  // Where a voxel's pixels lie in one view's buffer: [begin, end). A view has fewer pixels than
+  // 2^32.
+  struct Span {
+    uint32_t begin = 0, end = 0;
+  };
+  // A voxel of a batch that a view sees pixels of: its index in the batch and their statistics.
+  struct BatchHit {
+    int k = 0;
+    ViewColourStats stats;
+  };
+  // Per view, written only by the thread that runs the view (mostly the same one from task to
+  // task, see RunViewTask): the Vis pixels of the two batches in flight (the one being carved
+  // and the next), each entry's span in them and the entries seen (in batch order, with their
+  // statistics); the voxels its rays reached, per carved entry (in batch_carved_ order); its time
+  // since the last sorting. A task so hands the other threads little more than the statistics
+  // the judging needs. (A record per view and voxel of the batch, which the judging read and the
+  // next task wrote over, had the two cores trade its cache lines: two threads did 40-50% more
+  // work than one.)
   struct alignas(64) ViewBuffers {
     std::vector<PixelRef> vis[2];
+    std::vector<Span> spans[2];
+    std::vector<BatchHit> hits[2];
     std::vector<int64_t> reached;
+    std::vector<Span> reached_spans;
     int64_t nanoseconds = 0;
   };
   // Batched carving is a pipeline of two batches: batches_[current_] has its Vis found (when
@@ -462,13 +473,16 @@ class IncrementalCarver {
   // slot `carving_slot`), then finds the Vis of `finding`'s voxels (when not null; into slot
   // `finding_slot`). Views are claimed one at a time, each group first its own (view v
   // belongs to group v mod G, so that a view's rays stay in one core's cache from batch to
-  // batch), then any left, the costliest of the last task first. Which group takes a view never
-  // changes what is computed.
+  // batch), then any left, the costliest first. Which group takes a view never changes what is
+  // computed.
   void RunViewTask(Batch* carving, int carving_slot, Batch* finding, int finding_slot);
-  // Judges every voxel of `batch` (Vis found in `slot`), the groups claiming voxels; with
-  // `colouring`, also each one's reprojection error.
+  // Judges every voxel of `batch` (Vis found in `slot`); with `colouring`, also each one's
+  // reprojection error. The mean-colour test is a few arithmetic operations a view, less than a
+  // hand-over to the workers costs: it runs on the calling thread; the pattern test and
+  // colouring, which read pixels, run on every group, which claim voxels.
   void JudgeEntries(Batch* batch, int slot, bool colouring);
-  // Sorts claim_order_ by the views' time in the last tasks, the costliest first.
+  // Every kSortTasks tasks: sorts claim_order_ by the views' time since the last sorting, the
+  // costliest first.
   void SortViewsByCost();
   // Puts a batch found but not yet judged back at the front of the queue (before carving
   // outside the pipeline: its Vis would go stale).
@@ -480,6 +494,7 @@ class IncrementalCarver {
   std::vector<ViewBuffers> view_buffers_;
   std::vector<int> claim_order_;  // views, costliest first
   std::unique_ptr<std::atomic<uint8_t>[]> view_claimed_;
+  int tasks_since_sort_ = 0;
   std::vector<GroupBuffers> groups_;
   std::vector<size_t> advance_begin_;  // per view: where its pixels start in the rays to step
   int64_t prefetched_ = -1;  // the voxel whose Vis and statistics vis_ and stats_ already hold

@@ -73,9 +73,6 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
   const size_t n = mesh.vertices.size();
   std::vector<std::vector<VertexSighting>> sightings(n);
   if (on_rim != nullptr) on_rim->assign(n, 0);
-  TriangleMesh shape;  // drawn without colours: only the depth is wanted
-  shape.vertices = mesh.vertices;
-  shape.triangles = mesh.triangles;
   // Each view on its own (in parallel): the vertices it sees, and which lie on its mask's rim.
   std::vector<std::vector<std::pair<uint32_t, float>>> per_view(views.size());
   std::vector<std::vector<uint32_t>> rims(views.size());
@@ -84,7 +81,7 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
     for (size_t v = first; v < last; ++v) {
       const CalibratedView& view = views[v];
       // The mesh is closed (MeshSolidVoxels) and the cameras outside it: front faces suffice.
-      const Rendering drawn = RenderMesh(shape, view, /*front_faces_only=*/true);
+      const cv::Mat depths = RenderMeshDepth(mesh, view, /*front_faces_only=*/true);
       // Distance (pixels) from each object pixel to the nearest background pixel.
       cv::Mat to_background;
       if (on_rim != nullptr && !view.mask.empty() && voxel_size > 0.0) {
@@ -93,13 +90,15 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
       const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
       for (size_t i = 0; i < n; ++i) {
         const Eigen::Vector3d world = mesh.vertices[i].cast<double>();
-        const double depth = view.Depth(world);
+        // P's last row is the camera's z (K's last row is (0, 0, 1)): one product gives both.
+        const Eigen::Vector3d image = view.P * world.homogeneous();
+        const double depth = image.z();
         if (!(depth > 0.0)) continue;
-        const Eigen::Vector2d pixel = view.Project(world);
+        const Eigen::Vector2d pixel = image.head<2>() / depth;
         const int col = static_cast<int>(std::floor(pixel.x()));
         const int row = static_cast<int>(std::floor(pixel.y()));
         if (col < 0 || row < 0 || col >= view.width || row >= view.height) continue;
-        if (depth > drawn.depth.at<float>(row, col) + depth_tolerance) continue;
+        if (depth > depths.at<float>(row, col) + depth_tolerance) continue;
         if (!to_background.empty() && view.mask.at<uint8_t>(row, col) != 0 &&
             to_background.at<float>(row, col) <= rim_voxels * focal * voxel_size / depth) {
           rims[v].push_back(static_cast<uint32_t>(i));

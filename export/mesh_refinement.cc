@@ -18,6 +18,14 @@ namespace {
 
 constexpr int kPatchSamples = 5;
 
+// A vertex's patch in one view, in homogeneous pixel coordinates (P times the world point): the
+// vertex, a unit step along its normal, and the patch's offsets from the vertex.
+struct Projected {
+  Eigen::Vector3d centre;
+  Eigen::Vector3d normal;
+  Eigen::Vector3d around[kPatchSamples];
+};
+
 // Two unit vectors spanning the plane normal to `n`.
 void TangentBasis(const Eigen::Vector3d& n, Eigen::Vector3d* u, Eigen::Vector3d* w) {
   const Eigen::Vector3d helper =
@@ -122,6 +130,7 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
     ParallelRanges(n, threads, /*min_per_thread=*/1024, [&](size_t begin, size_t end) {
     std::vector<Eigen::Vector3f> patch(static_cast<size_t>(kPatchSamples) * views.size());
     std::vector<VertexSighting> seen;
+    std::vector<Projected> projected(views.size());
     for (size_t i = begin; i < end; ++i) {
       seen = sightings[i];
       if (static_cast<int>(seen.size()) < options.min_views) continue;
@@ -141,6 +150,18 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
       const Eigen::Vector3d around[kPatchSamples] = {
           Eigen::Vector3d::Zero(), options.patch_radius * u, -options.patch_radius * u,
           options.patch_radius * w, -options.patch_radius * w};
+      // Projection is linear in homogeneous coordinates: per view, the centre's image and those
+      // of a step along the normal and of the patch's offsets, so that each sample costs a
+      // division rather than a matrix product.
+      const int num_seen = static_cast<int>(seen.size());
+      for (int v = 0; v < num_seen; ++v) {
+        const Eigen::Matrix<double, 3, 4>& P = views[seen[v].view].P;
+        const Eigen::Matrix3d M = P.leftCols<3>();
+        Projected& at = projected[v];
+        at.centre = M * centre + P.col(3);
+        at.normal = M * normal;
+        for (int k = 0; k < kPatchSamples; ++k) at.around[k] = M * around[k];
+      }
       double best_cost = std::numeric_limits<double>::infinity(), stay_cost = best_cost;
       double cost_sum = 0.0;
       int costs = 0, best_terms = 0;
@@ -149,17 +170,18 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
       const int first_step = on_rim[i] ? options.steps_per_side : 0;
       for (int s = first_step; s < steps; ++s) {
         const double t = (s - options.steps_per_side) * step;
-        const Eigen::Vector3d point = centre + t * normal;
         // Sample the patch in every view that sees the vertex; a view whose patch leaves its
         // photo's data (or the object's mask) says the offset is wrong.
         int views_used = 0;
         bool outside = false;
         Eigen::Matrix<float, 3, kPatchSamples> mean = Eigen::Matrix<float, 3, kPatchSamples>::Zero();
-        for (const VertexSighting& sighting : seen) {
-          const CalibratedView& view = views[sighting.view];
+        for (int v = 0; v < num_seen; ++v) {
+          const CalibratedView& view = views[seen[v].view];
+          const Projected& at = projected[v];
+          const Eigen::Vector3d moved = at.centre + t * at.normal;
           for (int k = 0; k < kPatchSamples && !outside; ++k) {
             Eigen::Vector3f colour;
-            if (!SamplePhoto(view, view.Project(point + around[k]), &colour)) {
+            if (!SamplePhoto(view, (moved + at.around[k]).hnormalized(), &colour)) {
               outside = k == 0;  // only the centre must stay on the object
               colour = Eigen::Vector3f::Constant(-1.0f);
             }

@@ -7,24 +7,28 @@
 namespace raycarve {
 namespace exporter {
 
-Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view, bool front_faces_only) {
-  Rendering rendering;
-  rendering.image = cv::Mat(view.height, view.width, CV_8UC3, cv::Scalar::all(0));
-  rendering.silhouette = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
-  rendering.depth = cv::Mat(view.height, view.width, CV_32FC1,
-                            cv::Scalar(std::numeric_limits<float>::infinity()));
+namespace {
+
+// Draws `mesh` into `view` with a depth buffer `depth` (CV_32FC1, +inf where nothing is drawn);
+// `image` and `silhouette`, when not null, get the colours and the covered pixels.
+void Rasterise(const TriangleMesh& mesh, const CalibratedView& view, bool front_faces_only,
+               cv::Mat* depth, cv::Mat* image, cv::Mat* silhouette) {
+  *depth = cv::Mat(view.height, view.width, CV_32FC1,
+                   cv::Scalar(std::numeric_limits<float>::infinity()));
+  if (image != nullptr) *image = cv::Mat(view.height, view.width, CV_8UC3, cv::Scalar::all(0));
+  if (silhouette != nullptr) *silhouette = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
   const size_t n = mesh.vertices.size();
   // Per vertex: its pixel and the inverse of its depth (P's last row is the camera's z, as K's
   // last row is (0, 0, 1)); 0 at or behind the camera plane.
   std::vector<Eigen::Vector2d> pixels(n);
   std::vector<double> inverse_depths(n);
   for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d world = mesh.vertices[i].cast<double>();
-    const double depth = view.Depth(world);
-    inverse_depths[i] = depth > 0.0 ? 1.0 / depth : 0.0;
-    pixels[i] = depth > 0.0 ? view.Project(world) : Eigen::Vector2d::Zero();
+    const Eigen::Vector3d image = view.P * mesh.vertices[i].cast<double>().homogeneous();
+    const double z = image.z();
+    inverse_depths[i] = z > 0.0 ? 1.0 / z : 0.0;
+    pixels[i] = z > 0.0 ? Eigen::Vector2d(image.head<2>() / z) : Eigen::Vector2d::Zero();
   }
-  const bool coloured = mesh.colours.size() == n;
+  const bool coloured = image != nullptr && mesh.colours.size() == n;
   for (const Eigen::Vector3i& t : mesh.triangles) {
     const double iz0 = inverse_depths[t[0]], iz1 = inverse_depths[t[1]], iz2 = inverse_depths[t[2]];
     if (!(iz0 > 0.0 && iz1 > 0.0 && iz2 > 0.0)) continue;
@@ -54,9 +58,9 @@ Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view, bool 
     const double e1 = (c.x() * a.y() - c.y() * a.x()) * inverse_area;
     for (int row = row_min; row <= row_max; ++row) {
       const double y = row + 0.5;
-      float* depth_row = rendering.depth.ptr<float>(row);
-      cv::Vec3b* colour_row = rendering.image.ptr<cv::Vec3b>(row);
-      uint8_t* covered_row = rendering.silhouette.ptr<uint8_t>(row);
+      float* depth_row = depth->ptr<float>(row);
+      cv::Vec3b* colour_row = image != nullptr ? image->ptr<cv::Vec3b>(row) : nullptr;
+      uint8_t* covered_row = silhouette != nullptr ? silhouette->ptr<uint8_t>(row) : nullptr;
       const double x0 = col_min + 0.5;
       double w0 = e0 + x0 * dx0 + y * dy0;
       double w1 = e1 + x0 * dx1 + y * dy1;
@@ -69,7 +73,8 @@ Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view, bool 
         const float z = static_cast<float>(1.0 / inverse_z);
         if (!(z < depth_row[col])) continue;
         depth_row[col] = z;
-        covered_row[col] = 255;
+        if (covered_row != nullptr) covered_row[col] = 255;
+        if (colour_row == nullptr) continue;
         if (coloured) {
           const double p0 = w0 * iz0 / inverse_z, p1 = w1 * iz1 / inverse_z, p2 = w2 * iz2 / inverse_z;
           cv::Vec3b colour;
@@ -85,7 +90,20 @@ Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view, bool 
       }
     }
   }
+}
+
+}  // namespace
+
+Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view, bool front_faces_only) {
+  Rendering rendering;
+  Rasterise(mesh, view, front_faces_only, &rendering.depth, &rendering.image, &rendering.silhouette);
   return rendering;
+}
+
+cv::Mat RenderMeshDepth(const TriangleMesh& mesh, const CalibratedView& view, bool front_faces_only) {
+  cv::Mat depth;
+  Rasterise(mesh, view, front_faces_only, &depth, nullptr, nullptr);
+  return depth;
 }
 
 }  // namespace exporter

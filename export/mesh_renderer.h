@@ -19,6 +19,10 @@ namespace exporter {
 // the camera. Cost: the triangles' projected area.
 Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view,
                      bool front_faces_only = false);
+// RenderMesh's depth buffer alone (the same values), without the colour and silhouette images:
+// what finding the vertices a view sees needs, for less memory traffic.
+cv::Mat RenderMeshDepth(const TriangleMesh& mesh, const CalibratedView& view,
+                        bool front_faces_only = false);
 
 }  // namespace exporter
 }  // namespace raycarve

@@ -98,7 +98,7 @@ TEST(RenderMesh, FrontFacesAloneGiveAClosedMeshsDepthBuffer) {
   const TriangleMesh mesh = MeshSolidVoxels(Volume(grid, std::move(bits)), SurfaceMeshOptions());
   ASSERT_GT(mesh.triangles.size(), 1000u);
   // Views from several sides, each at distance 3 looking at the origin.
-  int pixels = 0, differing = 0;
+  int pixels = 0, differing = 0, depth_only_differing = 0;
   for (const Eigen::Vector3d& centre :
        {Eigen::Vector3d(0, 0, -3), Eigen::Vector3d(2.1, 0.5, -2.1), Eigen::Vector3d(0, -3, 0.2),
         Eigen::Vector3d(-2.5, 1.0, 1.3)}) {
@@ -117,15 +117,20 @@ TEST(RenderMesh, FrontFacesAloneGiveAClosedMeshsDepthBuffer) {
     view.P = view.K * view.cam_from_world.ToMatrix();
     const Rendering both = RenderMesh(mesh, view);
     const Rendering front = RenderMesh(mesh, view, /*front_faces_only=*/true);
+    // The depth alone, as the sightings draw it: the same buffer.
+    const cv::Mat depth_only = RenderMeshDepth(mesh, view, /*front_faces_only=*/true);
     ASSERT_GT(cv::countNonZero(both.silhouette), 1000);
+    ASSERT_EQ(depth_only.size(), front.depth.size());
     for (int row = 0; row < view.height; ++row) {
       for (int col = 0; col < view.width; ++col) {
         ++pixels;
         differing += both.depth.at<float>(row, col) != front.depth.at<float>(row, col);
+        depth_only_differing += depth_only.at<float>(row, col) != front.depth.at<float>(row, col);
       }
     }
   }
   EXPECT_EQ(differing, 0) << "of " << pixels << " pixels";
+  EXPECT_EQ(depth_only_differing, 0) << "of " << pixels << " pixels";
   // A triangle turned away from the camera is drawn only with both sides.
   const CalibratedView view = Straight();
   TriangleMesh facing;

@@ -36,7 +36,8 @@ bool FullyInside(const Eigen::Matrix<double, 3, 4>& P,
 
 VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
                                      Volume* volume,
-                                     int num_threads) {
+                                     int num_threads,
+                                     int min_background_views) {
   const auto start = std::chrono::steady_clock::now();
   VisualHullStatistics statistics;
   struct MaskedView {
@@ -101,13 +102,14 @@ VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
       }
       for (int64_t index : solid) {
         const Eigen::Vector3i voxel = grid.Voxel(index);
+        int background = 0;
         for (const MaskedView* m : asked) {
           Footprint footprint;
           if (!FullyInside(m->view->P, m->view->width, m->view->height, grid, voxel, &footprint)) {
             continue;
           }
           if (RectSum(m->valid_integral, footprint) == 0) continue;  // no photo data there
-          if (RectSum(m->object_integral, footprint) == 0) {
+          if (RectSum(m->object_integral, footprint) == 0 && ++background >= min_background_views) {
             outside[index] = 1;
             break;
           }

@@ -21,8 +21,11 @@ struct VisualHullStatistics {
 // all, is not judged by it, so the result contains the visual hull of the masks. Cost: one
 // footprint per voxel per masked view, answered in constant time from integral images; voxels
 // are judged on `num_threads` threads (< 1: one per hardware thread), with the same result.
+// With `min_background_views` > 1 a voxel is carved only where that many views show it entirely
+// on background: a hull that one view's wrong mask cannot cut (AgreeMasks).
 VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
                                      Volume* volume,
-                                     int num_threads = 1);
+                                     int num_threads = 1,
+                                     int min_background_views = 1);
 
 }  // namespace raycarve

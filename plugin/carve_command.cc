@@ -38,12 +38,32 @@ double SecondsSince(Clock::time_point start) {
 
 }  // namespace
 
+MaskAgreementStatistics AgreeBackdropMasks(const CarveRequest& request,
+                                           const ViewReaderSummary& summary,
+                                           const Eigen::AlignedBox3d& box,
+                                           std::vector<CalibratedView>* views) {
+  if (!request.agree_masks || summary.masks_from_backdrop == 0 || summary.masks_from_files > 0) {
+    return MaskAgreementStatistics();
+  }
+  MaskAgreementOptions options;
+  // The voting grid: at most 64 voxels a side. Its hull only sorts pixels, and a voxel's width
+  // is the margin kept inside its outline.
+  options.resolution = std::min(request.options.resolution, 64);
+  options.num_threads = request.options.num_threads;
+  options.colour_tolerance = request.view_options.background.tolerance;
+  MaskAgreementStatistics statistics = AgreeMasks(box, options, views);
+  std::vector<std::string> names;
+  for (const CalibratedView& view : *views) names.push_back(view.name);
+  LOG(INFO) << statistics.Summary(names);
+  return statistics;
+}
+
 CarveRun CarveProject(const CarveRequest& request) {
   CarveRun run;
   std::string reason;
   if (!request.options.IsValid(&reason)) throw InputError("raycarve carve: " + reason);
   Clock::time_point stage = Clock::now();
-  const LoadedProject project =
+  LoadedProject project =
       LoadProject("carve", request.workspace_path, request.input_path, request.image_path,
                   request.output_path, request.bounds, request.view_options, /*min_images=*/2,
                   request.model_index, request.colour_calibration);
@@ -58,6 +78,11 @@ CarveRun CarveProject(const CarveRequest& request) {
   run.mask_photos = project.view_summary.photos;
   run.colour = project.colour;
   run.stage_seconds.emplace_back("load_project", SecondsSince(stage));
+  stage = Clock::now();
+  run.mask_agreement =
+      AgreeBackdropMasks(request, project.view_summary, run.bounds.box, &project.views);
+  if (run.mask_agreement.views > 0) run.stage_seconds.emplace_back("agree_masks", SecondsSince(stage));
+  for (const CalibratedView& view : project.views) run.view_names.push_back(view.name);
   const std::vector<CalibratedView>& views = project.views;
 
   if (!CheckCarveFits(views, run.bounds.box, request.options, &reason)) {
@@ -399,9 +424,25 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
           .Key("regions_restored_by_seeds").Value(photo.mask.regions_restored)
           .Key("cut_to_volume").Value(photo.mask.cut_to_box);
     }
+    const auto at = std::find(run.view_names.begin(), run.view_names.end(), photo.name);
+    if (run.mask_agreement.views > 0 && at != run.view_names.end()) {
+      const size_t v = static_cast<size_t>(at - run.view_names.begin());
+      json.Key("agreement_added_pixels").Value(run.mask_agreement.added[v]);
+    }
     json.EndObject();
   }
   json.EndArray();
+  {
+    const MaskAgreementStatistics& agreement = run.mask_agreement;
+    const double before = std::max<int64_t>(1, agreement.TotalObjectBefore());
+    json.Key("mask_agreement").BeginObject()
+        .Key("enabled").Value(request.agree_masks)
+        .Key("views").Value(agreement.views)
+        .Key("hull_voxels").Value(agreement.hull_voxels)
+        .Key("added_share").Value(agreement.views > 0 ? agreement.TotalAdded() / before : 0.0)
+        .Key("seconds").Value(agreement.seconds)
+        .EndObject();
+  }
   if (request.colour_calibration) {
     json.Key("colour_calibration").BeginObject()
         .Key("points_used").Value(run.colour.points_used)
@@ -705,6 +746,10 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->AddDefault("mask_graph_cut", &request->view_options.background.refine,
                      "auto masks: refine the colour rule by a graph cut (GrabCut) seeded with the "
                      "sparse points; 0: the colour rule alone");
+  parser->AddDefault("agree_masks", &request->agree_masks,
+                     "masks from the backdrop: where a photo's mask leaves out what 2+ others "
+                     "agree is object (well inside their hull's outline, in the colour they see "
+                     "there), it becomes object");
   parser->AddDefault("visual_hull", &request->options.visual_hull,
                      "with masks, carve the silhouettes' visual hull before colouring");
   parser->AddDefault("mesh", &request->mesh_kind,

@@ -13,6 +13,7 @@
 #include "calib/reconstruction.h"
 #include "calib/view_reader.h"
 #include "carve/carver.h"
+#include "carve/mask_agreement.h"
 #include "export/carve_export.h"
 #include "export/point_cloud_compare.h"
 #include "plugin/option_parser.h"
@@ -183,7 +184,17 @@ struct CarveRequest {
   // With the smooth mesh: cloud.ply keeps the surface that at least this many photos see. Two
   // photos always find a colour they agree on somewhere; a third is the first check of it.
   int cloud_min_views = 3;
+  // Masks made from the backdrop are made to agree across the views (AgreeMasks) before the
+  // carve; masks from files are the user's and are left as they are.
+  bool agree_masks = true;
 };
+
+// AgreeMasks over `views` when `request` asks for it and their masks came from the backdrop;
+// logs its summary. Returns what it changed (views 0 when it did not run).
+MaskAgreementStatistics AgreeBackdropMasks(const CarveRequest& request,
+                                           const ViewReaderSummary& summary,
+                                           const Eigen::AlignedBox3d& box,
+                                           std::vector<CalibratedView>* views);
 
 struct CarveRun {
   std::string model_path;
@@ -195,6 +206,8 @@ struct CarveRun {
   int masks_from_files = 0;
   int masks_from_backdrop = 0;
   std::vector<PhotoMaskInfo> mask_photos;  // per view: where its mask came from, what was found
+  MaskAgreementStatistics mask_agreement;
+  std::vector<std::string> view_names;
   ColourCalibration colour;
   std::unique_ptr<CarveResult> result;
   std::vector<std::pair<std::string, double>> stage_seconds;

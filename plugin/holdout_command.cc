@@ -129,6 +129,9 @@ int RunHoldout(int argc, char** argv) {
       throw InputError("raycarve holdout: " + reason);
     }
     CheckVolumeSeen("holdout", project, training, request.options.min_views, request.bounds);
+    // The training photos' masks agree among themselves; the held-out photos' are scored as
+    // made.
+    AgreeBackdropMasks(request, project.view_summary, project.bounds.box, &training);
     LOG(INFO) << "carving with " << training.size() << " views, holding out " << held_out.size();
     options.surface_points = SurfacePointsOf(project.reconstruction, training, project.bounds.box);
     result = std::make_unique<CarveResult>(CarveVolume(training, project.bounds.box, options));

@@ -41,6 +41,15 @@ TEST(VisualHull, KeepsEveryVoxelOfTheTrueSurfaceAndRemovesMostEmptySpace) {
   for (int64_t i = 0; i < volume.grid().num_voxels(); ++i) {
     ASSERT_EQ(threaded.IsSolid(i), volume.IsSolid(i)) << i;
   }
+  // Two views needed to carve (the voting hull of AgreeMasks): it holds the plain hull, and
+  // still carves most of the empty space.
+  Volume voting(VoxelGrid(box, 48));
+  const VisualHullStatistics votes = CarveVisualHull(views, &voting, 2, /*min_background_views=*/2);
+  EXPECT_LT(votes.carved, statistics.carved);
+  EXPECT_GT(votes.carved, volume.grid().num_voxels() / 3);
+  for (int64_t i = 0; i < volume.grid().num_voxels(); ++i) {
+    if (volume.IsSolid(i)) ASSERT_TRUE(voting.IsSolid(i)) << i;
+  }
 }
 
 // Brute force: whether some masked view shows the voxel entirely on background, its footprint

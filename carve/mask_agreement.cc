@@ -75,7 +75,7 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
   std::vector<cv::Mat> original(num_views);
   for (size_t v = 0; v < num_views; ++v) original[v] = (*views)[v].mask;
   // The median colour the neighbouring masked views show on their object at a point; false where
-  // fewer than two do. (Occlusion is not asked: well inside the object's outline in every view,
+  // fewer than two do, or where `min_background_views` of them show the point on background. (Occlusion is not asked: well inside the object's outline in every view,
   // the photos agree on little else.)
   // Per masked view, the other masked views nearest to it (by camera centre), at most
   // kNeighbourViews: they see most of what it sees from the same side.
@@ -93,6 +93,7 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
   }
   auto others_see = [&](size_t self, const Eigen::Vector3d& point, Eigen::Vector3d* colour) {
     std::vector<double> channel[3];
+    int background = 0;
     for (size_t u : neighbours[self]) {
       const CalibratedView& other = (*views)[u];
       const Eigen::Vector3d image = other.P * point.homogeneous();
@@ -100,7 +101,13 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
       const int col = static_cast<int>(std::floor(image.x() / image.z()));
       const int row = static_cast<int>(std::floor(image.y() / image.z()));
       if (col < 0 || row < 0 || col >= other.width || row >= other.height) continue;
-      if (original[u].at<uint8_t>(row, col) == 0) continue;
+      if (!other.valid.empty() && other.valid.at<uint8_t>(row, col) == 0) continue;
+      // Two neighbours showing the point on background say it is not the object's, as two
+      // views carve a voxel from the voting hull.
+      if (original[u].at<uint8_t>(row, col) == 0) {
+        if (++background >= options.min_background_views) return false;
+        continue;
+      }
       const cv::Vec3b rgb = other.image.at<cv::Vec3b>(row, col);
       for (int c = 0; c < 3; ++c) channel[c].push_back(rgb[c]);
     }

@@ -42,9 +42,11 @@ struct MaskAgreementStatistics {
 //    so that one photo's mask alone cannot cut it;
 // 2. in each masked view, a background pixel whose ray meets the voting hull at least a voxel's
 //    width (in that view's pixels, at the box's centre) inside the hull's outline becomes
-//    object, where its colour is what the other masked views show there (within
-//    `colour_tolerance` of their median at the ray's first hull voxel's centre). A pixel that
-//    shows something else, the backdrop through a gap only this view sees (which the voting hull
+//    object, where its colour is what the 8 nearest masked views show there: at one of the
+//    points every half voxel over the hull's first three voxels along its ray, fewer than
+//    `min_background_views` of them show the point on background, two or more on their object,
+//    and the pixel lies within `colour_tolerance` of their median colour. A pixel that shows
+//    something else, the backdrop through a gap only this view sees (which the voting hull
 //    keeps), stays background.
 // Object pixels stay object, and each mask keeps its own outline. Views without a mask, and
 // every view when fewer than 3 have one, are left as they are.

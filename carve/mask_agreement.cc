@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
+#include <iomanip>
+#include <sstream>
 
 #include <opencv2/imgproc.hpp>
 
@@ -43,15 +44,15 @@ std::string MaskAgreementStatistics::Summary(const std::vector<std::string>& nam
       most_share = share;
     }
   }
-  char text[512];
-  std::snprintf(text, sizeof(text),
-                "masks agreed across %d views: %.2f%% more object pixels (background pixels "
-                "inside the hull that 2+ views leave, in the colour the others see there); most "
-                "in %s (+%.1f%%); %.2f s",
-                views, 100.0 * TotalAdded() / std::max<int64_t>(1, TotalObjectBefore()),
-                most >= 0 && most < static_cast<int>(names.size()) ? names[most].c_str() : "none",
-                100.0 * most_share, seconds);
-  return text;
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(2) << "masks agreed across " << views << " views: "
+       << 100.0 * TotalAdded() / std::max<int64_t>(1, TotalObjectBefore())
+       << "% more object pixels (background pixels inside the hull that 2+ views leave, in the "
+          "colour the others see there); most in "
+       << (most >= 0 && most < static_cast<int>(names.size()) ? names[most] : std::string("none"))
+       << " (+" << std::setprecision(1) << 100.0 * most_share << "%); " << std::setprecision(2)
+       << seconds << " s";
+  return text.str();
 }
 
 MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,

@@ -1,6 +1,7 @@
 #include "carve/mask_agreement.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -75,9 +76,6 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
   // The masks as made: each view's change is judged against the others' own masks.
   std::vector<cv::Mat> original(num_views);
   for (size_t v = 0; v < num_views; ++v) original[v] = (*views)[v].mask;
-  // The median colour the neighbouring masked views show on their object at a point; false where
-  // fewer than two do, or where `min_background_views` of them show the point on background. (Occlusion is not asked: well inside the object's outline in every view,
-  // the photos agree on little else.)
   // Per masked view, the other masked views nearest to it (by camera centre), at most
   // kNeighbourViews: they see most of what it sees from the same side.
   std::vector<std::vector<size_t>> neighbours(num_views);
@@ -92,8 +90,13 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
     });
     if (neighbours[v].size() > kNeighbourViews) neighbours[v].resize(kNeighbourViews);
   }
+  // The median colour the neighbouring masked views show on their object at a point; false where
+  // fewer than two do, or where `min_background_views` of them show the point on background.
+  // (Occlusion is not asked: well inside the object's outline in every view, the photos agree
+  // on little else.)
   auto others_see = [&](size_t self, const Eigen::Vector3d& point, Eigen::Vector3d* colour) {
-    std::vector<double> channel[3];
+    std::array<double, kNeighbourViews> channel[3];
+    size_t seen = 0;
     int background = 0;
     for (size_t u : neighbours[self]) {
       const CalibratedView& other = (*views)[u];
@@ -110,12 +113,13 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
         continue;
       }
       const cv::Vec3b rgb = other.image.at<cv::Vec3b>(row, col);
-      for (int c = 0; c < 3; ++c) channel[c].push_back(rgb[c]);
+      for (int c = 0; c < 3; ++c) channel[c][seen] = rgb[c];
+      ++seen;
     }
-    if (channel[0].size() < 2) return false;
+    if (seen < 2) return false;
     for (int c = 0; c < 3; ++c) {
-      const auto middle = channel[c].begin() + static_cast<std::ptrdiff_t>(channel[c].size() / 2);
-      std::nth_element(channel[c].begin(), middle, channel[c].end());
+      const auto middle = channel[c].begin() + static_cast<std::ptrdiff_t>(seen / 2);
+      std::nth_element(channel[c].begin(), middle, channel[c].begin() + static_cast<std::ptrdiff_t>(seen));
       (*colour)[c] = *middle;
     }
     return true;
@@ -151,12 +155,9 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
     cv::Mat inside;
     cv::erode(meets, inside,
               cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
-    cv::Mat agreed = view.mask.clone();
     const cv::Mat candidates = inside & (view.mask == 0);
-    if (cv::countNonZero(candidates) == 0) {
-      view.mask = agreed;
-      continue;
-    }
+    if (cv::countNonZero(candidates) == 0) continue;
+    cv::Mat agreed = view.mask.clone();
     RayImage rays(grid, view.WorldFromPixel(), view.centre, view.width, view.height, candidates);
     rays.Initialise(hull, &blocks, threads);
     for (int pixel = 0; pixel < rays.num_pixels(); ++pixel) {

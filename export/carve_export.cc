@@ -131,6 +131,14 @@ bool ModelMeshOptions::IsValid(std::string* reason) const {
     *reason = "mesh refinement passes must be >= 0";
     return false;
   }
+  if (part_min_views < 0) {
+    *reason = "mesh part minimum views must be >= 0";
+    return false;
+  }
+  if (silhouette_passes < 0) {
+    *reason = "mesh silhouette passes must be >= 0";
+    return false;
+  }
   if (!(refine_converged_voxels >= 0.0) || !std::isfinite(refine_converged_voxels)) {
     *reason = "mesh refinement convergence (voxels) must be a number >= 0";
     return false;
@@ -187,6 +195,7 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   model.mesh = MeshSolidVoxels(result.volume, geometry, &model.geometry);
   model.small_components_removed =
       RemoveSmallComponents(options.min_component_vertices, &model.mesh);
+  model.parts = RemoveUnneededParts(views, options.part_min_views, options.num_threads, &model.mesh);
   if (model.mesh.empty()) return model;
   MeshRefinementOptions refinement;
   refinement.passes = options.refine_passes;
@@ -213,6 +222,14 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
       model.final_smoothing_mean_move = moved / static_cast<double>(model.mesh.vertices.size());
       ComputeVertexNormals(&model.mesh);
     }
+  }
+  if (options.silhouette_passes > 0) {
+    SilhouetteFitOptions fit;
+    fit.passes = options.silhouette_passes;
+    fit.max_move = grid.voxel_size();
+    fit.depth_tolerance = grid.voxel_size();
+    fit.num_threads = options.num_threads;
+    model.silhouettes = FitMeshToSilhouettes(views, fit, &model.mesh);
   }
   MeshColouringOptions colouring;
   colouring.min_views = options.min_views;

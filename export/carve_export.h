@@ -7,6 +7,7 @@
 #include "calib/calibrated_view.h"
 #include "export/mesh_colouring.h"
 #include "export/mesh_refinement.h"
+#include "export/mesh_silhouettes.h"
 #include "export/point_cloud_io.h"
 #include "export/surface_mesh.h"
 
@@ -68,6 +69,15 @@ struct ModelMeshOptions {
   // corner. 24 is the iso-surface of a 2x2x2 block, the smallest speck the carve's default
   // --min_component_voxels 8 keeps; 0 keeps everything.
   int64_t min_component_vertices = 24;
+  // Then parts of the iso-surface that fewer than this many masked photos need go
+  // (RemoveUnneededParts: the visual hull's phantoms, pieces every photo sees within the object's
+  // silhouette); the largest part stays. 0 keeps every part. Two photos, as elsewhere: one photo's
+  // mask can be wrong, and the silhouette repair serves one photo's object pixels at a time.
+  int part_min_views = 2;
+  // After the final smoothing, passes of FitMeshToSilhouettes: outline vertices standing beyond
+  // the masks are pulled in onto their edges (by the median over the photos they are on the
+  // outline of, at most a voxel a pass). 0: none.
+  int silhouette_passes = 2;
   // Threads for refining and colouring (0 or less: every core); the mesh does not depend on it.
   int num_threads = 0;
   bool IsValid(std::string* reason) const;
@@ -78,6 +88,8 @@ struct ModelMesh {
   int64_t small_components_removed = 0;
   MeshRefinementSummary refinement;
   double final_smoothing_mean_move = 0.0;  // world units, over all vertices
+  MeshPartsSummary parts;
+  SilhouetteFitSummary silhouettes;
   MeshColouringSummary colouring;
   std::vector<std::vector<uint32_t>> seen_by;  // per vertex, the views (indices) that see it
   // Per vertex, 1 where it lies on the grid's wall: the part of the surface that separates solid

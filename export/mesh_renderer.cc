@@ -4,19 +4,23 @@
 #include <cmath>
 #include <limits>
 
+#include <glog/logging.h>
+
 namespace raycarve {
 namespace exporter {
 
 namespace {
 
-// Draws `mesh` into `view` with a depth buffer `depth` (CV_32FC1, +inf where nothing is drawn);
-// `image` and `silhouette`, when not null, get the colours and the covered pixels.
-void Rasterise(const TriangleMesh& mesh, const CalibratedView& view, bool front_faces_only,
-               cv::Mat* depth, cv::Mat* image, cv::Mat* silhouette) {
-  *depth = cv::Mat(view.height, view.width, CV_32FC1,
-                   cv::Scalar(std::numeric_limits<float>::infinity()));
-  if (image != nullptr) *image = cv::Mat(view.height, view.width, CV_8UC3, cv::Scalar::all(0));
-  if (silhouette != nullptr) *silhouette = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
+// Calls `pixel(triangle, row, col, a0, a1, a2)` for every pixel centre (COLMAP convention)
+// inside a triangle's projection, triangle by triangle in the mesh's order: a_k is the centre's
+// screen-space barycentric weight of corner k times that corner's inverse depth, so that their
+// sum is the inverse depth there (1/z is linear in screen space) and a_k / sum the
+// perspective-correct weights.
+// Triangles with a vertex at or behind the camera plane are skipped; with `front_faces_only`,
+// so are those whose winding faces away from the camera.
+template <typename PixelFn>
+void ForEachCoveredPixel(const TriangleMesh& mesh, const CalibratedView& view,
+                         bool front_faces_only, PixelFn&& pixel) {
   const size_t n = mesh.vertices.size();
   // Per vertex: its pixel and the inverse of its depth (P's last row is the camera's z, as K's
   // last row is (0, 0, 1)); 0 at or behind the camera plane.
@@ -28,8 +32,8 @@ void Rasterise(const TriangleMesh& mesh, const CalibratedView& view, bool front_
     inverse_depths[i] = z > 0.0 ? 1.0 / z : 0.0;
     pixels[i] = z > 0.0 ? Eigen::Vector2d(image.head<2>() / z) : Eigen::Vector2d::Zero();
   }
-  const bool coloured = image != nullptr && mesh.colours.size() == n;
-  for (const Eigen::Vector3i& t : mesh.triangles) {
+  for (size_t triangle = 0; triangle < mesh.triangles.size(); ++triangle) {
+    const Eigen::Vector3i& t = mesh.triangles[triangle];
     const double iz0 = inverse_depths[t[0]], iz1 = inverse_depths[t[1]], iz2 = inverse_depths[t[2]];
     if (!(iz0 > 0.0 && iz1 > 0.0 && iz2 > 0.0)) continue;
     const Eigen::Vector2d& a = pixels[t[0]];
@@ -58,9 +62,6 @@ void Rasterise(const TriangleMesh& mesh, const CalibratedView& view, bool front_
     const double e1 = (c.x() * a.y() - c.y() * a.x()) * inverse_area;
     for (int row = row_min; row <= row_max; ++row) {
       const double y = row + 0.5;
-      float* depth_row = depth->ptr<float>(row);
-      cv::Vec3b* colour_row = image != nullptr ? image->ptr<cv::Vec3b>(row) : nullptr;
-      uint8_t* covered_row = silhouette != nullptr ? silhouette->ptr<uint8_t>(row) : nullptr;
       const double x0 = col_min + 0.5;
       double w0 = e0 + x0 * dx0 + y * dy0;
       double w1 = e1 + x0 * dx1 + y * dy1;
@@ -68,28 +69,43 @@ void Rasterise(const TriangleMesh& mesh, const CalibratedView& view, bool front_
         const double w2 = 1.0 - w0 - w1;
         // Edges shared by two triangles: a centre on the edge is taken by both (harmless).
         if (w0 < -1e-9 || w1 < -1e-9 || w2 < -1e-9) continue;
-        // Perspective-correct: 1/z is linear in screen space.
-        const double inverse_z = w0 * iz0 + w1 * iz1 + w2 * iz2;
-        const float z = static_cast<float>(1.0 / inverse_z);
-        if (!(z < depth_row[col])) continue;
-        depth_row[col] = z;
-        if (covered_row != nullptr) covered_row[col] = 255;
-        if (colour_row == nullptr) continue;
-        if (coloured) {
-          const double p0 = w0 * iz0 / inverse_z, p1 = w1 * iz1 / inverse_z, p2 = w2 * iz2 / inverse_z;
-          cv::Vec3b colour;
-          for (int k = 0; k < 3; ++k) {
-            const double value = p0 * mesh.colours[t[0]][k] + p1 * mesh.colours[t[1]][k] +
-                                 p2 * mesh.colours[t[2]][k];
-            colour[k] = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
-          }
-          colour_row[col] = colour;
-        } else {
-          colour_row[col] = cv::Vec3b(128, 128, 128);
-        }
+        pixel(triangle, row, col, w0 * iz0, w1 * iz1, w2 * iz2);
       }
     }
   }
+}
+
+// Draws `mesh` into `view` with a depth buffer `depth` (CV_32FC1, +inf where nothing is drawn);
+// `image` and `silhouette`, when not null, get the colours and the covered pixels.
+void Rasterise(const TriangleMesh& mesh, const CalibratedView& view, bool front_faces_only,
+               cv::Mat* depth, cv::Mat* image, cv::Mat* silhouette) {
+  *depth = cv::Mat(view.height, view.width, CV_32FC1,
+                   cv::Scalar(std::numeric_limits<float>::infinity()));
+  if (image != nullptr) *image = cv::Mat(view.height, view.width, CV_8UC3, cv::Scalar::all(0));
+  if (silhouette != nullptr) *silhouette = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
+  const bool coloured = image != nullptr && mesh.colours.size() == mesh.vertices.size();
+  ForEachCoveredPixel(mesh, view, front_faces_only,
+                      [&](size_t triangle, int row, int col, double a0, double a1, double a2) {
+    const double inverse_z = a0 + a1 + a2;
+    const float z = static_cast<float>(1.0 / inverse_z);
+    float& nearest = depth->at<float>(row, col);
+    if (!(z < nearest)) return;
+    nearest = z;
+    if (silhouette != nullptr) silhouette->at<uint8_t>(row, col) = 255;
+    if (image == nullptr) return;
+    cv::Vec3b& colour = image->at<cv::Vec3b>(row, col);
+    if (!coloured) {
+      colour = cv::Vec3b(128, 128, 128);
+      return;
+    }
+    const Eigen::Vector3i& t = mesh.triangles[triangle];
+    const double p0 = a0 / inverse_z, p1 = a1 / inverse_z, p2 = a2 / inverse_z;
+    for (int k = 0; k < 3; ++k) {
+      const double value = p0 * mesh.colours[t[0]][k] + p1 * mesh.colours[t[1]][k] +
+                           p2 * mesh.colours[t[2]][k];
+      colour[k] = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+    }
+  });
 }
 
 }  // namespace
@@ -104,6 +120,28 @@ cv::Mat RenderMeshDepth(const TriangleMesh& mesh, const CalibratedView& view, bo
   cv::Mat depth;
   Rasterise(mesh, view, front_faces_only, &depth, nullptr, nullptr);
   return depth;
+}
+
+void DrawMeshParts(const TriangleMesh& mesh, const std::vector<int>& triangle_part, int num_parts,
+                   const CalibratedView& view, cv::Mat* count, cv::Mat* last_part,
+                   std::vector<int64_t>* covered) {
+  CHECK_EQ(triangle_part.size(), mesh.triangles.size());
+  *count = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
+  *last_part = cv::Mat(view.height, view.width, CV_32SC1, cv::Scalar(-1));
+  covered->assign(num_parts, 0);
+  int previous = -1;
+  ForEachCoveredPixel(mesh, view, /*front_faces_only=*/true,
+                      [&](size_t triangle, int row, int col, double, double, double) {
+    const int part = triangle_part[triangle];
+    CHECK(part >= previous && part < num_parts) << "the triangles must be grouped by part";
+    previous = part;
+    int& last = last_part->at<int>(row, col);
+    if (last == part) return;
+    last = part;
+    uint8_t& n = count->at<uint8_t>(row, col);
+    if (n < 255) ++n;
+    ++(*covered)[part];
+  });
 }
 
 }  // namespace exporter

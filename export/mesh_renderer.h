@@ -1,5 +1,8 @@
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "calib/calibrated_view.h"
 #include "export/point_renderer.h"
 #include "export/surface_mesh.h"
@@ -23,6 +26,15 @@ Rendering RenderMesh(const TriangleMesh& mesh, const CalibratedView& view,
 // what finding the vertices a view sees needs, for less memory traffic.
 cv::Mat RenderMeshDepth(const TriangleMesh& mesh, const CalibratedView& view,
                         bool front_faces_only = false);
+
+// Which of a mesh's parts cover each pixel of `view`, front faces only (closed parts seen from
+// outside): `count` (CV_8UC1, saturating at 255) gets how many parts cover the pixel, `last_part`
+// (CV_32SC1, -1 where none) the last of them, and `covered` per part the pixels it covers.
+// `triangle_part` gives each triangle's part (0 to num_parts - 1), in ascending order: the
+// triangles must be grouped by part.
+void DrawMeshParts(const TriangleMesh& mesh, const std::vector<int>& triangle_part, int num_parts,
+                   const CalibratedView& view, cv::Mat* count, cv::Mat* last_part,
+                   std::vector<int64_t>* covered);
 
 }  // namespace exporter
 }  // namespace raycarve

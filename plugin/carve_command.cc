@@ -249,9 +249,11 @@ CarveRun CarveProject(const CarveRequest& request) {
   } else {
     exporter::ModelMesh model = exporter::MeshCarvedModel(*run.result, views, request.mesh);
     LOG(INFO) << model.geometry.Summary();
+    if (model.parts.removed > 0) LOG(INFO) << model.parts.Summary();
     if (!model.mesh.empty()) {
       LOG(INFO) << model.refinement.Summary();
       LOG(INFO) << exporter::FinalSmoothingSummary(model, request.mesh);
+      if (model.silhouettes.passes > 0) LOG(INFO) << model.silhouettes.Summary();
       LOG(INFO) << model.colouring.Summary();
     }
     run.stage_seconds.emplace_back("mesh", SecondsSince(stage));
@@ -262,6 +264,8 @@ CarveRun CarveProject(const CarveRequest& request) {
     run.num_mesh_vertices = model.mesh.vertices.size();
     run.mesh_colouring = model.colouring;
     run.mesh_refinement = model.refinement;
+    run.mesh_parts = model.parts;
+    run.mesh_silhouettes = model.silhouettes;
     run.mesh_final_smoothing_mean_move = model.final_smoothing_mean_move;
     run.mesh_small_components_removed = model.small_components_removed;
     run.mesh_grid_wall_vertices = model.grid_wall_vertices;
@@ -614,6 +618,17 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
         .Key("final_smoothing_iterations").Value(request.mesh.final_smoothing_iterations)
         .Key("final_smoothing_mean_move_voxels")
         .Value(run.mesh_final_smoothing_mean_move / run.result->volume.grid().voxel_size())
+        .Key("part_min_views").Value(request.mesh.part_min_views)
+        .Key("parts_before").Value(run.mesh_parts.parts)
+        .Key("parts_removed_unneeded").Value(run.mesh_parts.removed)
+        .Key("vertices_removed_unneeded").Value(run.mesh_parts.removed_vertices)
+        .Key("silhouette_passes").Value(run.mesh_silhouettes.passes)
+        .Key("silhouette_outline_vertices").Value(run.mesh_silhouettes.outline_vertices)
+        .Key("silhouette_pulled_vertices").Value(run.mesh_silhouettes.pulled_vertices)
+        .Key("silhouette_beyond_masks_px_first").Value(run.mesh_silhouettes.mean_outside_pixels_first)
+        .Key("silhouette_beyond_masks_px_last").Value(run.mesh_silhouettes.mean_outside_pixels_last)
+        .Key("silhouette_mean_move_voxels")
+        .Value(run.mesh_silhouettes.mean_move / run.result->volume.grid().voxel_size())
         .Key("vertices_coloured_from_photos").Value(c.from_photos)
         .Key("vertices_coloured_from_neighbours").Value(c.from_neighbours)
         .Key("vertices_uncoloured").Value(c.uncoloured)
@@ -774,6 +789,15 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "by the share the photos leave open (none where a clear cost minimum pins "
                      "it; all over plain surfaces and where fewer than two photos see it); 0: "
                      "none");
+  parser->AddDefault("mesh_part_min_views", &request->mesh.part_min_views,
+                     "smooth mesh: a part of the mesh (a connected piece) stays only where this "
+                     "many masked photos need it (half or more of what it covers in the photo is "
+                     "object that no other part covers); the largest part always stays; 0: keep "
+                     "every part");
+  parser->AddDefault("mesh_silhouette_passes", &request->mesh.silhouette_passes,
+                     "smooth mesh: after the final smoothing, passes pulling the outline's "
+                     "vertices that stand beyond the masks in onto the masks' edges (the median "
+                     "over the photos; at most a voxel a pass); 0: none");
   parser->AddDefault("mesh_refine_converged", &request->mesh.refine_converged_voxels,
                      "smooth mesh: the refinement stops after a pass that moves the vertices by "
                      "less than this many voxels on average (0: run every pass)");

@@ -217,6 +217,8 @@ struct CarveRun {
   exporter::MeshTopology mesh_topology;
   exporter::MeshColouringSummary mesh_colouring;  // the smooth mesh's (vertices 0 otherwise)
   exporter::MeshRefinementSummary mesh_refinement;
+  exporter::MeshPartsSummary mesh_parts;
+  exporter::SilhouetteFitSummary mesh_silhouettes;
   double mesh_final_smoothing_mean_move = 0.0;  // world units
   int64_t mesh_small_components_removed = 0;
   int64_t mesh_grid_wall_vertices = 0;  // on the grid's wall: left out of the cloud

@@ -163,6 +163,8 @@ int RunHoldout(int argc, char** argv) {
       LOG(INFO) << model.geometry.Summary();
       if (!model.mesh.empty()) LOG(INFO) << model.refinement.Summary();
       if (!model.mesh.empty()) LOG(INFO) << exporter::FinalSmoothingSummary(model, request.mesh);
+      if (model.parts.removed > 0) LOG(INFO) << model.parts.Summary();
+      if (model.silhouettes.passes > 0) LOG(INFO) << model.silhouettes.Summary();
       if (!model.mesh.empty()) LOG(INFO) << model.colouring.Summary();
     }
   }
@@ -185,7 +187,8 @@ int RunHoldout(int argc, char** argv) {
       .Key("render").Value(render)
       .Key("mesh_triangles").Value(static_cast<uint64_t>(model.mesh.triangles.size()))
       .Key("mesh_seconds")
-      .Value(model.geometry.seconds + model.refinement.seconds + model.colouring.seconds)
+      .Value(model.geometry.seconds + model.parts.seconds + model.refinement.seconds +
+             model.silhouettes.seconds + model.colouring.seconds)
       .Key("model").Value(other_path.empty() ? std::string("carved") : other_path)
       .Key("carve").Value(result ? result->statistics.Summary() : std::string())
       .Key("evaluated").Value(result ? result->statistics.evaluated : int64_t{0})

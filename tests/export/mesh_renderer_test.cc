@@ -142,6 +142,35 @@ TEST(RenderMesh, FrontFacesAloneGiveAClosedMeshsDepthBuffer) {
   EXPECT_GT(cv::countNonZero(RenderMesh(facing, view).silhouette), 0);
 }
 
+TEST(DrawMeshParts, CountsThePartsOverEachPixelAndWhatEachCovers) {
+  const CalibratedView view = Straight();
+  // Part 0: pixels 5..25 x 5..15 at depth 4; part 1: 15..35 x 10..25 at depth 6 (behind it where
+  // they overlap); part 2: two triangles far off to the side, never drawn.
+  TriangleMesh mesh;
+  mesh.vertices = {Unproject(view, 5, 5, 4),    Unproject(view, 25, 5, 4),   Unproject(view, 25, 15, 4),
+                   Unproject(view, 5, 15, 4),   Unproject(view, 15, 10, 6),  Unproject(view, 35, 10, 6),
+                   Unproject(view, 35, 25, 6),  Unproject(view, 15, 25, 6),  Unproject(view, 500, 0, 4),
+                   Unproject(view, 520, 0, 4),  Unproject(view, 520, 20, 4)};
+  // Wound as front faces (clockwise on the screen).
+  mesh.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 6, 5}, {4, 7, 6}, {8, 10, 9}};
+  const std::vector<int> part = {0, 0, 1, 1, 2};
+  cv::Mat count, last;
+  std::vector<int64_t> covered;
+  DrawMeshParts(mesh, part, 3, view, &count, &last, &covered);
+  ASSERT_EQ(covered.size(), 3u);
+  EXPECT_EQ(covered[0], 20 * 10);
+  EXPECT_EQ(covered[1], 20 * 15);
+  EXPECT_EQ(covered[2], 0);
+  for (int row = 0; row < view.height; ++row) {
+    for (int col = 0; col < view.width; ++col) {
+      const bool in0 = col >= 5 && col < 25 && row >= 5 && row < 15;
+      const bool in1 = col >= 15 && col < 35 && row >= 10 && row < 25;
+      ASSERT_EQ(count.at<uint8_t>(row, col), int(in0) + int(in1)) << col << "," << row;
+      ASSERT_EQ(last.at<int>(row, col), in1 ? 1 : (in0 ? 0 : -1)) << col << "," << row;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

@@ -1,0 +1,340 @@
+#include "export/mesh_silhouettes.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include <glog/logging.h>
+#include <opencv2/imgproc.hpp>
+
+#include "carve/view_workers.h"
+#include "export/mesh_renderer.h"
+#include "export/parallel_ranges.h"
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+// Signed distance (pixels) from each pixel centre to the mask's edge, positive on the background:
+// the edge lies half a pixel beyond the last object pixel.
+cv::Mat SignedMaskDistance(const cv::Mat& mask) {
+  cv::Mat inside, outside;
+  cv::distanceTransform(mask, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  const cv::Mat background = mask == 0;
+  cv::distanceTransform(background, outside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::Mat distance(mask.size(), CV_32F);
+  for (int row = 0; row < mask.rows; ++row) {
+    const uint8_t* object = mask.ptr<uint8_t>(row);
+    const float* in = inside.ptr<float>(row);
+    const float* out = outside.ptr<float>(row);
+    float* d = distance.ptr<float>(row);
+    for (int col = 0; col < mask.cols; ++col) {
+      d[col] = object[col] != 0 ? 0.5f - in[col] : out[col] - 0.5f;
+    }
+  }
+  return distance;
+}
+
+// Bilinear sample of a CV_32F image at a COLMAP pixel position (centres at +0.5), clamped to
+// the image's centres.
+float SampleField(const cv::Mat& field, double x, double y) {
+  const double u = std::clamp(x - 0.5, 0.0, field.cols - 1.0);
+  const double v = std::clamp(y - 0.5, 0.0, field.rows - 1.0);
+  const int c0 = std::min(static_cast<int>(u), std::max(field.cols - 2, 0));
+  const int r0 = std::min(static_cast<int>(v), std::max(field.rows - 2, 0));
+  const int c1 = std::min(c0 + 1, field.cols - 1), r1 = std::min(r0 + 1, field.rows - 1);
+  const float fu = static_cast<float>(u - c0), fv = static_cast<float>(v - r0);
+  return (1.0f - fv) * ((1.0f - fu) * field.at<float>(r0, c0) + fu * field.at<float>(r0, c1)) +
+         fv * ((1.0f - fu) * field.at<float>(r1, c0) + fu * field.at<float>(r1, c1));
+}
+
+// `passes` times, each value becomes the mean of itself and its neighbours' (a vertex listed once
+// per triangle edge it shares).
+void AverageOverNeighbours(const std::vector<std::vector<int>>& neighbours, int passes,
+                           std::vector<float>* values) {
+  const size_t n = values->size();
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<float> averaged(n);
+    for (size_t i = 0; i < n; ++i) {
+      double sum = (*values)[i];
+      for (int j : neighbours[i]) sum += (*values)[j];
+      averaged[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
+    }
+    values->swap(averaged);
+  }
+}
+
+std::vector<size_t> MaskedViews(const std::vector<CalibratedView>& views) {
+  std::vector<size_t> masked;
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (!views[v].mask.empty()) masked.push_back(v);
+  }
+  return masked;
+}
+
+}  // namespace
+
+std::string MeshPartsSummary::Summary() const {
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "mesh parts: %d; %d that fewer than two of %d masked photos need removed (%lld "
+                "vertices) in %.2f s",
+                parts, removed, masked_views, static_cast<long long>(removed_vertices), seconds);
+  return text;
+}
+
+MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
+                                     int min_needing_views, int num_threads, TriangleMesh* mesh) {
+  const auto start = std::chrono::steady_clock::now();
+  MeshPartsSummary summary;
+  const std::vector<size_t> masked = MaskedViews(views);
+  summary.masked_views = static_cast<int>(masked.size());
+  const int n = static_cast<int>(mesh->vertices.size());
+  // Parts: union-find over the triangles' corners, numbered in order of their first vertex.
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&parent](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const Eigen::Vector3i& t : mesh->triangles) {
+    parent[find(t[1])] = find(t[0]);
+    parent[find(t[2])] = find(t[0]);
+  }
+  std::vector<int> part_of_root(n, -1), part(n);
+  int parts = 0;
+  for (int i = 0; i < n; ++i) {
+    int& p = part_of_root[find(i)];
+    if (p < 0) p = parts++;
+    part[i] = p;
+  }
+  summary.parts = parts;
+  if (parts < 2 || min_needing_views <= 0 ||
+      static_cast<int>(masked.size()) < min_needing_views) {
+    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return summary;
+  }
+  std::vector<int64_t> part_vertices(parts, 0);
+  for (int i = 0; i < n; ++i) ++part_vertices[part[i]];
+  const int largest = static_cast<int>(
+      std::max_element(part_vertices.begin(), part_vertices.end()) - part_vertices.begin());
+  // The triangles grouped by part, as DrawMeshParts needs them.
+  TriangleMesh grouped;
+  grouped.vertices = mesh->vertices;
+  std::vector<size_t> order(mesh->triangles.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return part[mesh->triangles[a][0]] < part[mesh->triangles[b][0]];
+  });
+  std::vector<int> triangle_part(order.size());
+  grouped.triangles.reserve(order.size());
+  for (size_t k = 0; k < order.size(); ++k) {
+    grouped.triangles.push_back(mesh->triangles[order[k]]);
+    triangle_part[k] = part[mesh->triangles[order[k]][0]];
+  }
+  // Per masked view, the parts it needs.
+  std::vector<std::vector<uint8_t>> needs(masked.size(), std::vector<uint8_t>(parts, 0));
+  ParallelRanges(masked.size(), ResolveNumThreads(num_threads), /*min_per_thread=*/1,
+                 [&](size_t first, size_t last) {
+    cv::Mat count, last_part;
+    std::vector<int64_t> covered, alone(parts);
+    for (size_t m = first; m < last; ++m) {
+      const CalibratedView& view = views[masked[m]];
+      DrawMeshParts(grouped, triangle_part, parts, view, &count, &last_part, &covered);
+      std::fill(alone.begin(), alone.end(), 0);
+      for (int row = 0; row < view.height; ++row) {
+        const uint8_t* c = count.ptr<uint8_t>(row);
+        const int* p = last_part.ptr<int>(row);
+        const uint8_t* object = view.mask.ptr<uint8_t>(row);
+        for (int col = 0; col < view.width; ++col) {
+          if (c[col] == 1 && object[col] != 0) ++alone[p[col]];
+        }
+      }
+      for (int p = 0; p < parts; ++p) needs[m][p] = covered[p] > 0 && 2 * alone[p] >= covered[p];
+    }
+  });
+  std::vector<uint8_t> keep(parts, 0);
+  for (int p = 0; p < parts; ++p) {
+    int needing = 0;
+    for (size_t m = 0; m < masked.size(); ++m) needing += needs[m][p];
+    keep[p] = p == largest || needing >= min_needing_views;
+    if (!keep[p]) {
+      ++summary.removed;
+      summary.removed_vertices += part_vertices[p];
+    }
+  }
+  if (summary.removed > 0) {
+    std::vector<int> remap(n, -1);
+    TriangleMesh kept;
+    const bool normals = mesh->normals.size() == mesh->vertices.size();
+    const bool colours = mesh->colours.size() == mesh->vertices.size();
+    for (int i = 0; i < n; ++i) {
+      if (!keep[part[i]]) continue;
+      remap[i] = static_cast<int>(kept.vertices.size());
+      kept.vertices.push_back(mesh->vertices[i]);
+      if (normals) kept.normals.push_back(mesh->normals[i]);
+      if (colours) kept.colours.push_back(mesh->colours[i]);
+    }
+    for (const Eigen::Vector3i& t : mesh->triangles) {
+      if (remap[t[0]] < 0) continue;
+      kept.triangles.emplace_back(remap[t[0]], remap[t[1]], remap[t[2]]);
+    }
+    *mesh = std::move(kept);
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+bool SilhouetteFitOptions::IsValid(std::string* reason) const {
+  if (passes < 0 || smoothing_passes < 0) {
+    *reason = "silhouette fit passes must be >= 0";
+    return false;
+  }
+  if (!(max_move > 0.0) || !(depth_tolerance > 0.0) || !std::isfinite(max_move) ||
+      !std::isfinite(depth_tolerance)) {
+    *reason = "silhouette fit needs a finite max_move and depth_tolerance > 0";
+    return false;
+  }
+  return true;
+}
+
+std::string SilhouetteFitSummary::Summary() const {
+  char text[320];
+  std::snprintf(text, sizeof(text),
+                "mesh outlines: %lld vertices on %d masked photos' outlines, %lld pulled in onto "
+                "the masks; beyond the masks by %.2f px on average before, %.2f px before the "
+                "last of %d passes; in %.2f s",
+                static_cast<long long>(outline_vertices), masked_views,
+                static_cast<long long>(pulled_vertices), mean_outside_pixels_first,
+                mean_outside_pixels_last, passes, seconds);
+  return text;
+}
+
+SilhouetteFitSummary FitMeshToSilhouettes(const std::vector<CalibratedView>& views,
+                                          const SilhouetteFitOptions& options, TriangleMesh* mesh) {
+  std::string reason;
+  CHECK(options.IsValid(&reason)) << reason;
+  const auto start = std::chrono::steady_clock::now();
+  SilhouetteFitSummary summary;
+  const std::vector<size_t> masked = MaskedViews(views);
+  summary.masked_views = static_cast<int>(masked.size());
+  const size_t n = mesh->vertices.size();
+  if (n == 0 || masked.empty() || options.passes == 0) return summary;
+  if (mesh->normals.size() != n) ComputeVertexNormals(mesh);
+  std::vector<std::vector<int>> neighbours(n);
+  for (const Eigen::Vector3i& t : mesh->triangles) {
+    for (int k = 0; k < 3; ++k) {
+      neighbours[t[k]].push_back(t[(k + 1) % 3]);
+      neighbours[t[k]].push_back(t[(k + 2) % 3]);
+    }
+  }
+  const int threads = ResolveNumThreads(options.num_threads);
+  std::vector<cv::Mat> distances(masked.size());
+  ParallelRanges(masked.size(), threads, /*min_per_thread=*/1, [&](size_t first, size_t last) {
+    for (size_t m = first; m < last; ++m) distances[m] = SignedMaskDistance(views[masked[m]].mask);
+  });
+  // One view's say on one outline vertex: the move along its normal (<= 0) and how far beyond
+  // the mask's edge it lies (pixels, 0 on the object).
+  struct Vote {
+    uint32_t vertex;
+    float move;
+    float outside;
+  };
+  double move_sum = 0.0;
+  int64_t moves_made = 0;
+  for (int pass = 0; pass < options.passes; ++pass) {
+    std::vector<std::vector<Vote>> votes(masked.size());
+    ParallelRanges(masked.size(), threads, /*min_per_thread=*/1, [&](size_t first, size_t last) {
+      for (size_t m = first; m < last; ++m) {
+        const CalibratedView& view = views[masked[m]];
+        const cv::Mat depths = RenderMeshDepth(*mesh, view, /*front_faces_only=*/true);
+        const cv::Mat& distance = distances[m];
+        const Eigen::Matrix3d M = view.P.leftCols<3>();
+        for (size_t i = 0; i < n; ++i) {
+          const Eigen::Vector3d h = view.P * mesh->vertices[i].cast<double>().homogeneous();
+          if (!(h.z() > 0.0)) continue;
+          const double x = h.x() / h.z(), y = h.y() / h.z();
+          const int col = static_cast<int>(std::floor(x)), row = static_cast<int>(std::floor(y));
+          if (col < 1 || row < 1 || col >= view.width - 1 || row >= view.height - 1) continue;
+          const float own = depths.at<float>(row, col);
+          if (std::isfinite(own) && h.z() > own + options.depth_tolerance) continue;  // hidden
+          bool outline = false;
+          for (int dr = -1; dr <= 1 && !outline; ++dr) {
+            for (int dc = -1; dc <= 1 && !outline; ++dc) {
+              outline = !std::isfinite(depths.at<float>(row + dr, col + dc));
+            }
+          }
+          if (!outline) continue;
+          // The projection's velocity (pixels per world unit along the normal) and the rate at
+          // which it changes the signed distance; the normal must carry the projection across
+          // the edge outwards, not along it.
+          const Eigen::Vector3d dh = M * mesh->normals[i].cast<double>();
+          const double z2 = h.z() * h.z();
+          const Eigen::Vector2d velocity((dh.x() * h.z() - h.x() * dh.z()) / z2,
+                                         (dh.y() * h.z() - h.y() * dh.z()) / z2);
+          const float d = SampleField(distance, x, y);
+          const double gx = 0.5 * (SampleField(distance, x + 1.0, y) - SampleField(distance, x - 1.0, y));
+          const double gy = 0.5 * (SampleField(distance, x, y + 1.0) - SampleField(distance, x, y - 1.0));
+          const double rate = gx * velocity.x() + gy * velocity.y();
+          if (!(rate > 0.5 * velocity.norm() * std::hypot(gx, gy))) continue;
+          const double move = std::clamp(-d / rate, -options.max_move, 0.0);
+          votes[m].push_back({static_cast<uint32_t>(i), static_cast<float>(move), std::max(d, 0.0f)});
+        }
+      }
+    });
+    std::vector<std::vector<float>> moves(n);
+    double outside_sum = 0.0;
+    int64_t sightings = 0;
+    for (const std::vector<Vote>& view_votes : votes) {
+      for (const Vote& vote : view_votes) {
+        moves[vote.vertex].push_back(vote.move);
+        outside_sum += vote.outside;
+        ++sightings;
+      }
+    }
+    const double mean_outside = sightings > 0 ? outside_sum / sightings : 0.0;
+    if (pass == 0) summary.mean_outside_pixels_first = mean_outside;
+    summary.mean_outside_pixels_last = mean_outside;
+    std::vector<float> weighted(n, 0.0f), weights(n, 0.0f);
+    int64_t outline = 0, pulled = 0;
+    for (size_t i = 0; i < n; ++i) {
+      std::vector<float>& m = moves[i];
+      if (m.empty()) continue;
+      ++outline;
+      std::sort(m.begin(), m.end());
+      const size_t half = m.size() / 2;
+      const float median = m.size() % 2 == 1 ? m[half] : 0.5f * (m[half - 1] + m[half]);
+      if (median < 0.0f) ++pulled;
+      weighted[i] = median;
+      weights[i] = 1.0f;
+    }
+    if (pass == 0) {
+      summary.outline_vertices = outline;
+      summary.pulled_vertices = pulled;
+    }
+    // The weighted mean of the outline vertices' moves over each vertex's neighbourhood; a
+    // vertex whose neighbourhood holds less than half an outline vertex's weight moves by that
+    // share (the band fades into the surface).
+    AverageOverNeighbours(neighbours, options.smoothing_passes, &weighted);
+    AverageOverNeighbours(neighbours, options.smoothing_passes, &weights);
+    for (size_t i = 0; i < n; ++i) {
+      if (!(weights[i] > 0.0f) || weighted[i] == 0.0f) continue;
+      const float move = weighted[i] / std::max(weights[i], 0.5f);
+      mesh->vertices[i] += move * mesh->normals[i];
+      move_sum += std::abs(move);
+      ++moves_made;
+    }
+    ComputeVertexNormals(mesh);
+    summary.passes = pass + 1;
+    VLOG(1) << "silhouette fit pass " << pass + 1 << ": " << outline << " outline vertices, "
+            << pulled << " pulled in; beyond the masks " << mean_outside << " px on average";
+  }
+  summary.mean_move = moves_made > 0 ? move_sum / moves_made : 0.0;
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace exporter
+}  // namespace raycarve

@@ -195,7 +195,8 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   model.mesh = MeshSolidVoxels(result.volume, geometry, &model.geometry);
   model.small_components_removed =
       RemoveSmallComponents(options.min_component_vertices, &model.mesh);
-  model.parts = RemoveUnneededParts(views, options.part_min_views, options.num_threads, &model.mesh);
+  model.parts = RemoveUnneededParts(views, options.part_min_views, options.sparse_points,
+                                    1.5 * grid.voxel_size(), options.num_threads, &model.mesh);
   if (model.mesh.empty()) return model;
   MeshRefinementOptions refinement;
   refinement.passes = options.refine_passes;

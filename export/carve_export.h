@@ -74,6 +74,8 @@ struct ModelMeshOptions {
   // silhouette); the largest part stays. 0 keeps every part. Two photos, as elsewhere: one photo's
   // mask can be wrong, and the silhouette repair serves one photo's object pixels at a time.
   int part_min_views = 2;
+  // Reliable sparse points: a part within 1.5 voxels of one stays (RemoveUnneededParts).
+  std::vector<Eigen::Vector3d> sparse_points;
   // After the final smoothing, passes of FitMeshToSilhouettes: outline vertices standing beyond
   // the masks are pulled in onto their edges (by the median over the photos they are on the
   // outline of, at most a voxel a pass). 0: none.

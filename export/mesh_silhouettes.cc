@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <unordered_map>
 
 #include <glog/logging.h>
 #include <opencv2/imgproc.hpp>
@@ -79,14 +80,17 @@ std::vector<size_t> MaskedViews(const std::vector<CalibratedView>& views) {
 std::string MeshPartsSummary::Summary() const {
   char text[256];
   std::snprintf(text, sizeof(text),
-                "mesh parts: %d; %d that fewer than two of %d masked photos need removed (%lld "
-                "vertices) in %.2f s",
-                parts, removed, masked_views, static_cast<long long>(removed_vertices), seconds);
+                "mesh parts: %d; %d that fewer than two of %d masked photos need and no sparse "
+                "point holds removed (%lld vertices), %d kept for a sparse point alone; in %.2f s",
+                parts, removed, masked_views, static_cast<long long>(removed_vertices), anchored,
+                seconds);
   return text;
 }
 
 MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
-                                     int min_needing_views, int num_threads, TriangleMesh* mesh) {
+                                     int min_needing_views,
+                                     const std::vector<Eigen::Vector3d>& anchors,
+                                     double anchor_radius, int num_threads, TriangleMesh* mesh) {
   const auto start = std::chrono::steady_clock::now();
   MeshPartsSummary summary;
   const std::vector<size_t> masked = MaskedViews(views);
@@ -155,11 +159,45 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
       for (int p = 0; p < parts; ++p) needs[m][p] = covered[p] > 0 && 2 * alone[p] >= covered[p];
     }
   });
+  // Parts holding a sparse point: vertices hashed into cells anchor_radius wide.
+  std::vector<uint8_t> anchored(parts, 0);
+  if (!anchors.empty() && anchor_radius > 0.0) {
+    auto cell = [anchor_radius](const Eigen::Vector3d& p) {
+      return Eigen::Vector3i((p / anchor_radius).array().floor().cast<int>());
+    };
+    auto key = [](const Eigen::Vector3i& c) {
+      return (static_cast<uint64_t>(static_cast<uint32_t>(c.x()) & 0x1FFFFF) << 42) |
+             (static_cast<uint64_t>(static_cast<uint32_t>(c.y()) & 0x1FFFFF) << 21) |
+             (static_cast<uint64_t>(static_cast<uint32_t>(c.z()) & 0x1FFFFF));
+    };
+    std::unordered_map<uint64_t, std::vector<int>> cells;
+    for (int i = 0; i < n; ++i) {
+      if (part[i] != largest) cells[key(cell(mesh->vertices[i].cast<double>()))].push_back(i);
+    }
+    for (const Eigen::Vector3d& point : anchors) {
+      const Eigen::Vector3i c = cell(point);
+      for (int dx = -1; dx <= 1; ++dx) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dz = -1; dz <= 1; ++dz) {
+            const auto found = cells.find(key(c + Eigen::Vector3i(dx, dy, dz)));
+            if (found == cells.end()) continue;
+            for (int i : found->second) {
+              if ((mesh->vertices[i].cast<double>() - point).norm() <= anchor_radius) anchored[part[i]] = 1;
+            }
+          }
+        }
+      }
+    }
+  }
   std::vector<uint8_t> keep(parts, 0);
   for (int p = 0; p < parts; ++p) {
     int needing = 0;
     for (size_t m = 0; m < masked.size(); ++m) needing += needs[m][p];
-    keep[p] = p == largest || needing >= min_needing_views;
+    keep[p] = p == largest || needing >= min_needing_views || anchored[p];
+    if (p != largest && needing < min_needing_views && anchored[p]) ++summary.anchored;
+    VLOG(1) << "mesh part " << p << ": " << part_vertices[p] << " vertices, needed by " << needing
+            << " masked photos" << (anchored[p] ? ", holds a sparse point" : "")
+            << (keep[p] ? "" : ": removed");
     if (!keep[p]) {
       ++summary.removed;
       summary.removed_vertices += part_vertices[p];

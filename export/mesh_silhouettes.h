@@ -17,6 +17,7 @@ struct MeshPartsSummary {
   int parts = 0;           // connected components before
   int removed = 0;
   int64_t removed_vertices = 0;
+  int anchored = 0;        // kept for a sparse point alone (no two masks needed them)
   int masked_views = 0;
   double seconds = 0.0;
   std::string Summary() const;
@@ -30,9 +31,15 @@ struct MeshPartsSummary {
 // the masks overlap), and colour carving keeps those whose photos happen to agree; no mask needs
 // them. A separate object is seen on its own in most photos. The largest part always stays;
 // views without a mask count for nothing, and with fewer masked views than min_needing_views (or
-// min_needing_views <= 0) nothing is removed. Normals and colours follow the vertices.
+// min_needing_views <= 0) nothing is removed. A part with a vertex within `anchor_radius` of one
+// of `anchors` (reliable sparse points: features matched and triangulated across photos) stays
+// too: a real piece of the object the masks fail to show on its own (holes in masks made from
+// a backdrop the object shares colours with cut the model into pieces that overlap in every
+// photo). Normals and colours follow the vertices.
 MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
-                                     int min_needing_views, int num_threads, TriangleMesh* mesh);
+                                     int min_needing_views,
+                                     const std::vector<Eigen::Vector3d>& anchors,
+                                     double anchor_radius, int num_threads, TriangleMesh* mesh);
 
 // Pulls the vertices of a closed mesh's outlines in along their normals onto the masks' edges.
 //

@@ -247,9 +247,11 @@ CarveRun CarveProject(const CarveRequest& request) {
     run.num_mesh_vertices = mesh.num_vertices;
     run.stage_seconds.emplace_back("export", SecondsSince(stage));
   } else {
-    exporter::ModelMesh model = exporter::MeshCarvedModel(*run.result, views, request.mesh);
+    exporter::ModelMeshOptions mesh_options = request.mesh;
+    for (const SurfacePoint& point : project.surface_points) mesh_options.sparse_points.push_back(point.xyz);
+    exporter::ModelMesh model = exporter::MeshCarvedModel(*run.result, views, mesh_options);
     LOG(INFO) << model.geometry.Summary();
-    if (model.parts.removed > 0) LOG(INFO) << model.parts.Summary();
+    if (model.parts.removed > 0 || model.parts.anchored > 0) LOG(INFO) << model.parts.Summary();
     if (!model.mesh.empty()) {
       LOG(INFO) << model.refinement.Summary();
       LOG(INFO) << exporter::FinalSmoothingSummary(model, request.mesh);
@@ -622,6 +624,7 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
         .Key("parts_before").Value(run.mesh_parts.parts)
         .Key("parts_removed_unneeded").Value(run.mesh_parts.removed)
         .Key("vertices_removed_unneeded").Value(run.mesh_parts.removed_vertices)
+        .Key("parts_kept_for_sparse_points").Value(run.mesh_parts.anchored)
         .Key("silhouette_passes").Value(run.mesh_silhouettes.passes)
         .Key("silhouette_outline_vertices").Value(run.mesh_silhouettes.outline_vertices)
         .Key("silhouette_pulled_vertices").Value(run.mesh_silhouettes.pulled_vertices)

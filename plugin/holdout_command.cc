@@ -159,11 +159,13 @@ int RunHoldout(int argc, char** argv) {
     point_size = result->volume.grid().voxel_size();
     if (render == "mesh") {
       // Coloured from the training views only: the held-out photos never reach the model.
-      model = exporter::MeshCarvedModel(*result, training, request.mesh);
+      exporter::ModelMeshOptions mesh_options = request.mesh;
+      for (const SurfacePoint& point : options.surface_points) mesh_options.sparse_points.push_back(point.xyz);
+      model = exporter::MeshCarvedModel(*result, training, mesh_options);
       LOG(INFO) << model.geometry.Summary();
       if (!model.mesh.empty()) LOG(INFO) << model.refinement.Summary();
       if (!model.mesh.empty()) LOG(INFO) << exporter::FinalSmoothingSummary(model, request.mesh);
-      if (model.parts.removed > 0) LOG(INFO) << model.parts.Summary();
+      if (model.parts.removed > 0 || model.parts.anchored > 0) LOG(INFO) << model.parts.Summary();
       if (model.silhouettes.passes > 0) LOG(INFO) << model.silhouettes.Summary();
       if (!model.mesh.empty()) LOG(INFO) << model.colouring.Summary();
     }

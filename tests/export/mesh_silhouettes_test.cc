@@ -200,7 +200,7 @@ TEST(RemoveUnneededParts, APhantomNoMaskNeedsGoesAndASeparateObjectStays) {
   }
   const TriangleMesh all = Join(Join(ball, phantom), object);
   TriangleMesh mesh = all;
-  const MeshPartsSummary summary = RemoveUnneededParts(views, 2, 0, &mesh);
+  const MeshPartsSummary summary = RemoveUnneededParts(views, 2, {}, 0.0, 0, &mesh);
   EXPECT_EQ(summary.parts, 3);
   EXPECT_EQ(summary.removed, 1);
   EXPECT_EQ(summary.removed_vertices, static_cast<int64_t>(phantom.vertices.size()));
@@ -208,13 +208,23 @@ TEST(RemoveUnneededParts, APhantomNoMaskNeedsGoesAndASeparateObjectStays) {
   ASSERT_EQ(mesh.normals.size(), mesh.vertices.size());
   EXPECT_EQ(mesh.triangles.size(), ball.triangles.size() + object.triangles.size());
   for (const Eigen::Vector3f& v : mesh.vertices) EXPECT_LT(v.z(), 0.55f);  // nothing of the phantom
+  // A sparse point on the phantom's surface keeps it (a feature the photos matched there).
+  mesh = all;
+  const MeshPartsSummary anchored = RemoveUnneededParts(
+      views, 2, {Eigen::Vector3d(0.0, 0.0, 0.75 - 0.12)}, 0.075, 0, &mesh);
+  EXPECT_EQ(anchored.removed, 0);
+  EXPECT_EQ(anchored.anchored, 1);
+  EXPECT_EQ(mesh.vertices.size(), all.vertices.size());
+  // A point far from every small part keeps nothing.
+  mesh = all;
+  EXPECT_EQ(RemoveUnneededParts(views, 2, {Eigen::Vector3d(0.9, 0.9, 0.9)}, 0.075, 0, &mesh).removed, 1);
   // 0 keeps every part, and so do too few masked views.
   mesh = all;
-  EXPECT_EQ(RemoveUnneededParts(views, 0, 0, &mesh).removed, 0);
+  EXPECT_EQ(RemoveUnneededParts(views, 0, {}, 0.0, 0, &mesh).removed, 0);
   EXPECT_EQ(mesh.vertices.size(), all.vertices.size());
   std::vector<CalibratedView> one_mask = views;
   for (size_t v = 1; v < one_mask.size(); ++v) one_mask[v].mask = cv::Mat();
-  EXPECT_EQ(RemoveUnneededParts(one_mask, 2, 0, &mesh).removed, 0);
+  EXPECT_EQ(RemoveUnneededParts(one_mask, 2, {}, 0.0, 0, &mesh).removed, 0);
   EXPECT_EQ(mesh.vertices.size(), all.vertices.size());
 }
 

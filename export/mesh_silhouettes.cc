@@ -67,6 +67,19 @@ void AverageOverNeighbours(const std::vector<std::vector<int>>& neighbours, int 
   }
 }
 
+// The pixels a depth buffer leaves uncovered that connect (4-connected) to the image's border:
+// 255; covered pixels and see-through holes inside the outline: 0.
+cv::Mat ExteriorPixels(const cv::Mat& depths) {
+  cv::Mat padded(depths.rows + 2, depths.cols + 2, CV_8UC1, cv::Scalar(1));
+  for (int row = 0; row < depths.rows; ++row) {
+    const float* depth = depths.ptr<float>(row);
+    uint8_t* out = padded.ptr<uint8_t>(row + 1) + 1;
+    for (int col = 0; col < depths.cols; ++col) out[col] = std::isfinite(depth[col]) ? 0 : 1;
+  }
+  cv::floodFill(padded, cv::Point(0, 0), cv::Scalar(255), nullptr, cv::Scalar(0), cv::Scalar(0), 4);
+  return padded(cv::Rect(1, 1, depths.cols, depths.rows)) == 255;
+}
+
 std::vector<size_t> MaskedViews(const std::vector<CalibratedView>& views) {
   std::vector<size_t> masked;
   for (size_t v = 0; v < views.size(); ++v) {
@@ -290,6 +303,7 @@ SilhouetteFitSummary FitMeshToSilhouettes(const std::vector<CalibratedView>& vie
         const cv::Mat depths = RenderMeshDepth(*mesh, view, /*front_faces_only=*/true);
         const cv::Mat& distance = distances[m];
         const Eigen::Matrix3d M = view.P.leftCols<3>();
+        const cv::Mat exterior = ExteriorPixels(depths);
         for (size_t i = 0; i < n; ++i) {
           const Eigen::Vector3d h = view.P * mesh->vertices[i].cast<double>().homogeneous();
           if (!(h.z() > 0.0)) continue;
@@ -301,7 +315,7 @@ SilhouetteFitSummary FitMeshToSilhouettes(const std::vector<CalibratedView>& vie
           bool outline = false;
           for (int dr = -1; dr <= 1 && !outline; ++dr) {
             for (int dc = -1; dc <= 1 && !outline; ++dc) {
-              outline = !std::isfinite(depths.at<float>(row + dr, col + dc));
+              outline = exterior.at<uint8_t>(row + dr, col + dc) != 0;
             }
           }
           if (!outline) continue;

@@ -167,6 +167,50 @@ TEST(FitMeshToSilhouettes, ABallThinnerThanItsMasksIsLeftAlone) {
   EXPECT_EQ(mesh.vertices, before.vertices);
 }
 
+TEST(FitMeshToSilhouettes, TheRimOfASeeThroughHoleIsLeftAlone) {
+  // A washer about the z axis (radii 0.2 to 0.55, 0.4 thick) seen through its hole by cameras
+  // in front of it; the masks are a thinner washer's (0.3 to 0.5): the outer rim stands beyond
+  // them and is pulled in, and the hole, smaller in the mesh than in the masks (as a hole in a
+  // mask cut from a backdrop the object shares colours with would make it), is not widened.
+  const VoxelGrid grid(Eigen::AlignedBox3d(Eigen::Vector3d::Constant(-1), Eigen::Vector3d::Constant(1)), 40);
+  auto washer = [&grid](double inner, double outer) {
+    std::vector<uint64_t> bits((grid.num_voxels() + 63) / 64, 0);
+    for (int64_t i = 0; i < grid.num_voxels(); ++i) {
+      const Eigen::Vector3d p = grid.Centre(grid.Voxel(i));
+      const double r = p.head<2>().norm();
+      if (r >= inner && r <= outer && std::abs(p.z()) <= 0.2) bits[i / 64] |= uint64_t{1} << (i % 64);
+    }
+    TriangleMesh mesh = MeshSolidVoxels(Volume(grid, std::move(bits)), SurfaceMeshOptions());
+    ComputeVertexNormals(&mesh);
+    return mesh;
+  };
+  TriangleMesh mesh = washer(0.2, 0.55);
+  const TriangleMesh thin = washer(0.3, 0.5);
+  std::vector<CalibratedView> views;
+  for (int k = 0; k < 5; ++k) {
+    const double angle = -0.2 + 0.4 * k / 4.0;
+    views.push_back(LookingAtOrigin(3.0 * Eigen::Vector3d(std::sin(angle), 0.05, -std::cos(angle)).normalized()));
+    views.back().mask = Covered(thin, views.back());
+    // The premise: the hole is see-through in the mesh's own drawing.
+    const cv::Mat covered = Covered(mesh, views.back());
+    ASSERT_EQ(covered.at<uint8_t>(views.back().height / 2, views.back().width / 2), 0) << k;
+  }
+  const TriangleMesh before = mesh;
+  SilhouetteFitOptions options;
+  options.max_move = 0.05;
+  options.depth_tolerance = 0.05;
+  FitMeshToSilhouettes(views, options, &mesh);
+  int outer_moved = 0, inner_moved = 0;
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const double r = before.vertices[i].head<2>().norm();
+    const bool moved = (mesh.vertices[i] - before.vertices[i]).norm() > 1e-4f;
+    if (r > 0.5) outer_moved += moved;
+    if (r < 0.3) inner_moved += moved;
+  }
+  EXPECT_GT(outer_moved, 100);
+  EXPECT_EQ(inner_moved, 0);
+}
+
 TEST(FitMeshToSilhouettes, NoMasksNothingMoves) {
   const std::vector<CalibratedView> views = Ring(4, 0.3);
   TriangleMesh mesh = VoxelBall(Eigen::Vector3d::Zero(), 0.5);

@@ -34,22 +34,6 @@ void TangentBasis(const Eigen::Vector3d& n, Eigen::Vector3d* u, Eigen::Vector3d*
   *w = n.cross(*u);
 }
 
-// `passes` times, each value becomes the mean of itself and its neighbours' (a vertex listed once
-// per triangle edge it shares).
-void AverageOverNeighbours(const std::vector<std::vector<int>>& neighbours, int passes,
-                           std::vector<float>* values) {
-  const size_t n = values->size();
-  for (int pass = 0; pass < passes; ++pass) {
-    std::vector<float> averaged(n);
-    for (size_t i = 0; i < n; ++i) {
-      double sum = (*values)[i];
-      for (int j : neighbours[i]) sum += (*values)[j];
-      averaged[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
-    }
-    values->swap(averaged);
-  }
-}
-
 // How firmly the costs of the offsets tried place a vertex (MeshRefinementSummary::pinned).
 float PinnedShare(double cost_sum, int costs, double best_cost, int best_terms) {
   if (costs < 3 || best_terms < 1 || !(best_cost >= 0.0) || !std::isfinite(cost_sum)) return 0.0f;
@@ -108,13 +92,7 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
   MeshRefinementSummary summary;
   summary.vertices = static_cast<int64_t>(n);
   if (mesh->normals.size() != n) ComputeVertexNormals(mesh);
-  std::vector<std::vector<int>> neighbours(n);
-  for (const Eigen::Vector3i& t : mesh->triangles) {
-    for (int k = 0; k < 3; ++k) {
-      neighbours[t[k]].push_back(t[(k + 1) % 3]);
-      neighbours[t[k]].push_back(t[(k + 2) % 3]);
-    }
-  }
+  const std::vector<std::vector<int>> neighbours = VertexNeighbours(*mesh);
   const int steps = 2 * options.steps_per_side + 1;
   const double step = options.search_range / options.steps_per_side;
   double offset_sum = 0.0, abs_offset_sum = 0.0;

@@ -51,22 +51,6 @@ float SampleField(const cv::Mat& field, double x, double y) {
          fv * ((1.0f - fu) * field.at<float>(r1, c0) + fu * field.at<float>(r1, c1));
 }
 
-// `passes` times, each value becomes the mean of itself and its neighbours' (a vertex listed once
-// per triangle edge it shares).
-void AverageOverNeighbours(const std::vector<std::vector<int>>& neighbours, int passes,
-                           std::vector<float>* values) {
-  const size_t n = values->size();
-  for (int pass = 0; pass < passes; ++pass) {
-    std::vector<float> averaged(n);
-    for (size_t i = 0; i < n; ++i) {
-      double sum = (*values)[i];
-      for (int j : neighbours[i]) sum += (*values)[j];
-      averaged[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
-    }
-    values->swap(averaged);
-  }
-}
-
 // The pixels a depth buffer leaves uncovered that connect (4-connected) to the image's border:
 // 255; covered pixels and see-through holes inside the outline: 0.
 cv::Mat ExteriorPixels(const cv::Mat& depths) {
@@ -109,24 +93,8 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
   const std::vector<size_t> masked = MaskedViews(views);
   summary.masked_views = static_cast<int>(masked.size());
   const int n = static_cast<int>(mesh->vertices.size());
-  // Parts: union-find over the triangles' corners, numbered in order of their first vertex.
-  std::vector<int> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&parent](int v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (const Eigen::Vector3i& t : mesh->triangles) {
-    parent[find(t[1])] = find(t[0]);
-    parent[find(t[2])] = find(t[0]);
-  }
-  std::vector<int> part_of_root(n, -1), part(n);
   int parts = 0;
-  for (int i = 0; i < n; ++i) {
-    int& p = part_of_root[find(i)];
-    if (p < 0) p = parts++;
-    part[i] = p;
-  }
+  const std::vector<int> part = ConnectedParts(*mesh, &parts);
   summary.parts = parts;
   if (parts < 2 || min_needing_views <= 0 ||
       static_cast<int>(masked.size()) < min_needing_views) {
@@ -274,13 +242,7 @@ SilhouetteFitSummary FitMeshToSilhouettes(const std::vector<CalibratedView>& vie
   const size_t n = mesh->vertices.size();
   if (n == 0 || masked.empty() || options.passes == 0) return summary;
   if (mesh->normals.size() != n) ComputeVertexNormals(mesh);
-  std::vector<std::vector<int>> neighbours(n);
-  for (const Eigen::Vector3i& t : mesh->triangles) {
-    for (int k = 0; k < 3; ++k) {
-      neighbours[t[k]].push_back(t[(k + 1) % 3]);
-      neighbours[t[k]].push_back(t[(k + 2) % 3]);
-    }
-  }
+  const std::vector<std::vector<int>> neighbours = VertexNeighbours(*mesh);
   const int threads = ResolveNumThreads(options.num_threads);
   std::vector<cv::Mat> distances(masked.size());
   ParallelRanges(masked.size(), threads, /*min_per_thread=*/1, [&](size_t first, size_t last) {

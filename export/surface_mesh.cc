@@ -287,33 +287,72 @@ void ComputeVertexNormals(TriangleMesh* mesh) {
   }
 }
 
-int64_t RemoveSmallComponents(int64_t min_vertices, TriangleMesh* mesh) {
-  const int n = static_cast<int>(mesh->vertices.size());
+std::vector<std::vector<int>> VertexNeighbours(const TriangleMesh& mesh) {
+  std::vector<std::vector<int>> neighbours(mesh.vertices.size());
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      neighbours[t[k]].push_back(t[(k + 1) % 3]);
+      neighbours[t[k]].push_back(t[(k + 2) % 3]);
+    }
+  }
+  return neighbours;
+}
+
+void AverageOverNeighbours(const std::vector<std::vector<int>>& neighbours, int passes,
+                           std::vector<float>* values) {
+  const size_t n = values->size();
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<float> averaged(n);
+    for (size_t i = 0; i < n; ++i) {
+      double sum = (*values)[i];
+      for (int j : neighbours[i]) sum += (*values)[j];
+      averaged[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
+    }
+    values->swap(averaged);
+  }
+}
+
+std::vector<int> ConnectedParts(const TriangleMesh& mesh, int* num_parts) {
+  const int n = static_cast<int>(mesh.vertices.size());
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&parent](int v) {
     while (parent[v] != v) v = parent[v] = parent[parent[v]];
     return v;
   };
-  for (const Eigen::Vector3i& t : mesh->triangles) {
+  for (const Eigen::Vector3i& t : mesh.triangles) {
     parent[find(t[1])] = find(t[0]);
     parent[find(t[2])] = find(t[0]);
   }
-  std::vector<int64_t> size(n, 0);
-  for (int v = 0; v < n; ++v) ++size[find(v)];
+  std::vector<int> part_of_root(n, -1), part(n);
+  int parts = 0;
+  for (int v = 0; v < n; ++v) {
+    int& p = part_of_root[find(v)];
+    if (p < 0) p = parts++;
+    part[v] = p;
+  }
+  *num_parts = parts;
+  return part;
+}
+
+int64_t RemoveSmallComponents(int64_t min_vertices, TriangleMesh* mesh) {
+  const int n = static_cast<int>(mesh->vertices.size());
+  int parts = 0;
+  const std::vector<int> part = ConnectedParts(*mesh, &parts);
+  std::vector<int64_t> size(parts, 0);
+  for (int v = 0; v < n; ++v) ++size[part[v]];
+  const int64_t removed =
+      std::count_if(size.begin(), size.end(), [min_vertices](int64_t s) { return s < min_vertices; });
+  if (removed == 0) return 0;
   std::vector<int> remap(n, -1);
   TriangleMesh kept;
-  int64_t removed = 0;
   for (int v = 0; v < n; ++v) {
-    const int root = find(v);
-    if (root == v && size[v] < min_vertices) ++removed;
-    if (size[root] < min_vertices) continue;
+    if (size[part[v]] < min_vertices) continue;
     remap[v] = static_cast<int>(kept.vertices.size());
     kept.vertices.push_back(mesh->vertices[v]);
     if (mesh->normals.size() == mesh->vertices.size()) kept.normals.push_back(mesh->normals[v]);
     if (mesh->colours.size() == mesh->vertices.size()) kept.colours.push_back(mesh->colours[v]);
   }
-  if (removed == 0) return 0;
   for (const Eigen::Vector3i& t : mesh->triangles) {
     if (remap[t[0]] < 0) continue;
     kept.triangles.emplace_back(remap[t[0]], remap[t[1]], remap[t[2]]);

@@ -65,6 +65,18 @@ void SmoothMesh(int iterations, double pass_band, TriangleMesh* mesh);
 // side), normalised; a vertex in no triangle of non-zero area keeps a zero normal.
 void ComputeVertexNormals(TriangleMesh* mesh);
 
+// Per vertex, its neighbours along the triangles' edges: a vertex listed once per triangle edge
+// it shares (twice for an interior edge of a closed mesh).
+std::vector<std::vector<int>> VertexNeighbours(const TriangleMesh& mesh);
+
+// `passes` times, each value becomes the mean of itself and its neighbours' (VertexNeighbours).
+void AverageOverNeighbours(const std::vector<std::vector<int>>& neighbours, int passes,
+                           std::vector<float>* values);
+
+// Each vertex's connected part (through shared vertices), numbered 0, 1, ... in the order of
+// each part's first vertex; `num_parts` gets the count.
+std::vector<int> ConnectedParts(const TriangleMesh& mesh, int* num_parts);
+
 // Removes every connected component (through shared vertices) with fewer than `min_vertices`
 // vertices, and the vertices only they used (normals and colours follow). Returns the components
 // removed.

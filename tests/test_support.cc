@@ -242,3 +242,28 @@ Eigen::AlignedBox3d ReadMiddleburyReadmeBox(const std::string& readme_path) {
 
 }  // namespace testing
 }  // namespace raycarve
+
+namespace raycarve {
+namespace testing {
+
+CalibratedView PinholeViewLookingAtOrigin(const Eigen::Vector3d& centre, int width, int height,
+                                          double focal) {
+  CalibratedView view;
+  view.width = width;
+  view.height = height;
+  view.K << focal, 0, 0.5 * width, 0, focal, 0.5 * height, 0, 0, 1;
+  const Eigen::Vector3d forward = -centre.normalized();
+  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d(0.3, 1, 0.1)).normalized();
+  const Eigen::Vector3d down = forward.cross(right);
+  Eigen::Matrix3d rotation;
+  rotation << right.transpose(), down.transpose(), forward.transpose();
+  view.cam_from_world.rotation = Eigen::Quaterniond(rotation);
+  view.cam_from_world.translation = -rotation * centre;
+  view.centre = centre;
+  view.P = view.K * view.cam_from_world.ToMatrix();
+  view.valid = cv::Mat(height, width, CV_8UC1, cv::Scalar(255));
+  return view;
+}
+
+}  // namespace testing
+}  // namespace raycarve

@@ -77,3 +77,17 @@ Eigen::AlignedBox3d ReadMiddleburyReadmeBox(const std::string& readme_path);
 
 }  // namespace testing
 }  // namespace raycarve
+
+#include "calib/calibrated_view.h"
+
+namespace raycarve {
+namespace testing {
+
+// A pinhole view (no distortion; K, cam_from_world, centre and P set; no photo) of
+// `width` x `height` pixels with focal length `focal` and the principal point at the centre,
+// at `centre` looking at the origin, its image's up towards +y (about). `valid` is all 255.
+CalibratedView PinholeViewLookingAtOrigin(const Eigen::Vector3d& centre, int width, int height,
+                                          double focal);
+
+}  // namespace testing
+}  // namespace raycarve

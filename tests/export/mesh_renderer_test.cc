@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/test_support.h"
+
 namespace raycarve {
 namespace exporter {
 namespace {
@@ -102,19 +104,7 @@ TEST(RenderMesh, FrontFacesAloneGiveAClosedMeshsDepthBuffer) {
   for (const Eigen::Vector3d& centre :
        {Eigen::Vector3d(0, 0, -3), Eigen::Vector3d(2.1, 0.5, -2.1), Eigen::Vector3d(0, -3, 0.2),
         Eigen::Vector3d(-2.5, 1.0, 1.3)}) {
-    CalibratedView view = Straight();
-    view.width = 160;
-    view.height = 120;
-    view.K << 120, 0, 80, 0, 120, 60, 0, 0, 1;
-    const Eigen::Vector3d forward = -centre.normalized();
-    const Eigen::Vector3d right = forward.cross(Eigen::Vector3d(0.3, 1, 0.1)).normalized();
-    const Eigen::Vector3d down = forward.cross(right);
-    Eigen::Matrix3d rotation;
-    rotation << right.transpose(), down.transpose(), forward.transpose();
-    view.cam_from_world.rotation = Eigen::Quaterniond(rotation);
-    view.cam_from_world.translation = -rotation * centre;
-    view.centre = centre;
-    view.P = view.K * view.cam_from_world.ToMatrix();
+    const CalibratedView view = testing::PinholeViewLookingAtOrigin(centre, 160, 120, 120.0);
     const Rendering both = RenderMesh(mesh, view);
     const Rendering front = RenderMesh(mesh, view, /*front_faces_only=*/true);
     // The depth alone, as the sightings draw it: the same buffer.

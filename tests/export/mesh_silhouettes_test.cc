@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "export/mesh_renderer.h"
+#include "tests/test_support.h"
 
 namespace raycarve {
 namespace exporter {
@@ -13,21 +14,15 @@ namespace {
 
 // A 160x120 pinhole view (f = 120) at `centre`, looking at the origin.
 CalibratedView LookingAtOrigin(const Eigen::Vector3d& centre) {
-  CalibratedView view;
-  view.width = 160;
-  view.height = 120;
-  view.K << 120, 0, 80, 0, 120, 60, 0, 0, 1;
-  const Eigen::Vector3d forward = -centre.normalized();
-  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d(0.3, 1, 0.1)).normalized();
-  const Eigen::Vector3d down = forward.cross(right);
-  Eigen::Matrix3d rotation;
-  rotation << right.transpose(), down.transpose(), forward.transpose();
-  view.cam_from_world.rotation = Eigen::Quaterniond(rotation);
-  view.cam_from_world.translation = -rotation * centre;
-  view.centre = centre;
-  view.P = view.K * view.cam_from_world.ToMatrix();
-  view.valid = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(255));
-  return view;
+  return testing::PinholeViewLookingAtOrigin(centre, 160, 120, 120.0);
+}
+
+// The fit's options for the 40-voxel grid of VoxelBall (voxels 0.05 wide).
+SilhouetteFitOptions VoxelOptions() {
+  SilhouetteFitOptions options;
+  options.max_move = 0.05;
+  options.depth_tolerance = 0.05;
+  return options;
 }
 
 // The iso-surface of the voxels (a 40^3 grid over [-1, 1]^3, voxels 0.05 wide) within `radius`
@@ -102,10 +97,7 @@ TEST(FitMeshToSilhouettes, AFatBallIsPulledInOntoItsMasksAndNeverPushedOut) {
     object += cv::countNonZero(view.mask);
   }
   ASSERT_GT(outside_before, object / 10);  // the fat outline the fit is for
-  SilhouetteFitOptions options;
-  options.max_move = 0.05;
-  options.depth_tolerance = 0.05;
-  const SilhouetteFitSummary summary = FitMeshToSilhouettes(views, options, &mesh);
+  const SilhouetteFitSummary summary = FitMeshToSilhouettes(views, VoxelOptions(), &mesh);
   EXPECT_EQ(summary.passes, 2);
   EXPECT_EQ(summary.masked_views, 8);
   EXPECT_GT(summary.pulled_vertices, summary.outline_vertices / 2);
@@ -138,10 +130,7 @@ TEST(FitMeshToSilhouettes, AMeshOnItsOwnSilhouettesBarelyMoves) {
   TriangleMesh mesh = VoxelBall(Eigen::Vector3d::Zero(), 0.5);
   for (CalibratedView& view : views) view.mask = Covered(mesh, view);
   const TriangleMesh before = mesh;
-  SilhouetteFitOptions options;
-  options.max_move = 0.05;
-  options.depth_tolerance = 0.05;
-  const SilhouetteFitSummary summary = FitMeshToSilhouettes(views, options, &mesh);
+  const SilhouetteFitSummary summary = FitMeshToSilhouettes(views, VoxelOptions(), &mesh);
   EXPECT_LT(summary.mean_outside_pixels_first, 0.5);
   EXPECT_LT(summary.mean_move, 0.2 * 0.05);
   for (const CalibratedView& view : views) {
@@ -158,10 +147,7 @@ TEST(FitMeshToSilhouettes, ABallThinnerThanItsMasksIsLeftAlone) {
   for (CalibratedView& view : views) view.mask = SphereMask(view, Eigen::Vector3d::Zero(), 0.5);
   TriangleMesh mesh = VoxelBall(Eigen::Vector3d::Zero(), 0.42);
   const TriangleMesh before = mesh;
-  SilhouetteFitOptions options;
-  options.max_move = 0.05;
-  options.depth_tolerance = 0.05;
-  const SilhouetteFitSummary summary = FitMeshToSilhouettes(views, options, &mesh);
+  const SilhouetteFitSummary summary = FitMeshToSilhouettes(views, VoxelOptions(), &mesh);
   EXPECT_GT(summary.outline_vertices, 100);
   EXPECT_EQ(summary.pulled_vertices, 0);
   EXPECT_EQ(mesh.vertices, before.vertices);
@@ -196,10 +182,7 @@ TEST(FitMeshToSilhouettes, TheRimOfASeeThroughHoleIsLeftAlone) {
     ASSERT_EQ(covered.at<uint8_t>(views.back().height / 2, views.back().width / 2), 0) << k;
   }
   const TriangleMesh before = mesh;
-  SilhouetteFitOptions options;
-  options.max_move = 0.05;
-  options.depth_tolerance = 0.05;
-  FitMeshToSilhouettes(views, options, &mesh);
+  FitMeshToSilhouettes(views, VoxelOptions(), &mesh);
   int outer_moved = 0, inner_moved = 0;
   for (size_t i = 0; i < mesh.vertices.size(); ++i) {
     const double r = before.vertices[i].head<2>().norm();
@@ -215,10 +198,7 @@ TEST(FitMeshToSilhouettes, NoMasksNothingMoves) {
   const std::vector<CalibratedView> views = Ring(4, 0.3);
   TriangleMesh mesh = VoxelBall(Eigen::Vector3d::Zero(), 0.5);
   const TriangleMesh before = mesh;
-  SilhouetteFitOptions options;
-  options.max_move = 0.05;
-  options.depth_tolerance = 0.05;
-  const SilhouetteFitSummary summary = FitMeshToSilhouettes(views, options, &mesh);
+  const SilhouetteFitSummary summary = FitMeshToSilhouettes(views, VoxelOptions(), &mesh);
   EXPECT_EQ(summary.passes, 0);
   EXPECT_EQ(mesh.vertices, before.vertices);
 }

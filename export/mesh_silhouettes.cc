@@ -5,10 +5,12 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
-#include <unordered_map>
 
 #include <glog/logging.h>
 #include <opencv2/imgproc.hpp>
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
 
 #include "carve/view_workers.h"
 #include "export/mesh_renderer.h"
@@ -77,10 +79,10 @@ std::vector<size_t> MaskedViews(const std::vector<CalibratedView>& views) {
 std::string MeshPartsSummary::Summary() const {
   char text[256];
   std::snprintf(text, sizeof(text),
-                "mesh parts: %d; %d that fewer than two of %d masked photos need and no sparse "
+                "mesh parts: %d; %d that fewer than %d of %d masked photos need and no sparse "
                 "point holds removed (%lld vertices), %d kept for a sparse point alone; in %.2f s",
-                parts, removed, masked_views, static_cast<long long>(removed_vertices), anchored,
-                seconds);
+                parts, removed, min_needing_views, masked_views,
+                static_cast<long long>(removed_vertices), anchored, seconds);
   return text;
 }
 
@@ -90,6 +92,7 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
                                      double anchor_radius, int num_threads, TriangleMesh* mesh) {
   const auto start = std::chrono::steady_clock::now();
   MeshPartsSummary summary;
+  summary.min_needing_views = min_needing_views;
   const std::vector<size_t> masked = MaskedViews(views);
   summary.masked_views = static_cast<int>(masked.size());
   const int n = static_cast<int>(mesh->vertices.size());
@@ -140,33 +143,26 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
       for (int p = 0; p < parts; ++p) needs[m][p] = covered[p] > 0 && 2 * alone[p] >= covered[p];
     }
   });
-  // Parts holding a sparse point: vertices hashed into cells anchor_radius wide.
+  // Parts holding a sparse point: the anchors' neighbours among the other parts' vertices.
   std::vector<uint8_t> anchored(parts, 0);
   if (!anchors.empty() && anchor_radius > 0.0) {
-    auto cell = [anchor_radius](const Eigen::Vector3d& p) {
-      return Eigen::Vector3i((p / anchor_radius).array().floor().cast<int>());
-    };
-    auto key = [](const Eigen::Vector3i& c) {
-      return (static_cast<uint64_t>(static_cast<uint32_t>(c.x()) & 0x1FFFFF) << 42) |
-             (static_cast<uint64_t>(static_cast<uint32_t>(c.y()) & 0x1FFFFF) << 21) |
-             (static_cast<uint64_t>(static_cast<uint32_t>(c.z()) & 0x1FFFFF));
-    };
-    std::unordered_map<uint64_t, std::vector<int>> cells;
+    pcl::PointCloud<pcl::PointXYZ>::Ptr others(new pcl::PointCloud<pcl::PointXYZ>);
+    std::vector<int> vertex_of;
     for (int i = 0; i < n; ++i) {
-      if (part[i] != largest) cells[key(cell(mesh->vertices[i].cast<double>()))].push_back(i);
+      if (part[i] == largest) continue;
+      others->push_back(pcl::PointXYZ(mesh->vertices[i].x(), mesh->vertices[i].y(), mesh->vertices[i].z()));
+      vertex_of.push_back(i);
     }
-    for (const Eigen::Vector3d& point : anchors) {
-      const Eigen::Vector3i c = cell(point);
-      for (int dx = -1; dx <= 1; ++dx) {
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dz = -1; dz <= 1; ++dz) {
-            const auto found = cells.find(key(c + Eigen::Vector3i(dx, dy, dz)));
-            if (found == cells.end()) continue;
-            for (int i : found->second) {
-              if ((mesh->vertices[i].cast<double>() - point).norm() <= anchor_radius) anchored[part[i]] = 1;
-            }
-          }
-        }
+    if (!others->empty()) {
+      pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+      tree.setInputCloud(others);
+      std::vector<int> found;
+      std::vector<float> squared;
+      for (const Eigen::Vector3d& point : anchors) {
+        const pcl::PointXYZ query(static_cast<float>(point.x()), static_cast<float>(point.y()),
+                                  static_cast<float>(point.z()));
+        tree.radiusSearch(query, anchor_radius, found, squared);
+        for (int k : found) anchored[part[vertex_of[k]]] = 1;
       }
     }
   }
@@ -184,24 +180,7 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
       summary.removed_vertices += part_vertices[p];
     }
   }
-  if (summary.removed > 0) {
-    std::vector<int> remap(n, -1);
-    TriangleMesh kept;
-    const bool normals = mesh->normals.size() == mesh->vertices.size();
-    const bool colours = mesh->colours.size() == mesh->vertices.size();
-    for (int i = 0; i < n; ++i) {
-      if (!keep[part[i]]) continue;
-      remap[i] = static_cast<int>(kept.vertices.size());
-      kept.vertices.push_back(mesh->vertices[i]);
-      if (normals) kept.normals.push_back(mesh->normals[i]);
-      if (colours) kept.colours.push_back(mesh->colours[i]);
-    }
-    for (const Eigen::Vector3i& t : mesh->triangles) {
-      if (remap[t[0]] < 0) continue;
-      kept.triangles.emplace_back(remap[t[0]], remap[t[1]], remap[t[2]]);
-    }
-    *mesh = std::move(kept);
-  }
+  if (summary.removed > 0) KeepParts(part, keep, mesh);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

@@ -19,6 +19,7 @@ struct MeshPartsSummary {
   int64_t removed_vertices = 0;
   int anchored = 0;        // kept for a sparse point alone (no two masks needed them)
   int masked_views = 0;
+  int min_needing_views = 0;
   double seconds = 0.0;
   std::string Summary() const;
 };

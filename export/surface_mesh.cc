@@ -335,29 +335,38 @@ std::vector<int> ConnectedParts(const TriangleMesh& mesh, int* num_parts) {
   return part;
 }
 
-int64_t RemoveSmallComponents(int64_t min_vertices, TriangleMesh* mesh) {
+void KeepParts(const std::vector<int>& part, const std::vector<uint8_t>& keep, TriangleMesh* mesh) {
   const int n = static_cast<int>(mesh->vertices.size());
-  int parts = 0;
-  const std::vector<int> part = ConnectedParts(*mesh, &parts);
-  std::vector<int64_t> size(parts, 0);
-  for (int v = 0; v < n; ++v) ++size[part[v]];
-  const int64_t removed =
-      std::count_if(size.begin(), size.end(), [min_vertices](int64_t s) { return s < min_vertices; });
-  if (removed == 0) return 0;
+  const bool normals = mesh->normals.size() == mesh->vertices.size();
+  const bool colours = mesh->colours.size() == mesh->vertices.size();
   std::vector<int> remap(n, -1);
   TriangleMesh kept;
   for (int v = 0; v < n; ++v) {
-    if (size[part[v]] < min_vertices) continue;
+    if (!keep[part[v]]) continue;
     remap[v] = static_cast<int>(kept.vertices.size());
     kept.vertices.push_back(mesh->vertices[v]);
-    if (mesh->normals.size() == mesh->vertices.size()) kept.normals.push_back(mesh->normals[v]);
-    if (mesh->colours.size() == mesh->vertices.size()) kept.colours.push_back(mesh->colours[v]);
+    if (normals) kept.normals.push_back(mesh->normals[v]);
+    if (colours) kept.colours.push_back(mesh->colours[v]);
   }
   for (const Eigen::Vector3i& t : mesh->triangles) {
     if (remap[t[0]] < 0) continue;
     kept.triangles.emplace_back(remap[t[0]], remap[t[1]], remap[t[2]]);
   }
   *mesh = std::move(kept);
+}
+
+int64_t RemoveSmallComponents(int64_t min_vertices, TriangleMesh* mesh) {
+  int parts = 0;
+  const std::vector<int> part = ConnectedParts(*mesh, &parts);
+  std::vector<int64_t> size(parts, 0);
+  for (int p : part) ++size[p];
+  std::vector<uint8_t> keep(parts, 0);
+  int64_t removed = 0;
+  for (int p = 0; p < parts; ++p) {
+    keep[p] = size[p] >= min_vertices;
+    removed += !keep[p];
+  }
+  if (removed > 0) KeepParts(part, keep, mesh);
   return removed;
 }
 

@@ -77,6 +77,10 @@ void AverageOverNeighbours(const std::vector<std::vector<int>>& neighbours, int 
 // each part's first vertex; `num_parts` gets the count.
 std::vector<int> ConnectedParts(const TriangleMesh& mesh, int* num_parts);
 
+// Keeps the vertices whose part (ConnectedParts) `keep` marks, and the triangles among them;
+// normals and colours follow.
+void KeepParts(const std::vector<int>& part, const std::vector<uint8_t>& keep, TriangleMesh* mesh);
+
 // Removes every connected component (through shared vertices) with fewer than `min_vertices`
 // vertices, and the vertices only they used (normals and colours follow). Returns the components
 // removed.

@@ -16,6 +16,9 @@ struct CompareOptions {
   // The accuracy quantile: accuracy is the distance within which this share of the
   // reconstruction lies from the reference (Middlebury uses 90%).
   double accuracy_quantile = 0.9;
+  // Threads for the nearest-neighbour searches (< 1: one per core); the result is the same for
+  // any count.
+  int num_threads = -1;
 
   bool IsValid(std::string* reason) const;
 };
@@ -35,7 +38,7 @@ struct CloudComparison {
   std::string Summary() const;
 };
 
-// Compares `reconstruction` against `reference` with nearest-neighbour searches (PCL k-d trees)
+// Compares `reconstruction` against `reference` with nearest-neighbour searches (exact k-d trees)
 // in both directions. Both must be non-empty and the options valid (CHECKed).
 CloudComparison CompareClouds(const std::vector<Eigen::Vector3f>& reference,
                               const std::vector<Eigen::Vector3f>& reconstruction,
@@ -47,9 +50,10 @@ CloudComparison CompareClouds(const std::vector<Eigen::Vector3f>& reference,
 // when it cannot be read or holds no points.
 std::vector<Eigen::Vector3f> ReadComparablePoints(const std::string& path, int mesh_samples);
 
-// The median distance from a point to its nearest other point (PCL k-d tree): a cloud's own
-// sampling step. Non-finite points are left out; 0 with fewer than two points.
-double MedianNeighbourSpacing(const std::vector<Eigen::Vector3f>& points);
+// The median distance from a point to its nearest other point (a k-d tree; `num_threads` < 1:
+// one per core, the same result for any count): a cloud's own sampling step. Non-finite points
+// are left out; 0 with fewer than two points.
+double MedianNeighbourSpacing(const std::vector<Eigen::Vector3f>& points, int num_threads = -1);
 
 }  // namespace exporter
 }  // namespace raycarve

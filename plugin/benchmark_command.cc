@@ -114,6 +114,7 @@ int RunBenchmark(int argc, char** argv) {
       exporter::CompareOptions compare;
       compare.threshold = reference_threshold > 0.0 ? reference_threshold
                                                     : 2.0 * run.result->volume.grid().voxel_size();
+      compare.num_threads = options.num_threads;
       std::vector<Eigen::Vector3f> cloud;
       for (const exporter::ColouredPoint& point : points) cloud.push_back(point.xyz);
       run.comparison = exporter::CompareClouds(reference_points, cloud, compare);

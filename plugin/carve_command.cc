@@ -321,6 +321,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   if (!sparse.empty() && !cloud.empty()) {
     exporter::CompareOptions compare;
     compare.threshold = 2.0 * run.result->volume.grid().voxel_size();
+    compare.num_threads = request.options.num_threads;
     run.sparse = exporter::CompareClouds(cloud, sparse, compare);
     run.has_sparse = true;
   }

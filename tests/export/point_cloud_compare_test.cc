@@ -1,6 +1,9 @@
 #include "export/point_cloud_compare.h"
 
+#include <algorithm>
 #include <filesystem>
+#include <limits>
+#include <random>
 
 #include <gtest/gtest.h>
 #include <pcl/PolygonMesh.h>
@@ -69,6 +72,62 @@ TEST(CompareClouds, AccuracyIsTheQuantileOfTheDistances) {
   std::string reason;
   options.threshold = 0.0;
   EXPECT_FALSE(options.IsValid(&reason));
+}
+
+// Random points in the unit cube (a fixed seed).
+std::vector<Eigen::Vector3f> RandomPoints(int n, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  std::vector<Eigen::Vector3f> points(n);
+  for (Eigen::Vector3f& p : points) {
+    p = Eigen::Vector3f(uniform(random), uniform(random), uniform(random));
+  }
+  return points;
+}
+
+// The exact answers, by trying every pair.
+std::vector<double> BruteForceNearest(const std::vector<Eigen::Vector3f>& queries,
+                                     const std::vector<Eigen::Vector3f>& target, bool skip_self) {
+  std::vector<double> nearest;
+  for (size_t i = 0; i < queries.size(); ++i) {
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t j = 0; j < target.size(); ++j) {
+      if (skip_self && i == j) continue;
+      best = std::min(best, static_cast<double>((queries[i] - target[j]).norm()));
+    }
+    nearest.push_back(best);
+  }
+  return nearest;
+}
+
+TEST(CompareClouds, NearestNeighboursAreExactAndTheSameOnAnyNumberOfThreads) {
+  // Enough queries that four threads each take a share.
+  const std::vector<Eigen::Vector3f> reconstruction = RandomPoints(20000, 1);
+  const std::vector<Eigen::Vector3f> reference = RandomPoints(300, 2);
+  const std::vector<double> to_reference = BruteForceNearest(reconstruction, reference, false);
+  const std::vector<double> to_reconstruction = BruteForceNearest(reference, reconstruction, false);
+  double mean_to_reference = 0.0, mean_to_reconstruction = 0.0;
+  for (double d : to_reference) mean_to_reference += d / to_reference.size();
+  for (double d : to_reconstruction) mean_to_reconstruction += d / to_reconstruction.size();
+  CompareOptions options;
+  options.threshold = 0.05;
+  for (int threads : {1, 4}) {
+    options.num_threads = threads;
+    const CloudComparison result = CompareClouds(reference, reconstruction, options);
+    EXPECT_NEAR(result.mean_reconstruction_to_reference, mean_to_reference, 1e-6) << threads;
+    EXPECT_NEAR(result.mean_reference_to_reconstruction, mean_to_reconstruction, 1e-6) << threads;
+    const double within = std::count_if(to_reference.begin(), to_reference.end(),
+                                        [](double d) { return d <= 0.05; });
+    EXPECT_NEAR(result.precision, within / to_reference.size(), 1e-4) << threads;
+  }
+  // A cloud's own spacing: every point's nearest other point.
+  const std::vector<Eigen::Vector3f> cloud = RandomPoints(9000, 3);
+  std::vector<double> spacing = BruteForceNearest(cloud, cloud, true);
+  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
+  for (int threads : {1, 3}) {
+    EXPECT_NEAR(MedianNeighbourSpacing(cloud, threads), spacing[spacing.size() / 2], 1e-6)
+        << threads;
+  }
 }
 
 TEST(ReadComparablePoints, SamplesMeshesUniformlyOverTheirAreaAndKeepsClouds) {

@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -260,8 +261,19 @@ CarveRun CarveProject(const CarveRequest& request) {
     }
     run.stage_seconds.emplace_back("mesh", SecondsSince(stage));
     stage = Clock::now();
-    run.mesh_topology = exporter::AnalyseTopology(model.mesh);
-    exporter::WriteMeshPly(model.mesh, (out / "mesh.ply").string());
+    // The mesh's checks and file on a second thread while the cloud is sampled and written: both
+    // only read the mesh. (The future waits for its thread however this block is left; the
+    // mesh's own failure is thrown by get().)
+    auto mesh_file = [&run, &model, &out] {
+      run.mesh_topology = exporter::AnalyseTopology(model.mesh);
+      exporter::WriteMeshPly(model.mesh, (out / "mesh.ply").string());
+    };
+    std::future<void> mesh_written;
+    if (ResolveNumThreads(request.options.num_threads) > 1) {
+      mesh_written = std::async(std::launch::async, mesh_file);
+    } else {
+      mesh_file();
+    }
     run.num_mesh_triangles = model.mesh.triangles.size();
     run.num_mesh_vertices = model.mesh.vertices.size();
     run.mesh_colouring = model.colouring;
@@ -292,6 +304,7 @@ CarveRun CarveProject(const CarveRequest& request) {
     }
     exporter::WritePointCloudPly(points, (out / "cloud.ply").string());
     exporter::WritePointVisibility(visibility, (out / "cloud.ply.vis").string());
+    if (mesh_written.valid()) mesh_written.get();
     // COLMAP's dense workspace names, for its meshers: the same files under a second name (hard
     // links; copies where the file system has none), and the sparse model they index.
     for (const char* name : {"cloud.ply", "cloud.ply.vis"}) {

@@ -39,6 +39,12 @@ void ForEachCoveredPixel(const TriangleMesh& mesh, const CalibratedView& view,
     const Eigen::Vector2d& a = pixels[t[0]];
     const Eigen::Vector2d& b = pixels[t[1]];
     const Eigen::Vector2d& c = pixels[t[2]];
+    const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+    if (!(std::abs(area) > 1e-12)) continue;
+    // Pixels run right and down as the camera's x and y, so a triangle whose outward side faces
+    // the camera (its normal towards the camera, -z) winds clockwise on the screen: area < 0.
+    // (Tested before the bounding box: about half the triangles face away.)
+    if (front_faces_only && area > 0.0) continue;
     // Pixel centres (col + 0.5, row + 0.5) inside the triangle's bounding box.
     const int col_min = std::max(0, static_cast<int>(std::ceil(std::min({a.x(), b.x(), c.x()}) - 0.5)));
     const int col_max = std::min(view.width - 1,
@@ -48,11 +54,6 @@ void ForEachCoveredPixel(const TriangleMesh& mesh, const CalibratedView& view,
     const int row_max = std::min(view.height - 1,
                                  static_cast<int>(std::floor(std::max({a.y(), b.y(), c.y()}) - 0.5)));
     if (row_min > row_max) continue;
-    const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
-    if (!(std::abs(area) > 1e-12)) continue;
-    // Pixels run right and down as the camera's x and y, so a triangle whose outward side faces
-    // the camera (its normal towards the camera, -z) winds clockwise on the screen: area < 0.
-    if (front_faces_only && area > 0.0) continue;
     const double inverse_area = 1.0 / area;
     // Barycentric weights of (x, y), screen space: w0 = e0 + x * dx0 + y * dy0, likewise w1;
     // w2 = 1 - w0 - w1.

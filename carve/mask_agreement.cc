@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -125,10 +126,14 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
     return true;
   };
   const Eigen::Vector3d centre = box.center();
-  const int threads = ResolveNumThreads(options.num_threads);
-  for (size_t v = 0; v < num_views; ++v) {
+  // The views one at a time on every core: each judges its pixels against the others' masks as
+  // made (original) and writes only its own mask and counts, so the order does not matter.
+  ViewWorkers workers(static_cast<int>(num_views), options.num_threads);
+  const int threads = 1;  // per view: the views themselves share the cores
+  std::atomic<size_t> next_view{0};
+  auto agree = [&](size_t v) {
     CalibratedView& view = (*views)[v];
-    if (view.mask.empty()) continue;
+    if (view.mask.empty()) return;
     statistics.object_before[v] = cv::countNonZero(view.mask);
     // The pixels whose rays meet the voting hull, and those a voxel's width inside its outline:
     // from rays through every other pixel along each axis (the pixel (c, r) of the half-size
@@ -156,7 +161,7 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
     cv::erode(meets, inside,
               cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
     const cv::Mat candidates = inside & (view.mask == 0);
-    if (cv::countNonZero(candidates) == 0) continue;
+    if (cv::countNonZero(candidates) == 0) return;
     cv::Mat agreed = view.mask.clone();
     RayImage rays(grid, view.WorldFromPixel(), view.centre, view.width, view.height, candidates);
     rays.Initialise(hull, &blocks, threads);
@@ -182,7 +187,11 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
       ++statistics.added[v];
     }
     view.mask = agreed;
-  }
+  };
+  auto task = [&](int /*group*/) {
+    for (size_t v; (v = next_view.fetch_add(1, std::memory_order_relaxed)) < num_views;) agree(v);
+  };
+  workers.Run(task);
   statistics.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return statistics;

@@ -72,6 +72,23 @@ TEST(MaskAgreement, FillsAHoleOnePhotosMaskMadeAndLeavesTheOthers) {
   EXPECT_FALSE(statistics.Summary({}).empty());
 }
 
+TEST(MaskAgreement, GivesTheSameMasksOnAnyNumberOfThreads) {
+  MaskAgreementOptions options;
+  options.resolution = 64;
+  options.num_threads = 1;
+  Damaged one = DamagedScene();
+  const MaskAgreementStatistics on_one = AgreeMasks(one.box, options, &one.views);
+  ASSERT_GT(on_one.added[0], 0);
+  options.num_threads = 3;
+  Damaged three = DamagedScene();
+  const MaskAgreementStatistics on_three = AgreeMasks(three.box, options, &three.views);
+  EXPECT_EQ(on_three.added, on_one.added);
+  EXPECT_EQ(on_three.object_before, on_one.object_before);
+  for (size_t v = 0; v < one.views.size(); ++v) {
+    EXPECT_EQ(cv::countNonZero(one.views[v].mask != three.views[v].mask), 0) << v;
+  }
+}
+
 TEST(MaskAgreement, NeedsThreeMaskedViews) {
   Damaged damaged = DamagedScene();
   damaged.views.resize(2);

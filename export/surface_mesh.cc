@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include <glog/logging.h>
+#include <opencv2/core.hpp>
 #include <pcl/PolygonMesh.h>
 #include <pcl/console/print.h>
 #include <pcl/conversions.h>
@@ -28,11 +29,13 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataNormals.h>
+#include <vtkSMPTools.h>
 #include <vtkSmartPointer.h>
 #include <vtkWindowedSincPolyDataFilter.h>
 
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
+#include "carve/view_workers.h"
 #include "export/ply_reader.h"
 #include "export/point_cloud_io.h"
 
@@ -238,6 +241,12 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
   result.vertices = static_cast<int64_t>(mesh.vertices.size());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return mesh;
+}
+
+void SetLibraryThreads(int num_threads) {
+  const int threads = ResolveNumThreads(num_threads);
+  cv::setNumThreads(threads);
+  vtkSMPTools::Initialize(threads);
 }
 
 void SmoothMesh(int iterations, double pass_band, TriangleMesh* mesh) {

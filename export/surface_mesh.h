@@ -56,6 +56,11 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
                              const SurfaceMeshOptions& options,
                              SurfaceMeshSummary* summary = nullptr);
 
+// How many threads the libraries' own parallel loops may use, process-wide: OpenCV's (resizing,
+// filtering) and VTK's (the iso-surface, smoothing), which otherwise take every core whatever
+// --num_threads says. `num_threads` < 1: one per core this process may use.
+void SetLibraryThreads(int num_threads);
+
 // Windowed-sinc smoothing (as MeshSolidVoxels smooths the iso-surface) of an existing mesh's
 // vertices: `iterations` passes at `pass_band` (0-2; smaller smooths more). Vertices and
 // triangles keep their indices and count; normals are recomputed; colours are kept.

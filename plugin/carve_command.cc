@@ -875,9 +875,11 @@ void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
   if (request->cloud_min_views < 1) {
     throw InputError("--cloud_min_views: must be >= 1, got " + std::to_string(request->cloud_min_views));
   }
-  // --num_threads holds for every stage: loading the photos, carving, meshing, colouring.
+  // --num_threads holds for every stage: loading the photos, carving, meshing, colouring, and
+  // the libraries' own parallel loops.
   request->mesh.num_threads = request->options.num_threads;
   request->view_options.num_threads = request->options.num_threads;
+  exporter::SetLibraryThreads(request->options.num_threads);
   request->mesh.min_views = request->options.min_views;
   // The mesh drops what is smaller than the iso-surface of the smallest speck the carve keeps
   // (a cube of min_component_voxels voxels: 6 faces of n^(2/3) vertices).

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
 
 #include "carve/volume.h"
 #include "carve/voxel_grid.h"
@@ -81,6 +82,24 @@ TEST(SurfaceMesh, ABallOfVoxelsBecomesOneClosedManifoldSphereWithOutwardNormals)
   for (size_t i = 0; i < mesh.vertices.size(); ++i) {
     ASSERT_GT(from_winding.normals[i].dot(mesh.normals[i]), 0.9f) << "vertex " << i;
   }
+}
+
+TEST(SurfaceMesh, TheLibrariesThreadsAreLimitedAndTheMeshIsTheSameOnAnyCount) {
+  const Volume volume = Ball(40, 0.7);
+  SetLibraryThreads(1);
+  EXPECT_EQ(cv::getNumThreads(), 1);
+  const TriangleMesh one = MeshSolidVoxels(volume, SurfaceMeshOptions(), nullptr);
+  SetLibraryThreads(3);
+  EXPECT_EQ(cv::getNumThreads(), 3);
+  const TriangleMesh three = MeshSolidVoxels(volume, SurfaceMeshOptions(), nullptr);
+  SetLibraryThreads(-1);  // every core again, for the tests after this one
+  ASSERT_FALSE(one.empty());
+  ASSERT_EQ(one.vertices.size(), three.vertices.size());
+  ASSERT_EQ(one.triangles.size(), three.triangles.size());
+  for (size_t i = 0; i < one.vertices.size(); ++i) {
+    ASSERT_EQ(one.vertices[i], three.vertices[i]) << "vertex " << i;
+  }
+  EXPECT_EQ(one.triangles, three.triangles);
 }
 
 TEST(SurfaceMesh, SeparateSolidsAreSeparateComponentsAndTheGridBorderClosesTheMesh) {

@@ -62,22 +62,31 @@ Eigen::Vector3f RobustColour(const std::vector<Sample>& samples, double outlier_
 
 }  // namespace
 
-std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<CalibratedView>& views,
-                                                             const TriangleMesh& mesh,
-                                                             double depth_tolerance,
-                                                             std::vector<uint8_t>* on_rim,
-                                                             double voxel_size,
-                                                             double rim_voxels,
-                                                             int num_threads) {
+std::vector<cv::Mat> MaskDistances(const std::vector<CalibratedView>& views, int num_threads) {
+  std::vector<cv::Mat> distances(views.size());
+  ParallelRanges(views.size(), ResolveNumThreads(num_threads), /*min_per_thread=*/1,
+                 [&](size_t first, size_t last) {
+    for (size_t v = first; v < last; ++v) {
+      if (!views[v].mask.empty()) cv::distanceTransform(views[v].mask, distances[v], cv::DIST_L2, 3);
+    }
+  });
+  return distances;
+}
+
+std::vector<std::vector<VertexSighting>> FindVertexSightings(
+    const std::vector<CalibratedView>& views, const TriangleMesh& mesh, double depth_tolerance,
+    std::vector<uint8_t>* on_rim, double voxel_size, double rim_voxels, int num_threads,
+    const std::vector<cv::Mat>* mask_distances) {
   CHECK(mesh.normals.size() == mesh.vertices.size()) << "the mesh needs vertex normals";
+  CHECK(mask_distances == nullptr || mask_distances->size() == views.size());
   const size_t n = mesh.vertices.size();
+  const int threads = ResolveNumThreads(num_threads);
   std::vector<std::vector<VertexSighting>> sightings(n);
   if (on_rim != nullptr) on_rim->assign(n, 0);
   // Each view on its own (in parallel): the vertices it sees, and which lie on its mask's rim.
   std::vector<std::vector<std::pair<uint32_t, float>>> per_view(views.size());
   std::vector<std::vector<uint32_t>> rims(views.size());
-  ParallelRanges(views.size(), ResolveNumThreads(num_threads), /*min_per_thread=*/1,
-                 [&](size_t first, size_t last) {
+  ParallelRanges(views.size(), threads, /*min_per_thread=*/1, [&](size_t first, size_t last) {
     for (size_t v = first; v < last; ++v) {
       const CalibratedView& view = views[v];
       // The mesh is closed (MeshSolidVoxels) and the cameras outside it: front faces suffice.
@@ -85,7 +94,11 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
       // Distance (pixels) from each object pixel to the nearest background pixel.
       cv::Mat to_background;
       if (on_rim != nullptr && !view.mask.empty() && voxel_size > 0.0) {
-        cv::distanceTransform(view.mask, to_background, cv::DIST_L2, 3);
+        if (mask_distances != nullptr) {
+          to_background = (*mask_distances)[v];
+        } else {
+          cv::distanceTransform(view.mask, to_background, cv::DIST_L2, 3);
+        }
       }
       const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
       for (size_t i = 0; i < n; ++i) {
@@ -111,12 +124,34 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<C
       }
     }
   });
-  for (size_t v = 0; v < views.size(); ++v) {
-    for (const auto& [i, facing] : per_view[v]) sightings[i].push_back({static_cast<uint32_t>(v), facing});
-    if (on_rim != nullptr) {
-      for (uint32_t i : rims[v]) (*on_rim)[i] = 1;
+  // Per vertex in view order, the vertices split over the threads: each view's list is in vertex
+  // order, so a range of vertices is a range of each list.
+  ParallelRanges(n, threads, /*min_per_thread=*/4096, [&](size_t first, size_t last) {
+    std::vector<std::pair<size_t, size_t>> spans(views.size());
+    std::vector<uint8_t> count(last - first, 0);
+    for (size_t v = 0; v < views.size(); ++v) {
+      const auto& list = per_view[v];
+      const auto by_vertex = [](const std::pair<uint32_t, float>& a, size_t i) { return a.first < i; };
+      const size_t begin = std::lower_bound(list.begin(), list.end(), first, by_vertex) - list.begin();
+      const size_t end = std::lower_bound(list.begin() + begin, list.end(), last, by_vertex) - list.begin();
+      spans[v] = {begin, end};
+      for (size_t k = begin; k < end; ++k) {
+        if (count[list[k].first - first] < 255) ++count[list[k].first - first];
+      }
     }
-  }
+    for (size_t i = first; i < last; ++i) sightings[i].reserve(count[i - first]);
+    for (size_t v = 0; v < views.size(); ++v) {
+      const auto& list = per_view[v];
+      for (size_t k = spans[v].first; k < spans[v].second; ++k) {
+        sightings[list[k].first].push_back({static_cast<uint32_t>(v), list[k].second});
+      }
+      if (on_rim != nullptr) {
+        for (uint32_t i : rims[v]) {
+          if (i >= first && i < last) (*on_rim)[i] = 1;
+        }
+      }
+    }
+  });
   return sightings;
 }
 

@@ -54,14 +54,16 @@ struct VertexSighting {
 // a mask it is not hidden (at most depth_tolerance behind the mesh's depth, facing or not) and
 // projects onto an object pixel within `rim_voxels` voxel widths (`voxel_size`, projected at
 // its depth) of the background. The views are drawn on `num_threads` threads (0 or less: every
-// core).
-std::vector<std::vector<VertexSighting>> FindVertexSightings(const std::vector<CalibratedView>& views,
-                                                             const TriangleMesh& mesh,
-                                                             double depth_tolerance,
-                                                             std::vector<uint8_t>* on_rim = nullptr,
-                                                             double voxel_size = 0.0,
-                                                             double rim_voxels = 1.0,
-                                                             int num_threads = 0);
+// core). `mask_distances`, when given, holds MaskDistances(views), for callers that find the
+// sightings again and again (the masks do not change).
+std::vector<std::vector<VertexSighting>> FindVertexSightings(
+    const std::vector<CalibratedView>& views, const TriangleMesh& mesh, double depth_tolerance,
+    std::vector<uint8_t>* on_rim = nullptr, double voxel_size = 0.0, double rim_voxels = 1.0,
+    int num_threads = 0, const std::vector<cv::Mat>* mask_distances = nullptr);
+
+// Per view with a mask, each object pixel's distance (pixels) to the nearest background pixel
+// (CV_32FC1, cv::distanceTransform's DIST_L2 with a 3x3 mask); empty for a view without a mask.
+std::vector<cv::Mat> MaskDistances(const std::vector<CalibratedView>& views, int num_threads = 0);
 
 // Bilinear sample of an RGB image (CV_8UC3) at a COLMAP pixel position (pixel centres at +0.5);
 // false outside the image's centres. (Inline: the mesh refinement calls it tens of millions of

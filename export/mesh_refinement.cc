@@ -96,11 +96,12 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
   const int steps = 2 * options.steps_per_side + 1;
   const double step = options.search_range / options.steps_per_side;
   double offset_sum = 0.0, abs_offset_sum = 0.0;
+  const std::vector<cv::Mat> mask_distances = MaskDistances(views, options.num_threads);
   for (int pass = 0; pass < options.passes; ++pass) {
     std::vector<uint8_t> on_rim;
     const std::vector<std::vector<VertexSighting>> sightings = FindVertexSightings(
         views, *mesh, options.depth_tolerance, &on_rim, options.voxel_size, 1.0,
-        options.num_threads);
+        options.num_threads, &mask_distances);
     std::vector<float> offsets(n, 0.0f);
     std::vector<uint8_t> judged(n, 0), moved(n, 0);
     summary.pinned.assign(n, 0.0f);
@@ -217,7 +218,7 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
     });
     summary.judged = std::count(judged.begin(), judged.end(), 1);
     summary.moved = std::count(moved.begin(), moved.end(), 1);
-    AverageOverNeighbours(neighbours, options.smoothing_passes, &offsets);
+    AverageOverNeighbours(neighbours, options.smoothing_passes, &offsets, options.num_threads);
     double pass_abs_sum = 0.0;
     for (size_t i = 0; i < n; ++i) {
       mesh->vertices[i] += offsets[i] * mesh->normals[i];
@@ -235,7 +236,8 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
   if (!summary.pinned.empty()) {
     // Averaged over neighbours as the offsets are: a blend that changes from vertex to vertex
     // would make bumps of its own.
-    AverageOverNeighbours(neighbours, options.smoothing_passes, &summary.pinned);
+    AverageOverNeighbours(neighbours, options.smoothing_passes, &summary.pinned,
+                          options.num_threads);
     summary.mean_pinned =
         std::accumulate(summary.pinned.begin(), summary.pinned.end(), 0.0) / static_cast<double>(n);
   }

@@ -310,8 +310,8 @@ SilhouetteFitSummary FitMeshToSilhouettes(const std::vector<CalibratedView>& vie
     // The weighted mean of the outline vertices' moves over each vertex's neighbourhood; a
     // vertex whose neighbourhood holds less than half an outline vertex's weight moves by that
     // share (the band fades into the surface).
-    AverageOverNeighbours(neighbours, options.smoothing_passes, &weighted);
-    AverageOverNeighbours(neighbours, options.smoothing_passes, &weights);
+    AverageOverNeighbours(neighbours, options.smoothing_passes, &weighted, threads);
+    AverageOverNeighbours(neighbours, options.smoothing_passes, &weights, threads);
     for (size_t i = 0; i < n; ++i) {
       if (!(weights[i] > 0.0f) || weighted[i] == 0.0f) continue;
       const float move = weighted[i] / std::max(weights[i], 0.5f);

@@ -36,6 +36,7 @@
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "carve/view_workers.h"
+#include "export/parallel_ranges.h"
 #include "export/ply_reader.h"
 #include "export/point_cloud_io.h"
 
@@ -297,7 +298,13 @@ void ComputeVertexNormals(TriangleMesh* mesh) {
 }
 
 std::vector<std::vector<int>> VertexNeighbours(const TriangleMesh& mesh) {
+  // Counted first, so that each list is allocated once.
+  std::vector<int> count(mesh.vertices.size(), 0);
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) count[t[k]] += 2;
+  }
   std::vector<std::vector<int>> neighbours(mesh.vertices.size());
+  for (size_t i = 0; i < neighbours.size(); ++i) neighbours[i].reserve(count[i]);
   for (const Eigen::Vector3i& t : mesh.triangles) {
     for (int k = 0; k < 3; ++k) {
       neighbours[t[k]].push_back(t[(k + 1) % 3]);
@@ -308,15 +315,19 @@ std::vector<std::vector<int>> VertexNeighbours(const TriangleMesh& mesh) {
 }
 
 void AverageOverNeighbours(const std::vector<std::vector<int>>& neighbours, int passes,
-                           std::vector<float>* values) {
+                           std::vector<float>* values, int num_threads) {
   const size_t n = values->size();
+  const int threads = ResolveNumThreads(num_threads);
+  std::vector<float> averaged(n);
   for (int pass = 0; pass < passes; ++pass) {
-    std::vector<float> averaged(n);
-    for (size_t i = 0; i < n; ++i) {
-      double sum = (*values)[i];
-      for (int j : neighbours[i]) sum += (*values)[j];
-      averaged[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
-    }
+    // Each value from the previous pass's alone: the ranges do not depend on each other.
+    ParallelRanges(n, threads, /*min_per_thread=*/8192, [&](size_t first, size_t last) {
+      for (size_t i = first; i < last; ++i) {
+        double sum = (*values)[i];
+        for (int j : neighbours[i]) sum += (*values)[j];
+        averaged[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
+      }
+    });
     values->swap(averaged);
   }
 }

@@ -74,9 +74,10 @@ void ComputeVertexNormals(TriangleMesh* mesh);
 // it shares (twice for an interior edge of a closed mesh).
 std::vector<std::vector<int>> VertexNeighbours(const TriangleMesh& mesh);
 
-// `passes` times, each value becomes the mean of itself and its neighbours' (VertexNeighbours).
+// `passes` times, each value becomes the mean of itself and its neighbours' (VertexNeighbours),
+// on `num_threads` threads (< 1: one per core; the same values for any count).
 void AverageOverNeighbours(const std::vector<std::vector<int>>& neighbours, int passes,
-                           std::vector<float>* values);
+                           std::vector<float>* values, int num_threads = 1);
 
 // Each vertex's connected part (through shared vertices), numbered 0, 1, ... in the order of
 // each part's first vertex; `num_parts` gets the count.

@@ -102,6 +102,30 @@ TEST(SurfaceMesh, TheLibrariesThreadsAreLimitedAndTheMeshIsTheSameOnAnyCount) {
   EXPECT_EQ(one.triangles, three.triangles);
 }
 
+TEST(SurfaceMesh, AveragingOverNeighboursIsTheSameOnAnyNumberOfThreads) {
+  const TriangleMesh mesh = MeshSolidVoxels(Ball(112, 0.7), SurfaceMeshOptions(), nullptr);
+  ASSERT_GT(mesh.vertices.size(), 3 * 8192u);  // enough that three threads take a share each
+  const std::vector<std::vector<int>> neighbours = VertexNeighbours(mesh);
+  std::vector<float> start(mesh.vertices.size());
+  for (size_t i = 0; i < start.size(); ++i) start[i] = mesh.vertices[i].x() > 0.1f ? 1.0f : 0.0f;
+  // Two passes by hand.
+  std::vector<float> expected = start;
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<float> next(expected.size());
+    for (size_t i = 0; i < expected.size(); ++i) {
+      double sum = expected[i];
+      for (int j : neighbours[i]) sum += expected[j];
+      next[i] = static_cast<float>(sum / (1 + neighbours[i].size()));
+    }
+    expected = next;
+  }
+  for (int threads : {1, 3}) {
+    std::vector<float> values = start;
+    AverageOverNeighbours(neighbours, 2, &values, threads);
+    EXPECT_EQ(values, expected) << threads << " threads";
+  }
+}
+
 TEST(SurfaceMesh, SeparateSolidsAreSeparateComponentsAndTheGridBorderClosesTheMesh) {
   // Two boxes, one of them cut by the grid's border on three sides.
   const Volume volume = MakeVolume(24, [](const Eigen::Vector3d& p) {

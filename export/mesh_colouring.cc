@@ -83,6 +83,12 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(
   const int threads = ResolveNumThreads(num_threads);
   std::vector<std::vector<VertexSighting>> sightings(n);
   if (on_rim != nullptr) on_rim->assign(n, 0);
+  // The rims need each mask's distances to the background: the caller's, or made here.
+  std::vector<cv::Mat> own_distances;
+  if (on_rim != nullptr && voxel_size > 0.0 && mask_distances == nullptr) {
+    own_distances = MaskDistances(views, threads);
+    mask_distances = &own_distances;
+  }
   // Each view on its own (in parallel): the vertices it sees, and which lie on its mask's rim.
   std::vector<std::vector<std::pair<uint32_t, float>>> per_view(views.size());
   std::vector<std::vector<uint32_t>> rims(views.size());
@@ -94,11 +100,7 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(
       // Distance (pixels) from each object pixel to the nearest background pixel.
       cv::Mat to_background;
       if (on_rim != nullptr && !view.mask.empty() && voxel_size > 0.0) {
-        if (mask_distances != nullptr) {
-          to_background = (*mask_distances)[v];
-        } else {
-          cv::distanceTransform(view.mask, to_background, cv::DIST_L2, 3);
-        }
+        to_background = (*mask_distances)[v];
       }
       const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
       for (size_t i = 0; i < n; ++i) {

@@ -28,7 +28,6 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkPolyDataNormals.h>
 #include <vtkSMPTools.h>
 #include <vtkSmartPointer.h>
 #include <vtkWindowedSincPolyDataFilter.h>
@@ -229,15 +228,11 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
     surface = decimate->GetOutput();
   }
 
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(surface);
-  normals->SplittingOff();
-  normals->ConsistencyOn();
-  normals->AutoOrientNormalsOn();
-  normals->ComputePointNormalsOn();
-  normals->ComputeCellNormalsOff();
-  normals->Update();
-  TriangleMesh mesh = FromPolyData(normals->GetOutput());
+  // Flying edges winds every triangle with the occupancy's gradient, facing away from the solid
+  // side (a cavity's faces included), and the smoothing, splitting and decimation after it keep
+  // the winding: the normals follow from the triangles as they are.
+  TriangleMesh mesh = FromPolyData(surface);
+  ComputeVertexNormals(&mesh, NormalWeighting::kPerFace);
   result.triangles = static_cast<int64_t>(mesh.triangles.size());
   result.vertices = static_cast<int64_t>(mesh.vertices.size());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -281,14 +276,19 @@ void SmoothMesh(int iterations, double pass_band, TriangleMesh* mesh) {
   ComputeVertexNormals(mesh);
 }
 
-void ComputeVertexNormals(TriangleMesh* mesh) {
+void ComputeVertexNormals(TriangleMesh* mesh, NormalWeighting weighting) {
   std::vector<Eigen::Vector3d> sums(mesh->vertices.size(), Eigen::Vector3d::Zero());
   for (const Eigen::Vector3i& t : mesh->triangles) {
     const Eigen::Vector3d a = mesh->vertices[t[0]].cast<double>();
     const Eigen::Vector3d b = mesh->vertices[t[1]].cast<double>();
     const Eigen::Vector3d c = mesh->vertices[t[2]].cast<double>();
-    const Eigen::Vector3d area_normal = (b - a).cross(c - a);  // twice the area, along the normal
-    for (int k = 0; k < 3; ++k) sums[t[k]] += area_normal;
+    Eigen::Vector3d normal = (b - a).cross(c - a);  // twice the area, along the normal
+    if (weighting == NormalWeighting::kPerFace) {
+      const double length = normal.norm();
+      if (!(length > 0.0)) continue;
+      normal /= length;
+    }
+    for (int k = 0; k < 3; ++k) sums[t[k]] += normal;
   }
   mesh->normals.resize(mesh->vertices.size());
   for (size_t i = 0; i < sums.size(); ++i) {

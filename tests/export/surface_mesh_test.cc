@@ -84,6 +84,52 @@ TEST(SurfaceMesh, ABallOfVoxelsBecomesOneClosedManifoldSphereWithOutwardNormals)
   }
 }
 
+TEST(SurfaceMesh, AHollowBallsInnerSurfaceFacesIntoTheCavity) {
+  // A shell between radii 0.35 and 0.75: its mesh has two closed parts, and every normal points
+  // away from the solid: outwards on the outer sphere, towards the centre on the inner one.
+  const double inner = 0.35, outer = 0.75;
+  const Volume volume = MakeVolume(40, [&](const Eigen::Vector3d& p) {
+    return p.norm() >= inner && p.norm() <= outer;
+  });
+  const TriangleMesh mesh = MeshSolidVoxels(volume, SurfaceMeshOptions(), nullptr);
+  ASSERT_FALSE(mesh.empty());
+  const MeshTopology topology = AnalyseTopology(mesh);
+  EXPECT_TRUE(topology.IsClosedManifold());
+  EXPECT_EQ(topology.components, 2);
+  ASSERT_EQ(mesh.normals.size(), mesh.vertices.size());
+  int on_inner = 0, on_outer = 0;
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
+    const double radial = mesh.normals[i].cast<double>().dot(p.normalized());
+    if (p.norm() < 0.5 * (inner + outer)) {
+      ++on_inner;
+      ASSERT_LT(radial, -0.9) << "inner vertex " << i;
+    } else {
+      ++on_outer;
+      ASSERT_GT(radial, 0.9) << "outer vertex " << i;
+    }
+  }
+  EXPECT_GT(on_inner, 100);
+  EXPECT_GT(on_outer, on_inner);
+}
+
+TEST(SurfaceMesh, VertexNormalsWeighFacesByAreaOrOnceEach) {
+  // Two triangles meet at vertex 0: a large one in the plane z = 0 (normal +z) and a small one in
+  // the plane x = 0 (normal +x). By area the large one wins; once each, the normal bisects.
+  TriangleMesh mesh;
+  mesh.vertices = {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(10, 0, 0), Eigen::Vector3f(0, 10, 0),
+                   Eigen::Vector3f(0, 0, 1), Eigen::Vector3f(0, 1, 0)};
+  mesh.triangles = {Eigen::Vector3i(0, 1, 2), Eigen::Vector3i(0, 4, 3)};
+  ComputeVertexNormals(&mesh, NormalWeighting::kPerFace);
+  EXPECT_NEAR(mesh.normals[0].x(), std::sqrt(0.5), 1e-6);
+  EXPECT_NEAR(mesh.normals[0].z(), std::sqrt(0.5), 1e-6);
+  ComputeVertexNormals(&mesh, NormalWeighting::kByArea);
+  // Areas 50 and 0.5: the normal is (0.5, 0, 50) normalised.
+  EXPECT_NEAR(mesh.normals[0].x(), 0.5 / std::hypot(0.5, 50.0), 1e-6);
+  EXPECT_NEAR(mesh.normals[0].z(), 50.0 / std::hypot(0.5, 50.0), 1e-6);
+  EXPECT_NEAR(mesh.normals[3].x(), 1.0, 1e-6);  // only in the small triangle
+}
+
 TEST(SurfaceMesh, TheLibrariesThreadsAreLimitedAndTheMeshIsTheSameOnAnyCount) {
   const Volume volume = Ball(40, 0.7);
   SetLibraryThreads(1);

@@ -258,6 +258,13 @@ TEST(SurfaceMesh, SplittingAndAFaceBudgetKeepTheMeshClosed) {
   const Volume volume = Ball(32, 0.7);
   const double voxel = volume.grid().voxel_size();
   const TriangleMesh plain = MeshSolidVoxels(volume, SurfaceMeshOptions());
+  // Splitting and decimation keep flying edges' winding, which the normals follow: outwards.
+  const auto outwards = [](const TriangleMesh& mesh) {
+    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+      if (!(mesh.normals[i].dot(mesh.vertices[i].normalized()) > 0.5f)) return false;
+    }
+    return mesh.normals.size() == mesh.vertices.size() && !mesh.vertices.empty();
+  };
 
   SurfaceMeshOptions split;
   split.max_edge_length = 0.4 * voxel;
@@ -265,6 +272,7 @@ TEST(SurfaceMesh, SplittingAndAFaceBudgetKeepTheMeshClosed) {
   EXPECT_LE(MaxEdgeLength(fine), split.max_edge_length * 1.0001);
   EXPECT_GT(fine.triangles.size(), 2 * plain.triangles.size());
   EXPECT_TRUE(AnalyseTopology(fine).IsClosedManifold());
+  EXPECT_TRUE(outwards(fine));
 
   SurfaceMeshOptions budget;
   budget.max_triangles = static_cast<int64_t>(plain.triangles.size() / 4);
@@ -274,6 +282,7 @@ TEST(SurfaceMesh, SplittingAndAFaceBudgetKeepTheMeshClosed) {
   const MeshTopology topology = AnalyseTopology(coarse);
   EXPECT_TRUE(topology.IsClosedManifold());
   EXPECT_EQ(topology.components, 1);
+  EXPECT_TRUE(outwards(coarse));
   // A budget also caps the splitting.
   SurfaceMeshOptions both = split;
   both.max_triangles = static_cast<int64_t>(plain.triangles.size());

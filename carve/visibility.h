@@ -20,12 +20,20 @@ struct PixelRef {
 template <typename Matches>
 void AppendMatchingPixels(const Footprint& footprint, int width, uint32_t view, Matches&& matches,
                           std::vector<PixelRef>* pixels) {
+  if (footprint.empty()) return;
+  // Every pixel is written and the end moves on only past those that match: no branch on the
+  // match, which is as likely as not along a voxel's edge.
+  const size_t first = pixels->size();
+  pixels->resize(first + static_cast<size_t>(footprint.area()));
+  PixelRef* out = pixels->data() + first;
   for (int row = footprint.row_min; row <= footprint.row_max; ++row) {
     const int base = row * width;
     for (int col = footprint.col_min; col <= footprint.col_max; ++col) {
-      if (matches(base + col)) pixels->push_back({view, static_cast<uint32_t>(base + col)});
+      *out = {view, static_cast<uint32_t>(base + col)};
+      out += matches(base + col) ? 1 : 0;
     }
   }
+  pixels->resize(static_cast<size_t>(out - pixels->data()));
 }
 
 // How the carver learns which pixels see which voxel: the one thing in which ray casting, GVC

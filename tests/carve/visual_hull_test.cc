@@ -48,7 +48,9 @@ TEST(VisualHull, KeepsEveryVoxelOfTheTrueSurfaceAndRemovesMostEmptySpace) {
   EXPECT_LT(votes.carved, statistics.carved);
   EXPECT_GT(votes.carved, volume.grid().num_voxels() / 3);
   for (int64_t i = 0; i < volume.grid().num_voxels(); ++i) {
-    if (volume.IsSolid(i)) ASSERT_TRUE(voting.IsSolid(i)) << i;
+    if (volume.IsSolid(i)) {
+      ASSERT_TRUE(voting.IsSolid(i)) << i;
+    }
   }
 }
 

@@ -126,22 +126,6 @@ bool Batched(const CarveOptions& options) {
          options.decision == CarveDecision::kThreshold && !options.incremental_statistics;
 }
 
-// Calls body(item, group) for items [0, count) on `workers`, each group claiming `chunk`
-// consecutive items at a time. Consecutive items of a batch are neighbouring voxels,
-// whose rays are neighbouring pixels: claimed together, one thread's writes stay off the cache
-// lines the other threads write.
-template <typename Body>
-void ClaimItems(ViewWorkers& workers, int count, int chunk, Body body) {
-  std::atomic<int> next{0};
-  auto task = [&](int group) {
-    for (int first; (first = next.fetch_add(chunk, std::memory_order_relaxed)) < count;) {
-      const int last = std::min(count, first + chunk);
-      for (int item = first; item < last; ++item) body(item, group);
-    }
-  };
-  workers.Run(task);
-}
-
 // Calls work(view) for every view on `workers`, the groups claiming views one at a time: each
 // group first its own (view v belongs to group v mod G, so that a view's rays stay in one core's
 // cache from task to task), then any left, in `order` (the costliest first).

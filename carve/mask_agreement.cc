@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -130,7 +129,6 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
   // made (original) and writes only its own mask and counts, so the order does not matter.
   ViewWorkers workers(static_cast<int>(num_views), options.num_threads);
   const int threads = 1;  // per view: the views themselves share the cores
-  std::atomic<size_t> next_view{0};
   auto agree = [&](size_t v) {
     CalibratedView& view = (*views)[v];
     if (view.mask.empty()) return;
@@ -188,10 +186,7 @@ MaskAgreementStatistics AgreeMasks(const Eigen::AlignedBox3d& box,
     }
     view.mask = agreed;
   };
-  auto task = [&](int /*group*/) {
-    for (size_t v; (v = next_view.fetch_add(1, std::memory_order_relaxed)) < num_views;) agree(v);
-  };
-  workers.Run(task);
+  ClaimItems(workers, static_cast<int>(num_views), 1, [&](int v, int /*group*/) { agree(v); });
   statistics.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return statistics;

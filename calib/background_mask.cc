@@ -179,7 +179,12 @@ std::string BackdropModel::Summary() const {
   std::ostringstream text;
   if (!found) {
     text << "no plain backdrop (the border needs more than " << kMaxBackdropColours
-         << " colours; " << std::lround(100.0 * explained) << "% explained)";
+         << " colours; " << std::lround(100.0 * explained) << "% explained";
+    if (!object_colours.empty()) {
+      text << ", after " << std::lround(100.0 * object_border_share)
+           << "% in the object's colours was set aside";
+    }
+    text << ")";
     return text.str();
   }
   text << colours.size() << (colours.size() == 1 ? " colour (" : " colours (");
@@ -193,49 +198,116 @@ std::string BackdropModel::Summary() const {
     text << ", frame " << frame[0] << "/" << frame[1] << "/" << frame[2] << "/" << frame[3]
          << " px";
   }
+  if (!object_colours.empty()) {
+    text << "; " << std::lround(100.0 * object_border_share)
+         << "% of the border in the object's colours (sparse points) set aside";
+  }
   return text.str();
 }
 
-BackdropModel EstimateBackdropModel(const cv::Mat& rgb, double tolerance) {
-  CHECK_EQ(rgb.type(), CV_8UC3);
-  BackdropModel model;
-  for (int side = 0; side < 4; ++side) model.frame[side] = FrameWidth(rgb, side, tolerance);
-  const BorderBand band = MakeBand(rgb, model.frame);
-  std::vector<cv::Vec3b> border;
-  const int64_t band_pixels = 2LL * (band.top - model.frame[0]) * rgb.cols +
-                              2LL * (band.left - model.frame[2]) * rgb.rows;
-  const int stride = static_cast<int>(std::max<int64_t>(1, band_pixels / 40000));
-  int64_t index = 0;
-  for (int row = 0; row < rgb.rows; ++row) {
-    for (int col = 0; col < rgb.cols; ++col) {
-      if (band.InBand(row, col, rgb.rows, rgb.cols) && index++ % stride == 0) {
-        border.push_back(rgb.at<cv::Vec3b>(row, col));
-      }
-    }
-  }
-  if (border.size() < 16) return model;
+namespace {
 
-  // One colour: the median, as EstimateBackdropColour.
-  const Eigen::Vector3d median = MedianColour(border);
-  model.explained = ShareWithin(border, median, tolerance);
-  if (model.explained >= 0.8) {
-    model.found = true;
-    model.colours = {median};
-    model.shares = {model.explained};
-    return model;
-  }
-  cv::Mat samples(static_cast<int>(border.size()), 3, CV_32F);
-  for (size_t i = 0; i < border.size(); ++i) {
-    for (int k = 0; k < 3; ++k) samples.at<float>(static_cast<int>(i), k) = border[i][k];
-  }
+// Clusters `samples` (CV_32F, one RGB row each) into `count` colours with a fixed random state
+// (the same clusters on every run and thread); returns each sample's cluster.
+cv::Mat ClusterColours(const cv::Mat& samples, int count, cv::Mat* centres) {
   cv::RNG& rng = cv::theRNG();
   const uint64 saved_state = rng.state;
+  rng.state = 0x9e3779b97f4a7c15ULL;
+  cv::Mat labels;
+  cv::kmeans(samples, count, labels,
+             cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 0.5), 2,
+             cv::KMEANS_PP_CENTERS, *centres);
+  rng.state = saved_state;
+  return labels;
+}
+
+cv::Mat SampleMatrix(const std::vector<cv::Vec3b>& pixels) {
+  cv::Mat samples(static_cast<int>(pixels.size()), 3, CV_32F);
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    for (int k = 0; k < 3; ++k) samples.at<float>(static_cast<int>(i), k) = pixels[i][k];
+  }
+  return samples;
+}
+
+// Sets aside the pixels of `border` in the object's colours (EstimateBackdropModel): the border's
+// colours are clustered; a cluster is the object's when the share of the seeds' colours within
+// `tolerance` of its colour is at least kObjectSeedDensity times the share of the photo's pixels
+// (sampled) within `tolerance` of it. Its pixels leave `border`; `model` records which and how
+// many.
+void SetAsideObjectColours(const cv::Mat& rgb, double tolerance,
+                           const std::vector<Eigen::Vector2d>& seeds,
+                           std::vector<cv::Vec3b>* border, BackdropModel* model) {
+  std::vector<Eigen::Vector3d> seed_colours;
+  for (const Eigen::Vector2d& seed : seeds) {
+    const int col = static_cast<int>(std::floor(seed.x()));
+    const int row = static_cast<int>(std::floor(seed.y()));
+    if (col < 0 || row < 0 || col >= rgb.cols || row >= rgb.rows) continue;
+    seed_colours.push_back(ToVector(rgb.at<cv::Vec3b>(row, col)));
+  }
+  if (static_cast<int>(seed_colours.size()) < kMinColourSeeds ||
+      static_cast<int>(border->size()) < kMaxBackdropColours) {
+    return;
+  }
+  cv::Mat centres;
+  const cv::Mat labels = ClusterColours(SampleMatrix(*border), kMaxBackdropColours, &centres);
+  std::vector<std::vector<cv::Vec3b>> members(kMaxBackdropColours);
+  for (size_t i = 0; i < border->size(); ++i) {
+    members[labels.at<int>(static_cast<int>(i))].push_back((*border)[i]);
+  }
+  // The photo's pixels on a grid of about 40,000.
+  const int step = std::max(1, static_cast<int>(std::sqrt(rgb.total() / 40000.0)));
+  std::vector<Eigen::Vector3d> photo;
+  for (int row = step / 2; row < rgb.rows; row += step) {
+    for (int col = step / 2; col < rgb.cols; col += step) {
+      photo.push_back(ToVector(rgb.at<cv::Vec3b>(row, col)));
+    }
+  }
+  std::vector<bool> object(kMaxBackdropColours, false);
+  for (int c = 0; c < kMaxBackdropColours; ++c) {
+    if (members[c].size() < 0.03 * border->size()) continue;  // as below: too few to judge
+    const Eigen::Vector3d colour = MedianColour(members[c]);
+    const auto share = [&colour, tolerance](const std::vector<Eigen::Vector3d>& colours) {
+      int64_t close = 0;
+      for (const Eigen::Vector3d& other : colours) close += (other - colour).norm() <= tolerance;
+      return static_cast<double>(close) / std::max<size_t>(1, colours.size());
+    };
+    object[c] = share(seed_colours) >= kObjectSeedDensity * share(photo);
+    if (object[c]) model->object_colours.push_back(colour);
+  }
+  if (model->object_colours.empty()) return;
+  std::vector<cv::Vec3b> kept;
+  for (size_t i = 0; i < border->size(); ++i) {
+    if (!object[labels.at<int>(static_cast<int>(i))]) kept.push_back((*border)[i]);
+  }
+  model->object_border_share = 1.0 - static_cast<double>(kept.size()) / border->size();
+  border->swap(kept);
+}
+
+}  // namespace
+
+namespace {
+
+// Describes `border` by the fewest colours (1 to kMaxBackdropColours) that bring 80% of it within
+// `tolerance`: sets `model`'s found, colours, shares and explained.
+void DescribeBorder(const std::vector<cv::Vec3b>& border, double tolerance, BackdropModel* model) {
+  model->found = false;
+  model->colours.clear();
+  model->shares.clear();
+  model->explained = 0.0;
+  if (border.size() < 16) return;
+  // One colour: the median, as EstimateBackdropColour.
+  const Eigen::Vector3d median = MedianColour(border);
+  model->explained = ShareWithin(border, median, tolerance);
+  if (model->explained >= 0.8) {
+    model->found = true;
+    model->colours = {median};
+    model->shares = {model->explained};
+    return;
+  }
+  const cv::Mat samples = SampleMatrix(border);
   for (int count = 2; count <= kMaxBackdropColours; ++count) {
-    rng.state = 0x9e3779b97f4a7c15ULL;  // the same clusters on every run
-    cv::Mat labels, centres;
-    cv::kmeans(samples, count, labels,
-               cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 0.5), 2,
-               cv::KMEANS_PP_CENTERS, centres);
+    cv::Mat centres;
+    const cv::Mat labels = ClusterColours(samples, count, &centres);
     std::vector<std::vector<cv::Vec3b>> members(count);
     for (size_t i = 0; i < border.size(); ++i) {
       members[labels.at<int>(static_cast<int>(i))].push_back(border[i]);
@@ -256,17 +328,44 @@ BackdropModel EstimateBackdropModel(const cv::Mat& rgb, double tolerance) {
       }
       if (best <= tolerance) ++close, ++nearest_count[which];
     }
-    model.explained = static_cast<double>(close) / border.size();
-    if (model.explained >= 0.8) {
-      model.found = true;
-      model.colours = colours;
+    model->explained = static_cast<double>(close) / border.size();
+    if (model->explained >= 0.8) {
+      model->found = true;
+      model->colours = colours;
       for (size_t c = 0; c < colours.size(); ++c) {
-        model.shares.push_back(static_cast<double>(nearest_count[c]) / border.size());
+        model->shares.push_back(static_cast<double>(nearest_count[c]) / border.size());
       }
-      break;
+      return;
     }
   }
-  rng.state = saved_state;
+}
+
+}  // namespace
+
+BackdropModel EstimateBackdropModel(const cv::Mat& rgb, double tolerance,
+                                    const std::vector<Eigen::Vector2d>& object_seeds) {
+  CHECK_EQ(rgb.type(), CV_8UC3);
+  BackdropModel model;
+  for (int side = 0; side < 4; ++side) model.frame[side] = FrameWidth(rgb, side, tolerance);
+  const BorderBand band = MakeBand(rgb, model.frame);
+  std::vector<cv::Vec3b> border;
+  const int64_t band_pixels = 2LL * (band.top - model.frame[0]) * rgb.cols +
+                              2LL * (band.left - model.frame[2]) * rgb.rows;
+  const int stride = static_cast<int>(std::max<int64_t>(1, band_pixels / 40000));
+  int64_t index = 0;
+  for (int row = 0; row < rgb.rows; ++row) {
+    for (int col = 0; col < rgb.cols; ++col) {
+      if (band.InBand(row, col, rgb.rows, rgb.cols) && index++ % stride == 0) {
+        border.push_back(rgb.at<cv::Vec3b>(row, col));
+      }
+    }
+  }
+  DescribeBorder(border, tolerance, &model);
+  // A border that is not a few plain colours is a natural scene, whatever lies on it; one that
+  // is may owe some of its colours to the object running out of the frame.
+  if (!model.found) return model;
+  SetAsideObjectColours(rgb, tolerance, object_seeds, &border, &model);
+  if (!model.object_colours.empty()) DescribeBorder(border, tolerance, &model);
   return model;
 }
 

@@ -49,6 +49,10 @@ struct BackdropModel {
   std::vector<double> shares;          // of the border's pixels, per colour
   double explained = 0.0;              // share of the border's pixels within tolerance of one
   int frame[4] = {0, 0, 0, 0};         // uniform frame lines at the top, bottom, left, right
+  // Of the border's pixels, the share set aside as the object's own colours (where the object
+  // or the surface it stands on runs out of the frame; see EstimateBackdropModel's seeds).
+  double object_border_share = 0.0;
+  std::vector<Eigen::Vector3d> object_colours;  // the border's colours found to be the object's
   std::string Summary() const;         // "2 colours (85,100,160 60%; ...), frame 3 px"
 };
 
@@ -60,7 +64,25 @@ constexpr int kMaxBackdropColours = 5;
 // (2% of rows and columns) is described by the fewest colours (1 to kMaxBackdropColours, by
 // k-means, deterministic) that bring 80% of its pixels within `tolerance`. With one colour this
 // is EstimateBackdropColour. `found` is false when no such set exists.
-BackdropModel EstimateBackdropModel(const cv::Mat& rgb, double tolerance);
+//
+// `object_seeds` (pixels where sparse points inside the volume fall in the photo) tell the
+// object's colours from the backdrop's where the object, or the table it stands on, runs out of
+// the frame and so covers part of the border. A plain backdrop has no texture and holds no
+// sparse points of its own; the points that land on it come from errors (in the poses, in the
+// points). The border's colours are clustered (k-means, kMaxBackdropColours); a cluster whose
+// colour holds seeds at least kObjectSeedDensity times as densely as the photo as a whole (the
+// share of seeds within `tolerance` of it against the share of the photo's pixels) is the
+// object's, and the backdrop is described again without its border pixels. This only refines a
+// backdrop found on the whole border: a border that needs more colours is a natural scene, and
+// stays one. With fewer than kMinColourSeeds seeds in the photo every border pixel counts.
+BackdropModel EstimateBackdropModel(const cv::Mat& rgb, double tolerance,
+                                    const std::vector<Eigen::Vector2d>& object_seeds = {});
+constexpr int kMinColourSeeds = 20;
+// Seeds spread evenly over an object hold its colours at least as densely as the photo's average
+// (the object is part of the photo); half leaves room for its plain parts. A backdrop colour holds
+// X
+// worst poses put a sixth of the points on the black backdrop.
+constexpr double kObjectSeedDensity = 0.5;
 
 // How far a pixel's colour is from the backdrop: the least RGB distance to one of the model's
 // colours scaled by a brightness gain in [darkest, brightest] (shadows darken a backdrop, and

@@ -26,6 +26,11 @@ std::string ViewReaderSummary::Summary() const {
     text << "; " << masks_from_backdrop << " masks from the backdrop (mean colour "
          << mean_backdrop.transpose() << ")";
   }
+  if (object_on_border > 0) {
+    text << "; " << object_on_border << " photos with the object running out of the frame ("
+         << std::lround(100.0 * object_border_share)
+         << "% of their border on average in its colours, by the sparse points, not backdrop)";
+  }
   if (no_plain_backdrop > 0) text << "; " << no_plain_backdrop << " photos without a plain backdrop";
   if (num_downscaled > 0) text << "; " << num_downscaled << " photos reduced (--max_image_size)";
   return text.str();
@@ -45,6 +50,28 @@ std::vector<Eigen::Vector2d> SeedPixels(const Reconstruction& reconstruction, co
     seeds.push_back(point2D.xy.cwiseProduct(pixel_scale));
   }
   return seeds;
+}
+
+// Where the sparse points inside `volume` (all, when it is empty) fall in the photo, whether or
+// not the image observed them: a point of the scene projects onto the scene (itself, or what
+// stands in front of it), never onto the backdrop behind. This tells the object's colours from
+// the backdrop's in every photo, held-out ones included (whose own observations are removed).
+std::vector<Eigen::Vector2d> ProjectedPointPixels(const Reconstruction& reconstruction,
+                                                  const Camera& camera, const Image& image,
+                                                  const Eigen::AlignedBox3d& volume) {
+  std::vector<Eigen::Vector2d> pixels;
+  for (const auto& [id, point] : reconstruction.points3D) {
+    if (!volume.isEmpty() && !volume.contains(point.xyz)) continue;
+    const Eigen::Vector3d local = image.cam_from_world * point.xyz;
+    if (!(local.z() > 1e-9)) continue;
+    const Eigen::Vector2d pixel = camera.ImgFromCam(local.head<2>() / local.z());
+    if (!pixel.allFinite() || pixel.x() < 0.0 || pixel.y() < 0.0 ||
+        pixel.x() >= camera.width || pixel.y() >= camera.height) {
+      continue;
+    }
+    pixels.push_back(pixel);
+  }
+  return pixels;
 }
 
 // Points along the outline of `volume` in the photo (its twelve edges, sampled so that the
@@ -155,13 +182,16 @@ LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, cons
     mask_file = path + " (backdrop mask)";
     info.source = "colour";
   } else if (options.background.mode == BackgroundOptions::Mode::kAuto) {
-    info.backdrop = EstimateBackdropModel(rgb, options.background.tolerance);
+    const std::vector<Eigen::Vector2d> seeds =
+        SeedPixels(reconstruction, image, options.volume, pixel_scale);
+    info.backdrop = EstimateBackdropModel(
+        rgb, options.background.tolerance,
+        ProjectedPointPixels(reconstruction, camera, image, options.volume));
     if (!info.backdrop.found) {
       LOG(WARNING) << path << ": " << info.backdrop.Summary() << "; no backdrop mask";
     } else {
       mask = ObjectMaskFromModel(rgb, info.backdrop, options.background.tolerance,
-                                 options.background.refine,
-                                 SeedPixels(reconstruction, image, options.volume, pixel_scale),
+                                 options.background.refine, seeds,
                                  VolumeOutline(camera, image, options.volume), &info.mask);
       mask_file = path + " (backdrop mask)";
       info.source = "backdrop";
@@ -234,12 +264,17 @@ std::vector<CalibratedView> ReadCalibratedViews(const Reconstruction& reconstruc
         !info.backdrop.found) {
       ++summary->no_plain_backdrop;
     }
+    if (!info.backdrop.object_colours.empty()) {
+      ++summary->object_on_border;
+      summary->object_border_share += info.backdrop.object_border_share;
+    }
     summary->photos.push_back(info);
     summary->num_downscaled += result.downscaled;
     views.push_back(std::move(result.view));
   }
   summary->num_loaded = static_cast<int>(views.size());
   if (summary->masks_from_backdrop > 0) summary->mean_backdrop /= summary->masks_from_backdrop;
+  if (summary->object_on_border > 0) summary->object_border_share /= summary->object_on_border;
   if (views.empty()) {
     throw InputError(image_path + ": no view could be built: the model has " +
                      std::to_string(reconstruction.images.size()) +

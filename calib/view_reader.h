@@ -42,6 +42,10 @@ struct ViewReaderSummary {
   int masks_from_files = 0;
   int masks_from_backdrop = 0;
   int no_plain_backdrop = 0;  // kAuto found no one-coloured border: that view has no mask
+  // kAuto: photos whose border held the object's colours (BackdropModel::object_colours), set
+  // aside before the backdrop was described; and the mean share of their borders set aside.
+  int object_on_border = 0;
+  double object_border_share = 0.0;
   Eigen::Vector3d mean_backdrop = Eigen::Vector3d::Zero();  // over masks_from_backdrop views
   std::vector<std::string> missing;  // photo paths not found (only with skip_missing_images)
   std::vector<PhotoMaskInfo> photos;  // per loaded view, in view order

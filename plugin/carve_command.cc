@@ -436,6 +436,12 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
             .EndObject();
       }
       json.EndArray();
+      json.Key("object_colours_on_border").BeginArray();
+      for (const Eigen::Vector3d& colour : photo.backdrop.object_colours) {
+        json.Value(JsonArray(colour));
+      }
+      json.EndArray();
+      json.Key("object_border_share").Value(photo.backdrop.object_border_share);
       json.Key("frame_px").Value(std::vector<double>{
           static_cast<double>(photo.backdrop.frame[0]), static_cast<double>(photo.backdrop.frame[1]),
           static_cast<double>(photo.backdrop.frame[2]), static_cast<double>(photo.backdrop.frame[3])});

@@ -15,10 +15,16 @@ int RunSynth(int argc, char** argv) {
   OptionParser parser("synth",
                       "Generates a synthetic COLMAP project with ground truth: a textured sphere "
                       "and box (--scene simple) or the seed paper's textured teapot, sphere and "
-                      "cube (--scene paper) on a checkered ground, ray traced from cameras on a "
-                      "ring (images/, masks/, sparse/0, truth.ply).");
+                      "cube (--scene paper) on a checkered ground, ray traced from cameras around "
+                      "it (images/, masks/, sparse/0, truth.ply).");
   parser.AddRequired("output_path", &output_path, "project folder to write (created)");
-  parser.AddDefault("views", &options.num_views, "number of cameras on the ring");
+  parser.AddDefault("views", &options.num_views, "number of cameras");
+  std::string layout = "ring";
+  parser.AddDefault("layout", &layout,
+                    "where the cameras stand: a ring around the scene, a hemisphere (12 to 72 "
+                    "degrees up), an arc (the ring's front 150 degrees), or close (a ring at 0.6 "
+                    "of the distance, the ground leaving the frames)",
+                    CameraLayoutNames());
   parser.AddDefault("width", &options.width, "photo width in pixels");
   parser.AddDefault("height", &options.height, "photo height in pixels");
   parser.AddDefault("seed", &options.seed, "random seed of the sparse points and noise");
@@ -53,6 +59,7 @@ int RunSynth(int argc, char** argv) {
   if (!parser.Parse(argc, argv)) return 0;
   options.camera_model = CameraModelIdFromName(camera_model, "--camera_model");
   BackdropFromString(backdrop, &options.backdrop);
+  CameraLayoutFromString(layout, &options.layout);
   options.detail_texture = texture == "detailed";
   SceneKindFromString(scene_kind, &options.scene);
   std::string reason;

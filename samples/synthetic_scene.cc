@@ -28,6 +28,8 @@ constexpr double kSphereRadius = 0.55;
 const Eigen::Vector3d kBoxMin(-1.05, -0.75, 0.0);
 const Eigen::Vector3d kBoxMax(-0.2, 0.05, 0.8);
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// What every camera looks at.
+const Eigen::Vector3d kCameraTarget(0.0, 0.0, 0.35);
 
 enum class Surface { kNone, kGround, kSphere, kBox, kTeapot };
 
@@ -510,6 +512,63 @@ bool SceneKindFromString(const std::string& text, SceneKind* kind) {
   return false;
 }
 
+std::vector<std::string> CameraLayoutNames() { return {"ring", "hemisphere", "arc", "close"}; }
+
+std::string CameraLayoutToString(CameraLayout layout) {
+  return CameraLayoutNames()[static_cast<int>(layout)];
+}
+
+bool CameraLayoutFromString(const std::string& text, CameraLayout* layout) {
+  const std::vector<std::string> names = CameraLayoutNames();
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (text == names[i]) {
+      *layout = static_cast<CameraLayout>(i);
+      return true;
+    }
+  }
+  return false;
+}
+
+std::vector<Eigen::Vector3d> CameraCentres(CameraLayout layout, int num_views) {
+  std::vector<Eigen::Vector3d> centres;
+  const double ring_radius = 5.0;
+  for (int i = 0; i < num_views; ++i) {
+    double angle = 2.0 * M_PI * i / num_views + 0.3;
+    switch (layout) {
+      case CameraLayout::kRing:
+      case CameraLayout::kClose: {
+        const double scale = layout == CameraLayout::kClose ? 0.6 : 1.0;
+        const double height = 2.6 + 0.6 * std::sin(3.0 * angle);  // not all on one plane
+        centres.push_back(kCameraTarget + scale * (Eigen::Vector3d(ring_radius * std::cos(angle),
+                                                                   ring_radius * std::sin(angle),
+                                                                   height) -
+                                                   kCameraTarget));
+        break;
+      }
+      case CameraLayout::kArc: {
+        angle = 0.3 + (num_views == 1 ? 0.0 : (150.0 / 180.0 * M_PI) * i / (num_views - 1));
+        const double height = 2.6 + 0.6 * std::sin(3.0 * angle);
+        centres.emplace_back(ring_radius * std::cos(angle), ring_radius * std::sin(angle),
+                             height);
+        break;
+      }
+      case CameraLayout::kHemisphere: {
+        // Equal steps of sin(elevation) between 12 and 72 degrees: equal areas of the dome.
+        const double low = std::sin(12.0 / 180.0 * M_PI), high = std::sin(72.0 / 180.0 * M_PI);
+        const double elevation = std::asin(low + (high - low) * (i + 0.5) / num_views);
+        const double azimuth = 0.3 + i * M_PI * (3.0 - std::sqrt(5.0));  // the golden angle
+        const double distance = 5.6;
+        centres.push_back(kCameraTarget +
+                          distance * Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                                                     std::cos(elevation) * std::sin(azimuth),
+                                                     std::sin(elevation)));
+        break;
+      }
+    }
+  }
+  return centres;
+}
+
 std::vector<std::string> BackdropNames() {
   return {"patchwork", "uniform", "two_tone", "gradient", "vignetted", "shadowed_table"};
 }
@@ -601,20 +660,16 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
                       : options.camera_params;
   reconstruction.cameras.emplace(camera.camera_id, camera);
 
-  const double ring_radius = 5.0;
-  const Eigen::Vector3d target(0.0, 0.0, 0.35);
+  const std::vector<Eigen::Vector3d> centres = CameraCentres(options.layout, options.num_views);
   for (int i = 0; i < options.num_views; ++i) {
-    const double angle = 2.0 * M_PI * i / options.num_views + 0.3;
-    const double height = 2.6 + 0.6 * std::sin(3.0 * angle);  // not all on one plane
-    const Eigen::Vector3d centre(
-        ring_radius * std::cos(angle), ring_radius * std::sin(angle), height);
+    const Eigen::Vector3d& centre = centres[i];
     Image image;
     image.image_id = static_cast<image_t>(i + 1);
     image.camera_id = camera.camera_id;
     char name[32];
     std::snprintf(name, sizeof(name), "view%03d.png", i + 1);
     image.name = name;
-    image.cam_from_world = LookAt(centre, target);
+    image.cam_from_world = LookAt(centre, kCameraTarget);
     cv::Mat mask;
     scene.photos.emplace(image.image_id,
                          Render(geometry, camera, image.cam_from_world, options.supersampling,

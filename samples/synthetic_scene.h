@@ -41,6 +41,20 @@ std::string BackdropToString(Backdrop backdrop);
 bool BackdropFromString(const std::string& text, Backdrop* backdrop);
 std::vector<std::string> BackdropNames();
 
+// Where the cameras stand, all looking at the scene's centre from outside it.
+enum class CameraLayout {
+  kRing,        // around the scene, 27 degrees up on average (heights vary so not all share a plane)
+  kHemisphere,  // over a dome from 12 to 72 degrees up, area-uniform, on a golden-angle spiral
+  kArc,         // the ring's front 150 degrees only, as where a wall stops the photographer
+  kClose,       // a ring at 0.6 of the distance: the ground square leaves the frames
+};
+std::string CameraLayoutToString(CameraLayout layout);
+bool CameraLayoutFromString(const std::string& text, CameraLayout* layout);
+std::vector<std::string> CameraLayoutNames();
+
+// The camera centres of `layout` for `num_views` cameras (world frame), in image order.
+std::vector<Eigen::Vector3d> CameraCentres(CameraLayout layout, int num_views);
+
 // Where the paper's scene reads the teapot's Bezier patches: teapot/teapot_bezier.txt in
 // $RAYCARVE_DATA_DIR, else in the first ../shared/data found beside the working folder or beside
 // a folder holding the program.
@@ -52,7 +66,8 @@ struct SyntheticSceneOptions {
   SceneKind scene = SceneKind::kSimple;
   std::string teapot_path;      // the paper's scene: empty for DefaultTeapotPath()
   int teapot_tessellation = 12;  // quads per patch side
-  int num_views = 8;           // cameras on the ring
+  int num_views = 8;           // cameras
+  CameraLayout layout = CameraLayout::kRing;
   int width = 320;             // photo width in pixels
   int height = 240;            // photo height in pixels
   uint64_t seed = 1;           // seeds the surface points' sampling and the pixel noise

@@ -1,6 +1,7 @@
 #include "samples/synthetic_scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -75,6 +76,63 @@ TEST(SyntheticScene, EveryPointIsSeenByTwoViewsAndItsPixelsShowItsColour) {
   const std::vector<int> shifted = ColourDifferences(scene, 3);
   EXPECT_LE(at_point[at_point.size() / 2], 2);
   EXPECT_GE(shifted[shifted.size() / 2], 20);
+}
+
+// Elevation (degrees above the horizontal) and azimuth (degrees) of a centre seen from the
+// point every camera looks at, (0, 0, 0.35).
+Eigen::Vector2d ElevationAzimuth(const Eigen::Vector3d& centre) {
+  const Eigen::Vector3d d = centre - Eigen::Vector3d(0.0, 0.0, 0.35);
+  return Eigen::Vector2d(std::asin(d.z() / d.norm()), std::atan2(d.y(), d.x())) * 180.0 / M_PI;
+}
+
+TEST(SyntheticScene, CameraLayoutsPutTheCamerasWhereTheySay) {
+  const int n = 12;
+  const std::vector<Eigen::Vector3d> ring = CameraCentres(CameraLayout::kRing, n);
+  const std::vector<Eigen::Vector3d> close = CameraCentres(CameraLayout::kClose, n);
+  const std::vector<Eigen::Vector3d> arc = CameraCentres(CameraLayout::kArc, n);
+  const std::vector<Eigen::Vector3d> dome = CameraCentres(CameraLayout::kHemisphere, n);
+  ASSERT_EQ(ring.size(), 12u);
+  ASSERT_EQ(close.size(), 12u);
+  ASSERT_EQ(arc.size(), 12u);
+  ASSERT_EQ(dome.size(), 12u);
+  const Eigen::Vector3d target(0.0, 0.0, 0.35);
+  double arc_low = 1e9, arc_high = -1e9;
+  for (int i = 0; i < n; ++i) {
+    // The close ring is the ring at 0.6 of its distance, in the same directions.
+    EXPECT_NEAR((close[i] - target).norm(), 0.6 * (ring[i] - target).norm(), 1e-9);
+    EXPECT_NEAR((close[i] - target).normalized().dot((ring[i] - target).normalized()), 1.0, 1e-12);
+    const Eigen::Vector2d up = ElevationAzimuth(dome[i]);
+    EXPECT_NEAR((dome[i] - target).norm(), 5.6, 1e-9);
+    EXPECT_GE(up.x(), 12.0 - 1e-9);
+    EXPECT_LE(up.x(), 72.0 + 1e-9);
+    const double azimuth = ElevationAzimuth(arc[i]).y();
+    arc_low = std::min(arc_low, azimuth);
+    arc_high = std::max(arc_high, azimuth);
+  }
+  // The arc spans 150 degrees, ends included; the ring goes all round.
+  EXPECT_NEAR(arc_high - arc_low, 150.0, 1e-6);
+  EXPECT_LT(ElevationAzimuth(dome.front()).x(), 20.0);
+  EXPECT_GT(ElevationAzimuth(dome.back()).x(), 64.0);
+  // Each layout's cameras see the scene's centre in the middle of the photo.
+  for (CameraLayout layout : {CameraLayout::kRing, CameraLayout::kHemisphere, CameraLayout::kArc,
+                              CameraLayout::kClose}) {
+    SyntheticSceneOptions options = Small();
+    options.num_views = 4;
+    options.num_surface_samples = 0;
+    options.layout = layout;
+    const SyntheticScene scene = GenerateSyntheticScene(options);
+    for (const auto& [id, image] : scene.reconstruction.images) {
+      const Eigen::Vector3d local = image.cam_from_world * target;
+      EXPECT_GT(local.z(), 0.0);
+      EXPECT_NEAR(local.x() / local.z(), 0.0, 1e-9) << CameraLayoutToString(layout);
+      EXPECT_NEAR(local.y() / local.z(), 0.0, 1e-9) << CameraLayoutToString(layout);
+      EXPECT_GT(cv::countNonZero(scene.masks.at(id)), 0) << CameraLayoutToString(layout);
+    }
+  }
+  CameraLayout parsed = CameraLayout::kRing;
+  EXPECT_TRUE(CameraLayoutFromString("hemisphere", &parsed));
+  EXPECT_EQ(parsed, CameraLayout::kHemisphere);
+  EXPECT_FALSE(CameraLayoutFromString("dome", &parsed));
 }
 
 TEST(SyntheticScene, DetailedTextureChangesThePhotosNotTheGeometryAndPointsShowTheirColours) {

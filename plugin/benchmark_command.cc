@@ -78,7 +78,7 @@ int RunBenchmark(int argc, char** argv) {
   const LoadedProject project =
       LoadProject("benchmark", request.workspace_path, request.input_path, request.image_path,
                   request.output_path, request.bounds, request.view_options, /*min_images=*/2,
-                  request.model_index, request.colour_calibration);
+                  request.model_index, ColourCalibrationModeOf(request));
   std::vector<Eigen::Vector3f> reference_points;
   if (!reference.empty()) reference_points = exporter::ReadComparablePoints(reference, 200000);
   const std::filesystem::path out = std::filesystem::path(project.output_path) / "benchmark";

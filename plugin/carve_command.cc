@@ -67,7 +67,7 @@ CarveRun CarveProject(const CarveRequest& request) {
   LoadedProject project =
       LoadProject("carve", request.workspace_path, request.input_path, request.image_path,
                   request.output_path, request.bounds, request.view_options, /*min_images=*/2,
-                  request.model_index, request.colour_calibration);
+                  request.model_index, ColourCalibrationModeOf(request));
   run.model_path = project.model_path;
   run.image_path = project.image_path;
   run.output_path = project.output_path;
@@ -469,8 +469,10 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
         .Key("seconds").Value(agreement.seconds)
         .EndObject();
   }
-  if (request.colour_calibration) {
+  if (ColourCalibrationModeOf(request) != ColourCalibrationMode::kOff) {
     json.Key("colour_calibration").BeginObject()
+        .Key("mode").Value(request.colour_calibration)
+        .Key("applied").Value(run.colour.applied)
         .Key("points_used").Value(run.colour.points_used)
         .Key("observations_used").Value(run.colour.observations_used)
         .Key("spread_before").Value(run.colour.spread_before)
@@ -754,7 +756,10 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
                      "(specks in empty space) and carry on carving behind them; 0: keep all");
   parser->AddDefault("colour_calibration", &request->colour_calibration,
                      "estimate a gain and offset per photo and channel from the sparse points' "
-                     "colours (Ceres, robust) and correct the photos before carving");
+                     "colours (Ceres, robust) and correct the photos before carving: 1 always, "
+                     "auto where the correction at least halves the points' colour spread across "
+                     "photos (different exposures), 0 never",
+                     {"auto", "1", "0", "true", "false"});
   parser->AddDefault("num_threads", &request->options.num_threads,
                      "threads for ray casting and colouring (-1: one per core, at most one per "
                      "photo); the carving is identical for any count");

@@ -64,7 +64,7 @@ struct LoadedProject {
   Bounds bounds;
   std::vector<CalibratedView> views;
   ViewReaderSummary view_summary;
-  ColourCalibration colour;  // estimated and applied when asked (points_used 0 otherwise)
+  ColourCalibration colour;  // estimated unless off (points_used 0 otherwise); see its `applied`
   // The reliable sparse points (SurfacePointsOf) with the indices of the views that saw them.
   std::vector<SurfacePoint> surface_points;
   // With hold_out_every: the names of the held-out images (their observations were removed from
@@ -102,7 +102,7 @@ LoadedProject LoadProject(const std::string& command,
                           const ViewReaderOptions& view_options,
                           int min_images,
                           int model_index = -1,
-                          bool colour_calibration = false,
+                          ColourCalibrationMode colour_calibration = ColourCalibrationMode::kOff,
                           int hold_out_every = 0);
 
 // sfm --colmap_options: "Section.name=value,..." split into the arguments of the COLMAP step
@@ -173,7 +173,8 @@ struct CarveRequest {
   BoundsFlags bounds;
   ViewReaderOptions view_options;
   int model_index = -1;              // sparse/<index> among several models; -1: the largest
-  bool colour_calibration = false;   // per-photo gains and offsets from the sparse points
+  // Per-photo gains and offsets from the sparse points: "auto", "1" or "0" (ColourCalibrationMode).
+  std::string colour_calibration = "auto";
   std::string background = "auto";  // as given on the command line, for the report
   double progress_seconds = 2.0;     // between progress lines
   // mesh.ply: "smooth" (welded, coloured from the photos) or "voxels" (the voxel faces, each
@@ -188,6 +189,13 @@ struct CarveRequest {
   // carve; masks from files are the user's and are left as they are.
   bool agree_masks = true;
 };
+
+// The request's --colour_calibration (checked by the parser: "auto", "1", "0", "true", "false").
+inline ColourCalibrationMode ColourCalibrationModeOf(const CarveRequest& request) {
+  ColourCalibrationMode mode = ColourCalibrationMode::kAuto;
+  ColourCalibrationModeFromString(request.colour_calibration, &mode);
+  return mode;
+}
 
 // AgreeMasks over `views` when `request` asks for it and their masks came from the backdrop;
 // logs its summary. Returns what it changed (views 0 when it did not run).

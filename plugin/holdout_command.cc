@@ -62,7 +62,7 @@ int RunHoldout(int argc, char** argv) {
   const LoadedProject project =
       LoadProject("holdout", request.workspace_path, request.input_path, request.image_path,
                   request.output_path, request.bounds, request.view_options, /*min_images=*/3,
-                  request.model_index, request.colour_calibration, every);
+                  request.model_index, ColourCalibrationModeOf(request), every);
   // Every k-th image in name order is held out; its observations left the sparse points before
   // the bounds, the colour calibration and the surface evidence were taken from them.
   const std::set<std::string> held_out_names(project.held_out.begin(), project.held_out.end());

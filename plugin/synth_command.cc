@@ -52,6 +52,9 @@ int RunSynth(int argc, char** argv) {
                     "noise added (detailed) so that COLMAP's structure-from-motion can match the "
                     "photos",
                     {"plain", "detailed"});
+  parser.AddDefault("exposure_spread", &options.exposure_spread,
+                    "each photo brighter or darker by a gain within 1 +- this, differing from "
+                    "photo to photo, as an automatic exposure makes them (0: all alike)");
   std::vector<std::string> models;
   for (CameraModelId model : SupportedCameraModels()) models.push_back(CameraModelName(model));
   parser.AddDefault("camera_model", &camera_model,

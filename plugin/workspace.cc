@@ -173,7 +173,7 @@ LoadedProject LoadProject(const std::string& command,
                           const ViewReaderOptions& view_options,
                           int min_images,
                           int model_index,
-                          bool colour_calibration,
+                          ColourCalibrationMode colour_calibration,
                           int hold_out_every) {
   LoadedProject project;
   const WorkspacePaths paths =
@@ -218,14 +218,22 @@ LoadedProject LoadProject(const std::string& command,
                      " photos could be loaded; raycarve " + command + " needs at least " +
                      std::to_string(min_images));
   }
-  if (colour_calibration) {
+  if (colour_calibration != ColourCalibrationMode::kOff) {
     project.colour = EstimateColourCalibration(project.reconstruction, project.views);
     if (project.colour.points_used == 0) {
-      LOG(WARNING) << "colour calibration: no sparse point is seen by 3 or more photos; the "
-                      "photos are used as they are";
-    } else {
+      if (colour_calibration == ColourCalibrationMode::kOn) {
+        LOG(WARNING) << "colour calibration: no sparse point is seen by 3 or more photos; the "
+                        "photos are used as they are";
+      }
+    } else if (colour_calibration == ColourCalibrationMode::kOn ||
+               ColourCalibrationPays(project.colour)) {
       ApplyColourCalibration(project.colour, &project.views);
-      LOG(INFO) << project.colour.Summary();
+      project.colour.applied = true;
+      LOG(INFO) << project.colour.Summary() << "; the photos corrected";
+    } else {
+      LOG(INFO) << project.colour.Summary()
+                << "; the photos used as they are (--colour_calibration auto corrects them "
+                   "where that at least halves the spread: different exposures)";
     }
   }
   project.surface_points =

@@ -459,6 +459,10 @@ bool SyntheticSceneOptions::IsValid(std::string* reason) const {
     *reason = "teapot_tessellation must be in [1, 64]";
     return false;
   }
+  if (!(exposure_spread >= 0.0 && exposure_spread < 1.0)) {
+    *reason = "exposure_spread must be in [0, 1)";
+    return false;
+  }
   if (supersampling < 1 || supersampling > 8) {
     *reason = "supersampling must be in [1, 8]";
     return false;
@@ -671,9 +675,15 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
     image.name = name;
     image.cam_from_world = LookAt(centre, kCameraTarget);
     cv::Mat mask;
-    scene.photos.emplace(image.image_id,
-                         Render(geometry, camera, image.cam_from_world, options.supersampling,
-                                options.backdrop, options.detail_texture, &mask));
+    cv::Mat photo = Render(geometry, camera, image.cam_from_world, options.supersampling,
+                           options.backdrop, options.detail_texture, &mask);
+    if (options.exposure_spread > 0.0) {
+      // An automatic exposure: the whole photo brighter or darker, by a gain that varies from
+      // photo to photo over [1 - spread, 1 + spread].
+      const double gain = 1.0 + options.exposure_spread * std::sin(2.3 * i + 0.7);
+      photo.convertTo(photo, CV_8UC3, gain);
+    }
+    scene.photos.emplace(image.image_id, photo);
     scene.masks.emplace(image.image_id, mask);
     reconstruction.images.emplace(image.image_id, std::move(image));
   }

@@ -82,6 +82,9 @@ struct SyntheticSceneOptions {
   // A non-repeating noise texture over every surface, on top of the checks and stripes, so that
   // structure-from-motion (SIFT matching) can tell places apart; off, the photos are plain.
   bool detail_texture = false;
+  // Each photo's brightness scaled by a gain in [1 - exposure_spread, 1 + exposure_spread] that
+  // differs from photo to photo (an automatic exposure); the points' colours stay the surfaces'.
+  double exposure_spread = 0.0;
 
   bool IsValid(std::string* reason) const;
 };

@@ -1,5 +1,8 @@
 #include "calib/colour_calibration.h"
 
+#include <algorithm>
+#include <cstdio>
+
 #include <gtest/gtest.h>
 
 #include "samples/synthetic_scene.h"
@@ -71,6 +74,42 @@ TEST(ColourCalibration, UndoesKnownExposureAndWhiteBalanceChangesOfSomePhotos) {
   EXPECT_LT(after, 0.4 * before);
   // Photos that were not changed stay nearly as they were.
   EXPECT_LT(MeanDifference(changed[0], original[0]), 3.0);
+}
+
+TEST(ColourCalibration, PaysWhereExposuresDifferNotWherePhotosAgree) {
+  // The generated scene as an automatic exposure would take it (every photo's gain 1 +- 0.3),
+  // and as it is: the correction must halve the spread in the first, and does not in the second
+  // (the points' remaining disagreement is texture edges and sampling, no exposure).
+  SyntheticSceneOptions options;
+  options.num_views = 8;
+  options.width = 200;
+  options.height = 150;
+  options.num_surface_samples = 3000;
+  const SyntheticScene alike = GenerateSyntheticScene(options);
+  options.exposure_spread = 0.3;
+  const SyntheticScene exposed = GenerateSyntheticScene(options);
+  const ColourCalibration varying = EstimateColourCalibration(exposed.reconstruction, Views(exposed));
+  const ColourCalibration same = EstimateColourCalibration(alike.reconstruction, Views(alike));
+  std::printf("exposures varying: %s\nalike: %s\n", varying.Summary().c_str(),
+              same.Summary().c_str());
+  EXPECT_TRUE(ColourCalibrationPays(varying));
+  EXPECT_FALSE(ColourCalibrationPays(same));
+  // The gains found follow the photos' exposures (up to the common scale).
+  double most = 0.0, least = 1e9;
+  for (const ColourCorrection& correction : varying.corrections) {
+    most = std::max(most, correction.gain.mean());
+    least = std::min(least, correction.gain.mean());
+  }
+  EXPECT_GT(most / least, 1.5);  // the exposures span 0.7-1.3, up to the clipping of bright pixels
+
+  ColourCalibrationMode mode = ColourCalibrationMode::kOff;
+  EXPECT_TRUE(ColourCalibrationModeFromString("auto", &mode));
+  EXPECT_EQ(mode, ColourCalibrationMode::kAuto);
+  EXPECT_TRUE(ColourCalibrationModeFromString("1", &mode));
+  EXPECT_EQ(mode, ColourCalibrationMode::kOn);
+  EXPECT_TRUE(ColourCalibrationModeFromString("false", &mode));
+  EXPECT_EQ(mode, ColourCalibrationMode::kOff);
+  EXPECT_FALSE(ColourCalibrationModeFromString("yes", &mode));
 }
 
 TEST(ColourCalibration, WithoutSharedPointsNothingChanges) {

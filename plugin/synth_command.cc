@@ -55,6 +55,9 @@ int RunSynth(int argc, char** argv) {
   parser.AddDefault("exposure_spread", &options.exposure_spread,
                     "each photo brighter or darker by a gain within 1 +- this, differing from "
                     "photo to photo, as an automatic exposure makes them (0: all alike)");
+  parser.AddDefault("specular", &options.specular,
+                    "a white highlight of this strength (0-1) where the light mirrors into the "
+                    "camera: colours that change with the view, as on a glazed surface (0: none)");
   std::vector<std::string> models;
   for (CameraModelId model : SupportedCameraModels()) models.push_back(CameraModelName(model));
   parser.AddDefault("camera_model", &camera_model,

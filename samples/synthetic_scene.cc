@@ -283,8 +283,10 @@ cv::Mat Render(const SceneGeometry& geometry,
                int supersampling,
                Backdrop backdrop,
                bool detail,
+               double specular,
                cv::Mat* mask) {
   const Rigid3d world_from_cam = cam_from_world.Inverse();
+  const Eigen::Vector3d light = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
   cv::Mat photo(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC3);
   mask->create(photo.size(), CV_8UC1);
   for (int row = 0; row < photo.rows; ++row) {
@@ -301,9 +303,20 @@ cv::Mat Render(const SceneGeometry& geometry,
               (world_from_cam.rotation * normalized.homogeneous()).normalized();
           const Hit hit = Trace(geometry, world_from_cam.translation, direction);
           hits += hit.surface != Surface::kNone;
-          sum += hit.surface != Surface::kNone
-                     ? SurfaceColour(hit, detail)
-                     : BackdropColour(backdrop, world_from_cam.translation, direction);
+          if (hit.surface == Surface::kNone) {
+            sum += BackdropColour(backdrop, world_from_cam.translation, direction);
+            continue;
+          }
+          Eigen::Vector3d colour = SurfaceColour(hit, detail);
+          if (specular > 0.0) {
+            // A white highlight where the light's mirror direction meets the camera (Phong,
+            // exponent 30): it moves over the surface from view to view.
+            const Eigen::Vector3d mirror = 2.0 * hit.normal.dot(light) * hit.normal - light;
+            const double facing = std::max(0.0, mirror.dot(-direction));
+            colour = (colour + Eigen::Vector3d::Constant(specular * 255.0 * std::pow(facing, 30.0)))
+                         .cwiseMin(255.0);
+          }
+          sum += colour;
         }
       }
       const Eigen::Vector3d rgb = sum / (supersampling * supersampling);
@@ -457,6 +470,10 @@ bool SyntheticSceneOptions::IsValid(std::string* reason) const {
   }
   if (teapot_tessellation < 1 || teapot_tessellation > 64) {
     *reason = "teapot_tessellation must be in [1, 64]";
+    return false;
+  }
+  if (!(specular >= 0.0 && specular <= 1.0)) {
+    *reason = "specular must be in [0, 1]";
     return false;
   }
   if (!(exposure_spread >= 0.0 && exposure_spread < 1.0)) {
@@ -676,7 +693,7 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
     image.cam_from_world = LookAt(centre, kCameraTarget);
     cv::Mat mask;
     cv::Mat photo = Render(geometry, camera, image.cam_from_world, options.supersampling,
-                           options.backdrop, options.detail_texture, &mask);
+                           options.backdrop, options.detail_texture, options.specular, &mask);
     if (options.exposure_spread > 0.0) {
       // An automatic exposure: the whole photo brighter or darker, by a gain that varies from
       // photo to photo over [1 - spread, 1 + spread].

@@ -85,6 +85,10 @@ struct SyntheticSceneOptions {
   // Each photo's brightness scaled by a gain in [1 - exposure_spread, 1 + exposure_spread] that
   // differs from photo to photo (an automatic exposure); the points' colours stay the surfaces'.
   double exposure_spread = 0.0;
+  // A white highlight of this strength (0-1 of full white) where the light mirrors into the
+  // camera, so that the surfaces' colours change with the view, as glazed or varnished ones do;
+  // the points' colours stay the surfaces' own. 0: every surface looks the same from everywhere.
+  double specular = 0.0;
 
   bool IsValid(std::string* reason) const;
 };

@@ -227,6 +227,52 @@ TEST(SyntheticScene, OptionsAreChecked) {
   options.camera_params = {1, 2, 3};
   EXPECT_FALSE(options.IsValid(&reason));
   EXPECT_NE(reason.find("OPENCV"), std::string::npos);
+  options = SyntheticSceneOptions();
+  options.exposure_spread = 1.0;
+  EXPECT_FALSE(options.IsValid(&reason));
+  EXPECT_NE(reason.find("exposure_spread"), std::string::npos);
+  options = SyntheticSceneOptions();
+  options.specular = -0.1;
+  EXPECT_FALSE(options.IsValid(&reason));
+  EXPECT_NE(reason.find("specular"), std::string::npos);
+}
+
+TEST(SyntheticScene, ExposureAndHighlightsChangeThePhotosNotTheScene) {
+  SyntheticSceneOptions options = Small();
+  const SyntheticScene plain = GenerateSyntheticScene(options);
+  options.exposure_spread = 0.3;
+  const SyntheticScene exposed = GenerateSyntheticScene(options);
+  options.exposure_spread = 0.0;
+  options.specular = 1.0;
+  const SyntheticScene glossy = GenerateSyntheticScene(options);
+  testing::ExpectSameReconstruction(plain.reconstruction, exposed.reconstruction);
+  testing::ExpectSameReconstruction(plain.reconstruction, glossy.reconstruction);
+  std::vector<double> gains;
+  for (const auto& [id, photo] : plain.photos) {
+    EXPECT_EQ(cv::countNonZero(plain.masks.at(id) != exposed.masks.at(id)), 0);
+    EXPECT_EQ(cv::countNonZero(plain.masks.at(id) != glossy.masks.at(id)), 0);
+    // Exposure: the whole photo by one gain (the mean brightness's ratio, clipping aside).
+    gains.push_back(cv::mean(exposed.photos.at(id))[0] / cv::mean(photo)[0]);
+    // Highlights only brighten, and only some pixels.
+    cv::Mat darker, changed;
+    cv::compare(glossy.photos.at(id), photo, darker, cv::CMP_LT);
+    cv::compare(glossy.photos.at(id), photo, changed, cv::CMP_NE);
+    EXPECT_EQ(cv::countNonZero(darker.reshape(1)), 0);
+    EXPECT_LT(cv::countNonZero(changed.reshape(1)), static_cast<int>(photo.total()));
+  }
+  const auto [low, high] = std::minmax_element(gains.begin(), gains.end());
+  EXPECT_LT(*low, 0.85);
+  EXPECT_GT(*high, 1.15);
+  EXPECT_GT(*low, 0.69);
+  EXPECT_LT(*high, 1.31);
+  // Some photo shows a highlight.
+  bool highlight = false;
+  for (const auto& [id, photo] : plain.photos) {
+    cv::Mat changed;
+    cv::compare(glossy.photos.at(id), photo, changed, cv::CMP_NE);
+    highlight = highlight || cv::countNonZero(changed.reshape(1)) > 20;
+  }
+  EXPECT_TRUE(highlight);
 }
 
 }  // namespace

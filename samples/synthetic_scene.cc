@@ -533,6 +533,19 @@ bool SceneKindFromString(const std::string& text, SceneKind* kind) {
   return false;
 }
 
+namespace {
+
+// The enumerator whose position in `names` is that of `text`; false when it is none of them.
+template <typename Enum>
+bool EnumFromName(const std::vector<std::string>& names, const std::string& text, Enum* value) {
+  const auto found = std::find(names.begin(), names.end(), text);
+  if (found == names.end()) return false;
+  *value = static_cast<Enum>(found - names.begin());
+  return true;
+}
+
+}  // namespace
+
 std::vector<std::string> CameraLayoutNames() { return {"ring", "hemisphere", "arc", "close"}; }
 
 std::string CameraLayoutToString(CameraLayout layout) {
@@ -540,14 +553,7 @@ std::string CameraLayoutToString(CameraLayout layout) {
 }
 
 bool CameraLayoutFromString(const std::string& text, CameraLayout* layout) {
-  const std::vector<std::string> names = CameraLayoutNames();
-  for (size_t i = 0; i < names.size(); ++i) {
-    if (text == names[i]) {
-      *layout = static_cast<CameraLayout>(i);
-      return true;
-    }
-  }
-  return false;
+  return EnumFromName(CameraLayoutNames(), text, layout);
 }
 
 std::vector<Eigen::Vector3d> CameraCentres(CameraLayout layout, int num_views) {
@@ -599,14 +605,7 @@ std::string BackdropToString(Backdrop backdrop) {
 }
 
 bool BackdropFromString(const std::string& text, Backdrop* backdrop) {
-  const std::vector<std::string> names = BackdropNames();
-  for (size_t i = 0; i < names.size(); ++i) {
-    if (text == names[i]) {
-      *backdrop = static_cast<Backdrop>(i);
-      return true;
-    }
-  }
-  return false;
+  return EnumFromName(BackdropNames(), text, backdrop);
 }
 
 std::string DefaultTeapotPath() {

@@ -27,13 +27,18 @@ double MeanDifference(const CalibratedView& a, const CalibratedView& b) {
   return (mean[0] + mean[1] + mean[2]) / 3.0;
 }
 
-TEST(ColourCalibration, UndoesKnownExposureAndWhiteBalanceChangesOfSomePhotos) {
+// Eight photos of 200x150 with 3000 candidate sparse points.
+SyntheticSceneOptions EightPhotos() {
   SyntheticSceneOptions options;
   options.num_views = 8;
   options.width = 200;
   options.height = 150;
   options.num_surface_samples = 3000;
-  const SyntheticScene scene = GenerateSyntheticScene(options);
+  return options;
+}
+
+TEST(ColourCalibration, UndoesKnownExposureAndWhiteBalanceChangesOfSomePhotos) {
+  const SyntheticScene scene = GenerateSyntheticScene(EightPhotos());
   const std::vector<CalibratedView> original = Views(scene);
   std::vector<CalibratedView> changed = Views(scene);
   // Photo 2 darker and bluish, photo 5 brighter with a red cast (kept inside 0-255 mostly).
@@ -80,11 +85,7 @@ TEST(ColourCalibration, PaysWhereExposuresDifferNotWherePhotosAgree) {
   // The generated scene as an automatic exposure would take it (every photo's gain 1 +- 0.3),
   // and as it is: the correction must halve the spread in the first, and does not in the second
   // (the points' remaining disagreement is texture edges and sampling, no exposure).
-  SyntheticSceneOptions options;
-  options.num_views = 8;
-  options.width = 200;
-  options.height = 150;
-  options.num_surface_samples = 3000;
+  SyntheticSceneOptions options = EightPhotos();
   const SyntheticScene alike = GenerateSyntheticScene(options);
   options.exposure_spread = 0.3;
   const SyntheticScene exposed = GenerateSyntheticScene(options);

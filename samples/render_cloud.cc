@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
     const auto image = model.images.find(static_cast<raycarve::image_t>(std::stoul(argv[4])));
     if (image == model.images.end()) throw raycarve::InputError(std::string("no image ") + argv[4]);
     const std::string photo_path = std::string(argv[2]) + "/" + image->second.name;
-    cv::Mat bgr = cv::imread(photo_path, cv::IMREAD_COLOR);
+    cv::Mat bgr = cv::imread(photo_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
     if (bgr.empty()) throw raycarve::InputError(photo_path + ": cannot read the photo");
     cv::Mat rgb;
     cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);

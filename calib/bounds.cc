@@ -20,11 +20,58 @@ double Quantile(std::vector<double>* values, double q) {
   return (*values)[index];
 }
 
+// How many of the model's images show `point` inside their frame (in front of the camera).
+int FramedBy(const Reconstruction& reconstruction, const Eigen::Vector3d& point) {
+  int count = 0;
+  for (const auto& [image_id, image] : reconstruction.images) {
+    const auto camera = reconstruction.cameras.find(image.camera_id);
+    if (camera == reconstruction.cameras.end()) continue;
+    const Eigen::Vector3d local = image.cam_from_world * point;
+    if (!(local.z() > 0.0)) continue;
+    const Eigen::Vector2d pixel = camera->second.ImgFromCam(local.head<2>() / local.z());
+    count += pixel.allFinite() && pixel.x() >= 0.0 && pixel.y() >= 0.0 &&
+             pixel.x() < static_cast<double>(camera->second.width) &&
+             pixel.y() < static_cast<double>(camera->second.height);
+  }
+  return count;
+}
+
+// Photos of an object are taken around it and aimed at it: every photo frames the object, while
+// the room behind it (walls, furniture, a floor running on) is framed only by the photos that
+// face that way. Points framed by fewer photos than min_framed_share of the best framed ones
+// (the 90th percentile of the counts) are the room; they leave `points` when they are more than
+// twice trim_fraction of them (a few stray ones are the trim's) and enough points stay. Where
+// every photo frames everything (a forward-facing capture, a wall seen from in front) nothing
+// is dropped: the photos do not tell an object from its background there.
+void DropTheRoom(const Reconstruction& reconstruction, const BoundsOptions& options,
+                 std::vector<Eigen::Vector3d>* points, Bounds* bounds) {
+  if (options.min_framed_share <= 0.0 || points->empty() || reconstruction.images.empty()) return;
+  std::vector<double> counts(points->size());
+  for (size_t i = 0; i < points->size(); ++i) counts[i] = FramedBy(reconstruction, (*points)[i]);
+  std::vector<double> sorted = counts;
+  const double best = Quantile(&sorted, 0.9);
+  std::vector<Eigen::Vector3d> framed;
+  for (size_t i = 0; i < points->size(); ++i) {
+    if (counts[i] >= options.min_framed_share * best) framed.push_back((*points)[i]);
+  }
+  const size_t room = points->size() - framed.size();
+  if (room <= 2.0 * options.trim_fraction * points->size() ||
+      static_cast<int>(framed.size()) < options.min_points) {
+    return;
+  }
+  bounds->num_unframed = static_cast<int>(room);
+  points->swap(framed);
+}
+
 }  // namespace
 
 bool BoundsOptions::IsValid(std::string* reason) const {
   if (min_track_length < 0) {
     *reason = "min_track_length must be >= 0";
+    return false;
+  }
+  if (!(min_framed_share >= 0.0 && min_framed_share <= 1.0)) {
+    *reason = "min_framed_share must be in [0, 1]";
     return false;
   }
   if (min_points < 1) {
@@ -55,8 +102,9 @@ std::string Bounds::Summary() const {
     text << ", given explicitly";
   } else {
     text << ", from " << num_used << " of " << num_points << " sparse points (" << num_short_track
-         << " short tracks, " << num_high_error << " high error dropped; " << num_trimmed_outside
-         << " trimmed as outliers)";
+         << " short tracks, " << num_high_error << " high error";
+    if (num_unframed > 0) text << ", " << num_unframed << " of the room around (framed by few photos)";
+    text << " dropped; " << num_trimmed_outside << " trimmed as outliers)";
   }
   return text.str();
 }
@@ -84,6 +132,7 @@ Bounds ComputeBounds(const Reconstruction& reconstruction,
       used.push_back(point3D.xyz);
     }
   }
+  DropTheRoom(reconstruction, options, &used, &bounds);
   bounds.num_used = static_cast<int>(used.size());
   if (used.empty()) {
     std::ostringstream message;

@@ -17,6 +17,11 @@ struct BoundsOptions {
   int min_track_length = 2;
   // Points whose mean reprojection error (pixels) exceeds this are ignored; <= 0 disables.
   double max_reprojection_error = 2.0;
+  // The object is what the photos frame. A point framed by fewer photos than this share of the
+  // best framed points' count (their 90th percentile) is the room around the object; such points
+  // are dropped when they are more than twice trim_fraction of the points (a room, not a few
+  // stray points, which the trim takes). 0 keeps every point. See ComputeBounds.
+  double min_framed_share = 0.5;
   // Fraction of the remaining points dropped at each end of each axis (0 keeps the extremes).
   double trim_fraction = 0.01;
   // Added on every side, as a fraction of the trimmed box's largest extent.
@@ -36,6 +41,7 @@ struct Bounds {
   int num_used = 0;             // points that passed the filters
   int num_short_track = 0;      // dropped for track length
   int num_high_error = 0;       // dropped for reprojection error
+  int num_unframed = 0;         // dropped as the room around the object (min_framed_share)
   int num_trimmed_outside = 0;  // used points outside the trimmed box (before the margin)
 
   std::string Summary() const;

@@ -47,6 +47,10 @@ void AddBoundsFlags(OptionParser* parser, BoundsFlags* flags) {
   parser->AddDefault("max_reprojection_error", &flags->options.max_reprojection_error,
                      "sparse points with a larger mean reprojection error (px) are ignored; "
                      "<= 0 keeps all");
+  parser->AddDefault("min_framed_share", &flags->options.min_framed_share,
+                     "sparse points framed by fewer photos than this share of the best framed "
+                     "points' count are the room around the object, left out when they are more "
+                     "than twice --trim_fraction of the points (0 keeps all)");
   parser->AddDefault("trim_fraction", &flags->options.trim_fraction,
                      "fraction of points dropped at each end of each axis (outliers)");
   parser->AddDefault("min_points", &flags->options.min_points,

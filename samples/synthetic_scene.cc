@@ -145,6 +145,14 @@ Eigen::Vector3d SkyColour(const Eigen::Vector3d& direction) {
   return Eigen::Vector3d(40 + (hash & 0x7f), 40 + ((hash >> 8) & 0x7f), 60 + ((hash >> 16) & 0x7f));
 }
 
+// Where a ray from inside the room meets its floor (z = 0, inside the wall) or its wall (the
+// cylinder of kRoomRadius, up to kRoomHeight); false when it leaves through the open top.
+bool RoomHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+             Eigen::Vector3d* point);
+// The room's texture at a point of its floor or wall: boards on the floor, patches on the wall,
+// with value noise over both so that every place looks different.
+Eigen::Vector3d RoomColour(const Eigen::Vector3d& point);
+
 // What a ray that meets no part of the scene shows, for each backdrop. The table is the plane
 // z = 0 around the ground square (out to a radius of 14), the wall everything beyond it.
 Eigen::Vector3d BackdropColour(Backdrop backdrop, const Eigen::Vector3d& origin,
@@ -170,6 +178,10 @@ Eigen::Vector3d BackdropColour(Backdrop backdrop, const Eigen::Vector3d& origin,
     }
     case Backdrop::kVignetted:
       return Eigen::Vector3d(140, 90, 150);
+    case Backdrop::kRoom: {
+      Eigen::Vector3d point;
+      return RoomHit(origin, direction, &point) ? RoomColour(point) : SkyColour(direction);
+    }
     case Backdrop::kShadowedTable: {
       if (!table) return Eigen::Vector3d(225, 225, 230);
       // A soft shadow cast away from the light (see SurfaceColour), darkest near the objects.
@@ -204,6 +216,39 @@ double ValueNoise(const Eigen::Vector3d& point, double scale, uint32_t channel) 
              (dz ? w.z() : 1.0 - w.z());
   }
   return value;
+}
+
+bool RoomHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+             Eigen::Vector3d* point) {
+  if (direction.z() < 0.0) {
+    const Eigen::Vector3d floor = origin - direction * (origin.z() / direction.z());
+    if (floor.head<2>().norm() < kRoomRadius) {
+      *point = floor;
+      return true;
+    }
+  }
+  // |origin.xy + t direction.xy| = kRoomRadius, the root ahead (the origin is inside).
+  const Eigen::Vector2d o = origin.head<2>(), d = direction.head<2>();
+  const double a = d.squaredNorm(), b = o.dot(d), c = o.squaredNorm() - kRoomRadius * kRoomRadius;
+  if (a <= 0.0 || c >= 0.0) return false;
+  const double t = (-b + std::sqrt(b * b - a * c)) / a;
+  *point = origin + t * direction;
+  return point->z() >= 0.0 && point->z() <= kRoomHeight;
+}
+
+Eigen::Vector3d RoomColour(const Eigen::Vector3d& point) {
+  const Eigen::Vector3d noise(ValueNoise(point, 0.15, 11), ValueNoise(point, 0.15, 12),
+                              ValueNoise(point, 0.15, 13));
+  if (point.z() < 1e-9) {
+    // Floor boards 0.4 wide along x, each its own shade of wood.
+    const double board = ValueNoise(Eigen::Vector3d(std::floor(point.x() / 0.4), 0.0, 0.0), 1.0, 14);
+    return Eigen::Vector3d(120, 85, 55) * (0.7 + 0.5 * board) + 50.0 * (noise - Eigen::Vector3d::Constant(0.5));
+  }
+  const double angle = std::atan2(point.y(), point.x());
+  const Eigen::Vector3d patch(ValueNoise(Eigen::Vector3d(angle * 3.0, point.z(), 0.0), 0.5, 15),
+                              ValueNoise(Eigen::Vector3d(angle * 3.0, point.z(), 0.0), 0.5, 16),
+                              ValueNoise(Eigen::Vector3d(angle * 3.0, point.z(), 0.0), 0.5, 17));
+  return (Eigen::Vector3d::Constant(40.0) + 170.0 * patch + 40.0 * noise).cwiseMin(255.0);
 }
 
 // Texture colour (RGB, 0-255) of a surface point, with a fixed directional shading. With
@@ -597,7 +642,7 @@ std::vector<Eigen::Vector3d> CameraCentres(CameraLayout layout, int num_views) {
 }
 
 std::vector<std::string> BackdropNames() {
-  return {"patchwork", "uniform", "two_tone", "gradient", "vignetted", "shadowed_table"};
+  return {"patchwork", "uniform", "two_tone", "gradient", "vignetted", "shadowed_table", "room"};
 }
 
 std::string BackdropToString(Backdrop backdrop) {
@@ -655,6 +700,69 @@ std::shared_ptr<const SceneGeometry> MakeSceneGeometry(const SyntheticSceneOptio
                             geometry->box_max.z(), geometry->teapot->BoxMax().z()});
   return geometry;
 }
+
+namespace {
+
+// The room's sparse points (Backdrop::kRoom): as many tried as the scene's, uniform by area over
+// the floor outside the ground square and the wall, kept where two or more views see them
+// (inside the frame, nothing of the scene in front).
+void AddRoomPoints(const SyntheticSceneOptions& options, const SceneGeometry& geometry,
+                   std::mt19937_64* random, std::normal_distribution<double>* noise,
+                   SyntheticScene* scene) {
+  Reconstruction& reconstruction = scene->reconstruction;
+  const Camera& camera = reconstruction.cameras.begin()->second;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double floor_area = M_PI * kRoomRadius * kRoomRadius;
+  const double wall_area = 2.0 * M_PI * kRoomRadius * kRoomHeight;
+  const int tries = static_cast<int>(std::lround(options.num_surface_samples * kRoomPointShare /
+                                                 (1.0 - kRoomPointShare)));
+  point3D_t next_id = reconstruction.points3D.empty() ? 1 : reconstruction.points3D.rbegin()->first + 1;
+  for (int sample = 0; sample < tries; ++sample) {
+    Eigen::Vector3d point;
+    const double angle = 2.0 * M_PI * unit(*random);
+    if (unit(*random) * (floor_area + wall_area) < floor_area) {
+      const double radius = kRoomRadius * std::sqrt(unit(*random));
+      point = Eigen::Vector3d(radius * std::cos(angle), radius * std::sin(angle), 0.0);
+      if (std::abs(point.x()) < kGroundHalfSize && std::abs(point.y()) < kGroundHalfSize) continue;
+    } else {
+      point = Eigen::Vector3d(kRoomRadius * std::cos(angle), kRoomRadius * std::sin(angle),
+                              kRoomHeight * unit(*random));
+    }
+    std::vector<std::pair<image_t, Eigen::Vector2d>> observations;
+    for (const auto& [image_id, image] : reconstruction.images) {
+      const Eigen::Vector3d local = image.cam_from_world * point;
+      if (local.z() <= 0.0) continue;
+      const Eigen::Vector2d pixel = camera.ImgFromCam(local.hnormalized());
+      if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < camera.width &&
+            pixel.y() < camera.height)) {
+        continue;
+      }
+      const Eigen::Vector3d centre = image.ProjectionCenter();
+      const Eigen::Vector3d offset = point - centre;
+      if (Trace(geometry, centre, offset.normalized()).t < offset.norm()) continue;  // hidden
+      observations.emplace_back(image_id, pixel);
+    }
+    if (observations.size() < 2) continue;
+    Point3D point3D;
+    point3D.xyz = point;
+    const Eigen::Vector3d colour = RoomColour(point).cwiseMax(0.0).cwiseMin(255.0);
+    for (int k = 0; k < 3; ++k) point3D.color[k] = static_cast<uint8_t>(std::lround(colour[k]));
+    point3D.error = options.pixel_noise;
+    const point3D_t id = next_id++;
+    for (const auto& [image_id, pixel] : observations) {
+      Image& image = reconstruction.images.at(image_id);
+      Point2D point2D;
+      point2D.xy = pixel;
+      if (options.pixel_noise > 0.0) point2D.xy += Eigen::Vector2d((*noise)(*random), (*noise)(*random));
+      point2D.point3D_id = id;
+      point3D.track.push_back({image_id, static_cast<point2D_t>(image.points2D.size())});
+      image.points2D.push_back(point2D);
+    }
+    reconstruction.points3D.emplace(id, std::move(point3D));
+  }
+}
+
+}  // namespace
 
 SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
   std::string reason;
@@ -734,6 +842,7 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
     }
     reconstruction.points3D.emplace(point3D_id, std::move(point3D));
   }
+  if (options.backdrop == Backdrop::kRoom) AddRoomPoints(options, geometry, &random, &noise, &scene);
   return scene;
 }
 

@@ -36,7 +36,14 @@ enum class Backdrop {
   kGradient,   // a studio sweep: the colour goes from dark slate below to pale grey above
   kVignetted,  // a uniform grey backdrop, the whole photo darkened towards its corners
   kShadowedTable,  // a pale table plane with a soft shadow of the objects on it, a pale wall
+  kRoom,           // a room: a textured floor (z = 0) and a textured round wall (radius kRoomRadius,
+                   // up to kRoomHeight) with sky above; it holds sparse points of its own, as a
+                   // room behind an object does in a real capture (kRoomPointShare of them)
 };
+constexpr double kRoomRadius = 9.0;
+constexpr double kRoomHeight = 5.0;
+// The room's share of the sparse points tried (its floor and wall, uniform by area).
+constexpr double kRoomPointShare = 0.5;
 std::string BackdropToString(Backdrop backdrop);
 bool BackdropFromString(const std::string& text, Backdrop* backdrop);
 std::vector<std::string> BackdropNames();

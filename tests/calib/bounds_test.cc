@@ -7,6 +7,7 @@
 
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
+#include "samples/synthetic_scene.h"
 #include "tests/test_support.h"
 
 namespace raycarve {
@@ -69,6 +70,39 @@ TEST(Bounds, WithoutTrimmingOutliersStretchTheBox) {
   EXPECT_GT(ComputeBounds(model, options, "test").box.max().x(), 50.0);
 }
 
+TEST(Bounds, TheRoomAroundTheObjectIsLeftOut) {
+  // The generated scene in a textured room whose floor and wall hold as many sparse points as the
+  // scene: the room is framed by the few photos facing it, the scene by all of them.
+  SyntheticSceneOptions options;
+  options.num_views = 12;
+  options.width = 160;
+  options.height = 120;
+  options.num_surface_samples = 1500;
+  options.backdrop = Backdrop::kRoom;
+  const SyntheticScene room = GenerateSyntheticScene(options);
+  BoundsOptions keep_all;
+  keep_all.min_framed_share = 0.0;
+  const Bounds blind = ComputeBounds(room.reconstruction, keep_all, "room");
+  const Bounds bounds = ComputeBounds(room.reconstruction, BoundsOptions(), "room");
+  // Without the rule the box reaches the wall (radius 9) on every side.
+  EXPECT_GT(blind.box.sizes().head<2>().minCoeff(), 15.0) << blind.Summary();
+  EXPECT_EQ(blind.num_unframed, 0);
+  // With it the box holds the scene (the ground square is 3 wide) and a little of the floor.
+  EXPECT_GT(bounds.num_unframed, bounds.num_points / 4) << bounds.Summary();
+  EXPECT_TRUE(bounds.box.contains(room.object_box.min()) && bounds.box.contains(room.object_box.max()))
+      << bounds.Summary();
+  EXPECT_LT(bounds.box.sizes().head<2>().maxCoeff(), 6.0) << bounds.Summary();
+  EXPECT_NE(bounds.Summary().find("room around"), std::string::npos) << bounds.Summary();
+
+  // The same scene under the patchwork sky has no room: nothing is dropped, the box is the same
+  // as without the rule.
+  options.backdrop = Backdrop::kPatchwork;
+  const SyntheticScene open = GenerateSyntheticScene(options);
+  const Bounds open_bounds = ComputeBounds(open.reconstruction, BoundsOptions(), "open");
+  EXPECT_EQ(open_bounds.num_unframed, 0) << open_bounds.Summary();
+  EXPECT_TRUE(open_bounds.box.isApprox(ComputeBounds(open.reconstruction, keep_all, "open").box));
+}
+
 TEST(Bounds, ErrorsNameTheSourceAndSayWhatDroppedThePoints) {
   Reconstruction empty;
   try {
@@ -112,6 +146,10 @@ TEST(Bounds, ExplicitBoxIsCheckedAndOptionsValidated) {
   options = BoundsOptions();
   options.margin = -1;
   EXPECT_FALSE(options.IsValid(&reason));
+  options = BoundsOptions();
+  options.min_framed_share = 1.5;
+  EXPECT_FALSE(options.IsValid(&reason));
+  EXPECT_NE(reason.find("min_framed_share"), std::string::npos);
 }
 
 // The real sets: bounds from COLMAP models made by the real program contain the object's tight

@@ -44,7 +44,8 @@ int RunSynth(int argc, char** argv) {
   parser.AddDefault("backdrop", &backdrop,
                     "behind the scene: a patchwork sky (a natural scene), or a studio backdrop "
                     "that needs masks: uniform (dark), two_tone (wall and table, with a dark "
-                    "frame), gradient, vignetted, shadowed_table",
+                    "frame), gradient, vignetted, shadowed_table; or a textured room (floor and "
+                    "wall) holding sparse points of its own",
                     BackdropNames());
   std::string texture = "plain";
   parser.AddDefault("texture", &texture,

@@ -703,6 +703,32 @@ std::shared_ptr<const SceneGeometry> MakeSceneGeometry(const SyntheticSceneOptio
 
 namespace {
 
+// Adds a sparse point at `xyz` of `colour` seen at `observations` (image, exact pixel), each
+// pixel moved by Gaussian noise of `pixel_noise` (when > 0); its id follows the largest so far.
+void AddObservedPoint(const Eigen::Vector3d& xyz, const Eigen::Vector3d& colour,
+                      const std::vector<std::pair<image_t, Eigen::Vector2d>>& observations,
+                      double pixel_noise, std::mt19937_64* random,
+                      std::normal_distribution<double>* noise, Reconstruction* reconstruction) {
+  Point3D point3D;
+  point3D.xyz = xyz;
+  for (int k = 0; k < 3; ++k) {
+    point3D.color[k] = static_cast<uint8_t>(std::lround(std::clamp(colour[k], 0.0, 255.0)));
+  }
+  point3D.error = pixel_noise;
+  const point3D_t id =
+      reconstruction->points3D.empty() ? 1 : reconstruction->points3D.rbegin()->first + 1;
+  for (const auto& [image_id, pixel] : observations) {
+    Image& image = reconstruction->images.at(image_id);
+    Point2D point2D;
+    point2D.xy = pixel;
+    if (pixel_noise > 0.0) point2D.xy += Eigen::Vector2d((*noise)(*random), (*noise)(*random));
+    point2D.point3D_id = id;
+    point3D.track.push_back({image_id, static_cast<point2D_t>(image.points2D.size())});
+    image.points2D.push_back(point2D);
+  }
+  reconstruction->points3D.emplace(id, std::move(point3D));
+}
+
 // The room's sparse points (Backdrop::kRoom): as many tried as the scene's, uniform by area over
 // the floor outside the ground square and the wall, kept where two or more views see them
 // (inside the frame, nothing of the scene in front).
@@ -716,7 +742,6 @@ void AddRoomPoints(const SyntheticSceneOptions& options, const SceneGeometry& ge
   const double wall_area = 2.0 * M_PI * kRoomRadius * kRoomHeight;
   const int tries = static_cast<int>(std::lround(options.num_surface_samples * kRoomPointShare /
                                                  (1.0 - kRoomPointShare)));
-  point3D_t next_id = reconstruction.points3D.empty() ? 1 : reconstruction.points3D.rbegin()->first + 1;
   for (int sample = 0; sample < tries; ++sample) {
     Eigen::Vector3d point;
     const double angle = 2.0 * M_PI * unit(*random);
@@ -743,22 +768,8 @@ void AddRoomPoints(const SyntheticSceneOptions& options, const SceneGeometry& ge
       observations.emplace_back(image_id, pixel);
     }
     if (observations.size() < 2) continue;
-    Point3D point3D;
-    point3D.xyz = point;
-    const Eigen::Vector3d colour = RoomColour(point).cwiseMax(0.0).cwiseMin(255.0);
-    for (int k = 0; k < 3; ++k) point3D.color[k] = static_cast<uint8_t>(std::lround(colour[k]));
-    point3D.error = options.pixel_noise;
-    const point3D_t id = next_id++;
-    for (const auto& [image_id, pixel] : observations) {
-      Image& image = reconstruction.images.at(image_id);
-      Point2D point2D;
-      point2D.xy = pixel;
-      if (options.pixel_noise > 0.0) point2D.xy += Eigen::Vector2d((*noise)(*random), (*noise)(*random));
-      point2D.point3D_id = id;
-      point3D.track.push_back({image_id, static_cast<point2D_t>(image.points2D.size())});
-      image.points2D.push_back(point2D);
-    }
-    reconstruction.points3D.emplace(id, std::move(point3D));
+    AddObservedPoint(point, RoomColour(point), observations, options.pixel_noise, random, noise,
+                     &reconstruction);
   }
 }
 
@@ -814,11 +825,8 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
 
   std::mt19937_64 random(options.seed);
   std::normal_distribution<double> noise(0.0, options.pixel_noise);
-  point3D_t next_point3D_id = 1;
   for (int sample = 0; sample < options.num_surface_samples; ++sample) {
     const Hit surface = SampleSurface(geometry, &random);
-    Point3D point3D;
-    point3D.xyz = surface.point;
     std::vector<std::pair<image_t, Eigen::Vector2d>> observations;
     for (const auto& [image_id, image] : reconstruction.images) {
       Eigen::Vector2d pixel;
@@ -827,20 +835,8 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
       }
     }
     if (observations.size() < 2) continue;
-    const Eigen::Vector3d colour = SurfaceColour(surface, options.detail_texture);
-    for (int k = 0; k < 3; ++k) point3D.color[k] = static_cast<uint8_t>(std::lround(colour[k]));
-    point3D.error = options.pixel_noise;
-    const point3D_t point3D_id = next_point3D_id++;
-    for (const auto& [image_id, pixel] : observations) {
-      Image& image = reconstruction.images.at(image_id);
-      Point2D point2D;
-      point2D.xy = pixel;
-      if (options.pixel_noise > 0.0) point2D.xy += Eigen::Vector2d(noise(random), noise(random));
-      point2D.point3D_id = point3D_id;
-      point3D.track.push_back({image_id, static_cast<point2D_t>(image.points2D.size())});
-      image.points2D.push_back(point2D);
-    }
-    reconstruction.points3D.emplace(point3D_id, std::move(point3D));
+    AddObservedPoint(surface.point, SurfaceColour(surface, options.detail_texture), observations,
+                     options.pixel_noise, &random, &noise, &reconstruction);
   }
   if (options.backdrop == Backdrop::kRoom) AddRoomPoints(options, geometry, &random, &noise, &scene);
   return scene;

@@ -283,10 +283,6 @@ void SetAsideObjectColours(const cv::Mat& rgb, double tolerance,
   border->swap(kept);
 }
 
-}  // namespace
-
-namespace {
-
 // Describes `border` by the fewest colours (1 to kMaxBackdropColours) that bring 80% of it within
 // `tolerance`: sets `model`'s found, colours, shares and explained.
 void DescribeBorder(const std::vector<cv::Vec3b>& border, double tolerance, BackdropModel* model) {

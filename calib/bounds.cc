@@ -20,22 +20,6 @@ double Quantile(std::vector<double>* values, double q) {
   return (*values)[index];
 }
 
-// How many of the model's images show `point` inside their frame (in front of the camera).
-int FramedBy(const Reconstruction& reconstruction, const Eigen::Vector3d& point) {
-  int count = 0;
-  for (const auto& [image_id, image] : reconstruction.images) {
-    const auto camera = reconstruction.cameras.find(image.camera_id);
-    if (camera == reconstruction.cameras.end()) continue;
-    const Eigen::Vector3d local = image.cam_from_world * point;
-    if (!(local.z() > 0.0)) continue;
-    const Eigen::Vector2d pixel = camera->second.ImgFromCam(local.head<2>() / local.z());
-    count += pixel.allFinite() && pixel.x() >= 0.0 && pixel.y() >= 0.0 &&
-             pixel.x() < static_cast<double>(camera->second.width) &&
-             pixel.y() < static_cast<double>(camera->second.height);
-  }
-  return count;
-}
-
 // Photos of an object are taken around it and aimed at it: every photo frames the object, while
 // the room behind it (walls, furniture, a floor running on) is framed only by the photos that
 // face that way. Points framed by fewer photos than min_framed_share of the best framed ones
@@ -46,8 +30,20 @@ int FramedBy(const Reconstruction& reconstruction, const Eigen::Vector3d& point)
 void DropTheRoom(const Reconstruction& reconstruction, const BoundsOptions& options,
                  std::vector<Eigen::Vector3d>* points, Bounds* bounds) {
   if (options.min_framed_share <= 0.0 || points->empty() || reconstruction.images.empty()) return;
-  std::vector<double> counts(points->size());
-  for (size_t i = 0; i < points->size(); ++i) counts[i] = FramedBy(reconstruction, (*points)[i]);
+  // Each image with its camera, looked up once.
+  std::vector<std::pair<const Image*, const Camera*>> photos;
+  for (const auto& [image_id, image] : reconstruction.images) {
+    const auto camera = reconstruction.cameras.find(image.camera_id);
+    if (camera != reconstruction.cameras.end()) photos.emplace_back(&image, &camera->second);
+  }
+  // How many photos show each point inside their frame.
+  std::vector<double> counts(points->size(), 0.0);
+  Eigen::Vector2d pixel;
+  for (size_t i = 0; i < points->size(); ++i) {
+    for (const auto& [image, camera] : photos) {
+      counts[i] += ProjectIntoFrame(*camera, image->cam_from_world, (*points)[i], &pixel);
+    }
+  }
   std::vector<double> sorted = counts;
   const double best = Quantile(&sorted, 0.9);
   std::vector<Eigen::Vector3d> framed;

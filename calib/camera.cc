@@ -13,6 +13,16 @@ Eigen::Vector2d Camera::ImgFromCam(const Eigen::Vector2d& normalized) const {
   return raycarve::ImgFromCam(model, params, normalized);
 }
 
+bool ProjectIntoFrame(const Camera& camera, const Rigid3d& cam_from_world,
+                      const Eigen::Vector3d& world, Eigen::Vector2d* pixel) {
+  const Eigen::Vector3d local = cam_from_world * world;
+  if (!(local.z() > 1e-9)) return false;
+  *pixel = camera.ImgFromCam(local.head<2>() / local.z());
+  return pixel->allFinite() && pixel->x() >= 0.0 && pixel->y() >= 0.0 &&
+         pixel->x() < static_cast<double>(camera.width) &&
+         pixel->y() < static_cast<double>(camera.height);
+}
+
 Eigen::Vector2d Camera::CamFromImg(const Eigen::Vector2d& pixel) const {
   return raycarve::CamFromImg(model, params, pixel);
 }

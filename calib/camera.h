@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "calib/camera_models.h"
+#include "calib/rigid3d.h"
 #include "calib/types.h"
 
 namespace raycarve {
@@ -27,6 +28,11 @@ struct Camera {
   double FocalLengthY() const;
   Eigen::Vector2d PrincipalPoint() const;
 };
+
+// Where the world point `world` falls in a photo of `camera` posed by `cam_from_world`: true, with
+// its pixel (COLMAP convention), when it lies in front of the camera and inside the frame.
+bool ProjectIntoFrame(const Camera& camera, const Rigid3d& cam_from_world,
+                      const Eigen::Vector3d& world, Eigen::Vector2d* pixel);
 
 // The camera of the same photo resampled to new_width x new_height, as COLMAP's
 // Camera::Rescale: focal lengths and principal point scale with the image (a single focal length

@@ -60,16 +60,10 @@ std::vector<Eigen::Vector2d> ProjectedPointPixels(const Reconstruction& reconstr
                                                   const Camera& camera, const Image& image,
                                                   const Eigen::AlignedBox3d& volume) {
   std::vector<Eigen::Vector2d> pixels;
+  Eigen::Vector2d pixel;
   for (const auto& [id, point] : reconstruction.points3D) {
     if (!volume.isEmpty() && !volume.contains(point.xyz)) continue;
-    const Eigen::Vector3d local = image.cam_from_world * point.xyz;
-    if (!(local.z() > 1e-9)) continue;
-    const Eigen::Vector2d pixel = camera.ImgFromCam(local.head<2>() / local.z());
-    if (!pixel.allFinite() || pixel.x() < 0.0 || pixel.y() < 0.0 ||
-        pixel.x() >= camera.width || pixel.y() >= camera.height) {
-      continue;
-    }
-    pixels.push_back(pixel);
+    if (ProjectIntoFrame(camera, image.cam_from_world, point.xyz, &pixel)) pixels.push_back(pixel);
   }
   return pixels;
 }

@@ -30,6 +30,8 @@ const Eigen::Vector3d kBoxMax(-0.2, 0.05, 0.8);
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // What every camera looks at.
 const Eigen::Vector3d kCameraTarget(0.0, 0.0, 0.35);
+// Where the light comes from (a unit direction): the surfaces' shading and the highlights.
+const Eigen::Vector3d kLight = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
 
 enum class Surface { kNone, kGround, kSphere, kBox, kTeapot };
 
@@ -302,8 +304,7 @@ Eigen::Vector3d SurfaceColour(const Hit& hit, bool detail = false) {
       albedo[k] *= 0.35 + 1.1 * noise;
     }
   }
-  const Eigen::Vector3d light = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
-  const double shade = 0.55 + 0.45 * std::max(0.0, hit.normal.dot(light));
+  const double shade = 0.55 + 0.45 * std::max(0.0, hit.normal.dot(kLight));
   return (albedo * shade).cwiseMin(255.0);
 }
 
@@ -331,7 +332,6 @@ cv::Mat Render(const SceneGeometry& geometry,
                double specular,
                cv::Mat* mask) {
   const Rigid3d world_from_cam = cam_from_world.Inverse();
-  const Eigen::Vector3d light = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
   cv::Mat photo(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC3);
   mask->create(photo.size(), CV_8UC1);
   for (int row = 0; row < photo.rows; ++row) {
@@ -356,7 +356,7 @@ cv::Mat Render(const SceneGeometry& geometry,
           if (specular > 0.0) {
             // A white highlight where the light's mirror direction meets the camera (Phong,
             // exponent 30): it moves over the surface from view to view.
-            const Eigen::Vector3d mirror = 2.0 * hit.normal.dot(light) * hit.normal - light;
+            const Eigen::Vector3d mirror = 2.0 * hit.normal.dot(kLight) * hit.normal - kLight;
             const double facing = std::max(0.0, mirror.dot(-direction));
             colour = (colour + Eigen::Vector3d::Constant(specular * 255.0 * std::pow(facing, 30.0)))
                          .cwiseMin(255.0);

@@ -14,6 +14,13 @@
 // and colouring, and per thread its work in them and its waiting (the rest of that wall time).
 // The serial time (convergence + colouring - parallel) and the total work project the time on
 // more cores: about serial + work / n, while the work per batch outweighs a hand-over.
+// With --repeats N, each configuration runs N times, the thread counts alternating (a virtual
+// machine's speed drifts within seconds: runs side by side compare, runs minutes apart do not),
+// and a last table gives per configuration the median convergence time and its speed-up over
+// the first thread count's median.
+#include <algorithm>
+#include <map>
+#include <tuple>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -93,6 +100,7 @@ int main(int argc, char** argv) {
   // One level (the paper's ray casting) and the command line's automatic levels of detail.
   std::vector<int> level_counts = {1, raycarve::kAutomaticLevels};
   std::vector<int> batch_sizes = {raycarve::CarveOptions().batch_voxels};
+  int repeats = 1;
   if (raycarve::ResolveNumThreads(-1) > 1) thread_counts.push_back(raycarve::ResolveNumThreads(-1));
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
@@ -100,6 +108,7 @@ int main(int argc, char** argv) {
     else if (flag == "--width") scene_options.width = std::stoi(value);
     else if (flag == "--height") scene_options.height = std::stoi(value);
     else if (flag == "--threshold") threshold = std::stod(value);
+    else if (flag == "--repeats") repeats = std::max(1, std::stoi(value));
     else if (flag == "--incremental_statistics") incremental_statistics = std::stoi(value) != 0;
     else if (flag == "--vis_lookup") {
       raycarve::VisLookup lookup;
@@ -147,10 +156,15 @@ int main(int argc, char** argv) {
   std::ostringstream json;
   json << "[";
   bool first = true;
+  // Convergence seconds per (resolution, levels, lookup, batch, threads), over the repeats.
+  using Key = std::tuple<int, int, std::string, int, int>;
+  std::map<Key, std::vector<double>> convergence;
+  std::vector<Key> key_order;
   for (size_t k = 0; k < resolutions.size(); ++k) {
    for (const int levels : level_counts) {
    for (const raycarve::VisLookup lookup : lookups) {
    for (const int batch : batch_sizes) {
+   for (int repeat = 0; repeat < repeats; ++repeat) {
    for (const int threads : thread_counts) {
     if (lookup == raycarve::VisLookup::kRayLists && threads != thread_counts.front()) continue;
     raycarve::CarveOptions options;
@@ -189,7 +203,11 @@ int main(int argc, char** argv) {
                 static_cast<long long>(s.evaluated), 100.0 * quality.precision,
                 100.0 * quality.completeness, threads_text.c_str());
     std::fflush(stdout);
+    const Key key{resolutions[k], static_cast<int>(s.levels.size()), vis, batch, s.threads};
+    if (convergence.count(key) == 0) key_order.push_back(key);
+    convergence[key].push_back(s.carve_seconds);
     json << (first ? "" : ",") << "\n  {\"resolution\": " << resolutions[k]
+         << ", \"repeat\": " << repeat
          << ", \"vis_lookup\": \"" << vis << "\", \"batch_voxels\": " << batch
          << ", \"threads_asked\": " << options.num_threads << ", \"threads\": " << s.threads
          << ", \"lod_levels\": " << s.levels.size()
@@ -211,6 +229,31 @@ int main(int argc, char** argv) {
    }
    }
    }
+   }
+  }
+  if (repeats > 1) {
+    auto median = [](std::vector<double> values) {
+      std::sort(values.begin(), values.end());
+      const size_t n = values.size();
+      return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+    };
+    std::printf("\nmedian of %d runs\n%-10s %-6s %-10s %-5s %-7s %10s %9s\n", repeats, "resolution",
+                "levels", "vis", "batch", "threads", "converge s", "speed-up");
+    for (const Key& key : key_order) {
+      Key first_threads = key;
+      std::get<4>(first_threads) = std::get<4>(key_order.front());
+      for (const Key& other : key_order) {
+        if (std::get<0>(other) == std::get<0>(key) && std::get<1>(other) == std::get<1>(key) &&
+            std::get<2>(other) == std::get<2>(key) && std::get<3>(other) == std::get<3>(key)) {
+          first_threads = other;  // the first thread count run for this configuration
+          break;
+        }
+      }
+      const double seconds = median(convergence[key]);
+      std::printf("%-10d %-6d %-10s %-5d %-7d %10.2f %8.2fx\n", std::get<0>(key), std::get<1>(key),
+                  std::get<2>(key).c_str(), std::get<3>(key), std::get<4>(key), seconds,
+                  median(convergence[first_threads]) / seconds);
+    }
   }
   json << "\n]\n";
   std::printf("\n%s", json.str().c_str());

@@ -39,6 +39,8 @@ constexpr double kBytesPerListedVoxel = kBytesPerVoxel + 4.0;
 // Batched carving: voxels a group claims at once for judging (see ClaimItems), and the tasks
 // between two sortings of the views by their cost (SortViewsByCost).
 constexpr int kClaimChunk = 8;
+// Finding Vis: how many voxels ahead their rays and photo rows are fetched.
+constexpr int kPrefetchAhead = 3;
 constexpr int kSortTasks = 64;
 
 int64_t ElapsedNanoseconds(Clock::time_point since) {
@@ -704,7 +706,7 @@ bool IncrementalCarver::BehindKnownSurface(int64_t voxel,
 }
 
 void IncrementalCarver::FormBatch(Batch* batch) {
-  batch->entries.clear();
+  batch->Clear();
   while (static_cast<int>(batch->entries.size()) < batch_voxels_ && !queue_.empty()) {
     const int64_t voxel = queue_.front();
     queue_.pop_front();
@@ -745,16 +747,48 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       hits.clear();
       const int num_entries = static_cast<int>(finding->entries.size());
       spans.resize(num_entries);
+      // The footprints first, so that the rays and photo rows of the voxels a few ahead can be
+      // fetched while a voxel's are scanned: the scans wait on memory more than they compute.
+      std::vector<Footprint>& footprints = buffers.footprints;
+      footprints.resize(num_entries);
       for (int k = 0; k < num_entries; ++k) {
+        footprints[k] = ray_visibility_->VisFootprint(finding->coordinates[k], view);
+      }
+      const cv::Mat& photo = views_[view].image;
+      const uint8_t* image = photo.data;
+      for (int k = 0; k < num_entries; ++k) {
+        if (k + kPrefetchAhead < num_entries) {
+          const Footprint& ahead = footprints[k + kPrefetchAhead];
+          ray_visibility_->PrefetchRays(ahead, view);
+          for (int row = ahead.row_min; row <= ahead.row_max; ++row) {
+            const uint8_t* line = photo.ptr<uint8_t>(row);
+            __builtin_prefetch(line + 3 * ahead.col_min);
+            __builtin_prefetch(line + 3 * ahead.col_max + 2);
+          }
+        }
         Span& span = spans[k];
         span.begin = static_cast<uint32_t>(vis.size());
-        ray_visibility_->ComputeVisInView(finding->entries[k].coordinates, view, &vis);
+        ray_visibility_->AppendVis(footprints[k], finding->coordinates[k], view, &vis);
         span.end = static_cast<uint32_t>(vis.size());
         if (span.end == span.begin) continue;  // most views see none of a voxel
-        BatchHit& hit = hits.emplace_back();
-        hit.k = k;
-        hit.stats.view = view;
-        for (uint32_t p = span.begin; p < span.end; ++p) hit.stats.Add(PixelColour(vis[p]));
+        for (uint32_t first = span.begin; first < span.end; first += kMaxHitPixels) {
+          const uint32_t last = std::min(span.end, first + kMaxHitPixels);
+          uint32_t sum[3] = {0, 0, 0}, sum_squares[3] = {0, 0, 0};
+          for (uint32_t p = first; p < last; ++p) {
+            const uint8_t* rgb = image + 3 * static_cast<size_t>(vis[p].pixel);
+            for (int c = 0; c < 3; ++c) {
+              sum[c] += rgb[c];
+              sum_squares[c] += uint32_t{rgb[c]} * rgb[c];
+            }
+          }
+          BatchHit& hit = hits.emplace_back();
+          hit.k = k;
+          hit.count = last - first;
+          for (int c = 0; c < 3; ++c) {
+            hit.sum[c] = sum[c];
+            hit.sum_squares[c] = sum_squares[c];
+          }
+        }
       }
     }
     buffers.nanoseconds += ElapsedNanoseconds(start);
@@ -793,10 +827,18 @@ void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
       for (int view = 0; view < num_views; ++view) {
         const std::vector<BatchHit>& hits = view_buffers_[view].hits[slot];
         const BatchHit* hit = next[view];
-        if (hit == hits.data() + hits.size() || hit->k != k) continue;
-        stats.push_back(hit->stats);
-        entry.num_pixels += hit->stats.count;
-        ++next[view];
+        const BatchHit* end = hits.data() + hits.size();
+        if (hit == end || hit->k != k) continue;
+        ViewColourStats& view_stats = stats.emplace_back();
+        view_stats.view = view;
+        for (; hit != end && hit->k == k; ++hit) {
+          view_stats.count += static_cast<int>(hit->count);
+          view_stats.sum += Eigen::Vector3d(hit->sum[0], hit->sum[1], hit->sum[2]);
+          view_stats.sum_squares +=
+              Eigen::Vector3d(hit->sum_squares[0], hit->sum_squares[1], hit->sum_squares[2]);
+        }
+        next[view] = hit;
+        entry.num_pixels += view_stats.count;
       }
       entry.consistency = Judge(entry.voxel, stats);
       entry.carve = !entry.consistency.consistent;
@@ -837,7 +879,7 @@ void IncrementalCarver::ReturnPendingBatch() {
   for (auto entry = entries.rbegin(); entry != entries.rend(); ++entry) {
     queue_.push_front(entry->voxel);
   }
-  batches_[current_].entries.clear();
+  batches_[current_].Clear();
   batch_found_ = false;
 }
 
@@ -1099,7 +1141,7 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
     constexpr size_t kChunk = 4096;
     Batch& chunk = batches_[current_];
     for (size_t first = 0; first < voxels.size(); first += kChunk) {
-      chunk.entries.clear();
+      chunk.Clear();
       for (size_t i = first; i < std::min(voxels.size(), first + kChunk); ++i) {
         chunk.Add(voxels[i], volume_.grid());
       }
@@ -1111,7 +1153,7 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
         explained += entry.num_pixels;
       }
     }
-    chunk.entries.clear();
+    chunk.Clear();
   } else {
     for (int64_t voxel : volume_.SurfaceVoxels()) {
       const Consistency consistency = Evaluate(voxel);

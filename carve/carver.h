@@ -430,10 +430,18 @@ class IncrementalCarver {
   };
   struct Batch {
     std::vector<BatchEntry> entries;
+    // The entries' coordinates again, packed: what the workers read of a batch (a few cache
+    // lines to fetch from the thread that formed it, not one per entry).
+    std::vector<Eigen::Vector3i> coordinates;
     void Add(int64_t voxel, const VoxelGrid& grid) {
       entries.emplace_back();
       entries.back().voxel = voxel;
       entries.back().coordinates = grid.Voxel(voxel);
+      coordinates.push_back(entries.back().coordinates);
+    }
+    void Clear() {
+      entries.clear();
+      coordinates.clear();
     }
   };
   // Where a voxel's pixels lie in one view's buffer: [begin, end). A view has fewer pixels than
@@ -441,10 +449,17 @@ class IncrementalCarver {
   struct Span {
     uint32_t begin = 0, end = 0;
   };
-  // A voxel of a batch that a view sees pixels of: its index in the batch and their statistics.
+  // A voxel of a batch that a view sees pixels of: its index in the batch and the sums of their
+  // colours and squared colours. The channels are 8-bit, so integer sums are exact (as the
+  // doubles they become are) and take half the bytes the judging thread fetches from the one
+  // that found them. A voxel with more than kMaxHitPixels pixels in a view (where a square sum
+  // could overflow) gets several records in a row, merged when judged.
+  static constexpr uint32_t kMaxHitPixels = 65535;
   struct BatchHit {
-    int k = 0;
-    ViewColourStats stats;
+    int32_t k = 0;
+    uint32_t count = 0;
+    uint32_t sum[3] = {0, 0, 0};
+    uint32_t sum_squares[3] = {0, 0, 0};
   };
   // Per view, written only by the thread that runs the view (mostly the same one from task to
   // task, see RunViewTask): the Vis pixels of the two batches in flight (the one being carved
@@ -458,6 +473,7 @@ class IncrementalCarver {
     std::vector<PixelRef> vis[2];
     std::vector<Span> spans[2];
     std::vector<BatchHit> hits[2];
+    std::vector<Footprint> footprints;
     std::vector<int64_t> reached;
     std::vector<Span> reached_spans;
     int64_t nanoseconds = 0;

@@ -103,14 +103,34 @@ void RayCastVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels)
 void RayCastVisibility::ComputeVisInView(const Eigen::Vector3i& voxel,
                                          int view,
                                          std::vector<PixelRef>* pixels) const {
+  AppendVis(VisFootprint(voxel, view), voxel, view, pixels);
+}
+
+Footprint RayCastVisibility::VisFootprint(const Eigen::Vector3i& voxel, int view) const {
   // No ray of this view ends in the voxel: nothing to scan.
-  if (!rays_[view]->MayEndIn(volume_.grid().Index(voxel))) return;
+  if (!rays_[view]->MayEndIn(volume_.grid().Index(voxel))) return Footprint();
   const CalibratedView& v = views_[view];
-  const Footprint footprint = ComputeFootprint(v.P, v.width, v.height, volume_.grid(), voxel);
+  return ComputeFootprint(v.P, v.width, v.height, volume_.grid(), voxel);
+}
+
+void RayCastVisibility::AppendVis(const Footprint& footprint,
+                                  const Eigen::Vector3i& voxel,
+                                  int view,
+                                  std::vector<PixelRef>* pixels) const {
   const uint32_t key = rays_[view]->Key(voxel);
   const uint32_t* keys = rays_[view]->keys();
-  AppendMatchingPixels(footprint, v.width, static_cast<uint32_t>(view),
+  AppendMatchingPixels(footprint, views_[view].width, static_cast<uint32_t>(view),
                        [&](int pixel) { return keys[pixel] == key; }, pixels);
+}
+
+void RayCastVisibility::PrefetchRays(const Footprint& footprint, int view) const {
+  const uint32_t* keys = rays_[view]->keys();
+  const int width = views_[view].width;
+  // A row of a footprint spans a cache line or two: its first and last key fetch both.
+  for (int row = footprint.row_min; row <= footprint.row_max; ++row) {
+    __builtin_prefetch(keys + static_cast<size_t>(row) * width + footprint.col_min);
+    __builtin_prefetch(keys + static_cast<size_t>(row) * width + footprint.col_max);
+  }
 }
 
 void RayCastVisibility::AdvanceRays(const PixelRef* begin,

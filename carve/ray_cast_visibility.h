@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "calib/calibrated_view.h"
+#include "carve/footprint.h"
 #include "carve/ray_image.h"
 #include "carve/view_workers.h"
 #include "carve/visibility.h"
@@ -56,7 +57,19 @@ class RayCastVisibility : public Visibility {
 
   bool ViewParallel() const { return lookup_ == VisLookup::kFootprint && counts_.empty(); }
   // ComputeVis restricted to one view, for the voxel at grid coordinates `voxel`.
+  // It is AppendVis(VisFootprint(voxel, view), voxel, view, pixels), in two steps so that a
+  // caller can fetch the memory a later scan reads (PrefetchRays) while scanning.
   void ComputeVisInView(const Eigen::Vector3i& voxel, int view, std::vector<PixelRef>* pixels) const;
+  // The pixels of `view` to scan for the voxel: its footprint, or none when no ray of the view
+  // ends in it.
+  Footprint VisFootprint(const Eigen::Vector3i& voxel, int view) const;
+  // Appends the pixels of `footprint` whose ray ends in `voxel`.
+  void AppendVis(const Footprint& footprint,
+                 const Eigen::Vector3i& voxel,
+                 int view,
+                 std::vector<PixelRef>* pixels) const;
+  // A hint: starts fetching the rays of `footprint` into the cache. Changes nothing.
+  void PrefetchRays(const Footprint& footprint, int view) const;
   // Steps the rays of pixels [begin, end) (their voxel was carved) and appends the solid voxel
   // each reaches, as UpdateAfterCarve reports them (footprint lookup, no counts: CHECKed).
   void AdvanceRays(const PixelRef* begin, const PixelRef* end, std::vector<int64_t>* reached);

@@ -55,11 +55,13 @@ RayImage::RayImage(const VoxelGrid& grid,
       valid_(valid) {
   const Eigen::Vector3i& n = grid.dimensions();
   CHECK(KeyBitsFit(n)) << "grid " << n.transpose() << " too large for 31-bit ray keys";
-  CHECK(valid.empty() || (valid.type() == CV_8UC1 && valid.cols == width && valid.rows == height));
+  CHECK(valid.empty() || (valid.type() == CV_8UC1 && valid.cols == width && valid.rows == height &&
+                          valid.isContinuous()));
   shift_y_ = CoordinateBits(n.x());
   shift_z_ = shift_y_ + CoordinateBits(n.y());
   mask_x_ = (uint32_t{1} << shift_y_) - 1;
   mask_y_ = (uint32_t{1} << (shift_z_ - shift_y_)) - 1;
+  if (!valid.empty()) valid_pixels_ = valid_.ptr<uint8_t>(0);
   keys_.assign(static_cast<size_t>(width) * height, kInactive);
   const int64_t voxels = grid.num_voxels();
   if (voxels <= 32 * static_cast<int64_t>(width) * height) arrived_.assign((voxels + 63) / 64, 0);
@@ -75,7 +77,7 @@ Eigen::Vector3d RayImage::Direction(int pixel) const {
 
 void RayImage::InitialiseRay(int pixel) {
   keys_[pixel] = kInactive;
-  if (!valid_.empty() && valid_.data[pixel] == 0) return;
+  if (valid_pixels_ != nullptr && valid_pixels_[pixel] == 0) return;
   const Eigen::Vector3d d = GridDirection(pixel);
   const Eigen::Vector3d& o = centre_grid_;
   const Eigen::Vector3i& n = grid_.dimensions();

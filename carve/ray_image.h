@@ -135,6 +135,7 @@ class RayImage {
   int width_;
   int height_;
   cv::Mat valid_;
+  const uint8_t* valid_pixels_ = nullptr;  // valid_'s pixels (it is continuous), or none
   int shift_y_;  // key = x | y << shift_y_ | z << shift_z_
   int shift_z_;
   uint32_t mask_x_;

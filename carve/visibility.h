@@ -8,8 +8,12 @@
 
 namespace raycarve {
 
-// One pixel of one view.
+// One pixel of one view. Made without values unless given them: a Vis buffer grows by a
+// footprint's area before the scan writes it (AppendMatchingPixels), and zeroing it first
+// took 3% of a carve's instructions.
 struct PixelRef {
+  PixelRef() {}  // NOLINT: uninitialised on purpose
+  PixelRef(uint32_t view_index, uint32_t pixel_index) : view(view_index), pixel(pixel_index) {}
   uint32_t view;
   uint32_t pixel;  // row * width + col
 };

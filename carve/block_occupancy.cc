@@ -19,6 +19,21 @@ BlockOccupancy::BlockOccupancy(const Volume& volume) {
     }
   }
   for (uint8_t value : occupied_) num_occupied_ += value;
+  const Eigen::Vector3i& nb = dimensions_;
+  for (int z = 0; z < nb.z(); ++z) {
+    for (int y = 0; y < nb.y(); ++y) {
+      for (int x = 0; x < nb.x(); ++x) {
+        if (!IsOccupied(x, y, z)) continue;
+        const bool on_edge = x == 0 || y == 0 || z == 0 || x + 1 == nb.x() || y + 1 == nb.y() ||
+                             z + 1 == nb.z();
+        if (on_edge || !IsOccupied(x - 1, y, z) || !IsOccupied(x + 1, y, z) ||
+            !IsOccupied(x, y - 1, z) || !IsOccupied(x, y + 1, z) || !IsOccupied(x, y, z - 1) ||
+            !IsOccupied(x, y, z + 1)) {
+          boundary_.emplace_back(x, y, z);
+        }
+      }
+    }
+  }
 }
 
 }  // namespace raycarve

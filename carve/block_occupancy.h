@@ -30,11 +30,16 @@ class BlockOccupancy {
   bool IsOccupied(int64_t block) const { return occupied_[block] != 0; }
   int64_t num_occupied() const { return num_occupied_; }
   int64_t num_blocks() const { return static_cast<int64_t>(occupied_.size()); }
+  // The occupied blocks a ray from outside them must cross first to reach any occupied block:
+  // those with an unoccupied 6-neighbour or on the edge of the grid of blocks. Their block
+  // coordinates.
+  const std::vector<Eigen::Vector3i>& boundary() const { return boundary_; }
 
  private:
   Eigen::Vector3i dimensions_;
   std::vector<uint8_t> occupied_;
   int64_t num_occupied_ = 0;
+  std::vector<Eigen::Vector3i> boundary_;
 };
 
 }  // namespace raycarve

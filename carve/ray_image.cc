@@ -48,6 +48,7 @@ RayImage::RayImage(const VoxelGrid& grid,
     : grid_(grid),
       world_from_pixel_(world_from_pixel),
       grid_from_pixel_(world_from_pixel / grid.voxel_size()),
+      pixel_from_grid_(grid_from_pixel_.inverse()),
       inverse_width_(1.0 / width),
       centre_grid_((centre - grid.origin()) / grid.voxel_size()),
       width_(width),
@@ -104,47 +105,100 @@ void RayImage::InitialiseRay(int pixel) {
   keys_[pixel] = Key(voxel);
 }
 
+std::vector<uint8_t> RayImage::ReachableTiles(const BlockOccupancy& blocks) const {
+  constexpr int kSize = BlockOccupancy::kSize;
+  // Pixels to spare around a block's bounding box: far beyond the rounding of the projection
+  // and of the rays' stepping.
+  constexpr double kSlackPixels = 1.0;
+  const int across = tiles_across(), down = (height_ + kTileSize - 1) >> kTileShift;
+  std::vector<uint8_t> tiles(static_cast<size_t>(across) * down, 0);
+  const Eigen::Vector3i& n = grid_.dimensions();
+  for (const Eigen::Vector3i& block : blocks.boundary()) {
+    const Eigen::Vector3i low = block * kSize;
+    const Eigen::Vector3i high = (low.array() + kSize).min(n.array());
+    double x_min = INFINITY, x_max = -INFINITY, y_min = INFINITY, y_max = -INFINITY;
+    bool in_front = true;
+    for (int c = 0; c < 8 && in_front; ++c) {
+      const Eigen::Vector3d corner((c & 1) ? high.x() : low.x(), (c & 2) ? high.y() : low.y(),
+                                   (c & 4) ? high.z() : low.z());
+      const Eigen::Vector3d h = pixel_from_grid_ * (corner - centre_grid_);
+      // A block reaching the camera's plane may be seen anywhere in the photo.
+      in_front = h.z() > 1e-9 * h.head<2>().norm();
+      x_min = std::min(x_min, h.x() / h.z());
+      x_max = std::max(x_max, h.x() / h.z());
+      y_min = std::min(y_min, h.y() / h.z());
+      y_max = std::max(y_max, h.y() / h.z());
+    }
+    if (!in_front) {
+      std::fill(tiles.begin(), tiles.end(), 1);
+      return tiles;
+    }
+    // Pixel centres (col + 0.5, row + 0.5) within the box, with slack, clipped to the photo.
+    const double col_low = std::max(0.0, std::floor(x_min - 0.5 - kSlackPixels));
+    const double col_high = std::min(width_ - 1.0, std::ceil(x_max - 0.5 + kSlackPixels));
+    const double row_low = std::max(0.0, std::floor(y_min - 0.5 - kSlackPixels));
+    const double row_high = std::min(height_ - 1.0, std::ceil(y_max - 0.5 + kSlackPixels));
+    if (!(col_low <= col_high && row_low <= row_high)) continue;  // beside the photo
+    for (int row = static_cast<int>(row_low) >> kTileShift;
+         row <= static_cast<int>(row_high) >> kTileShift; ++row) {
+      for (int col = static_cast<int>(col_low) >> kTileShift;
+           col <= static_cast<int>(col_high) >> kTileShift; ++col) {
+        tiles[static_cast<size_t>(row) * across + col] = 1;
+      }
+    }
+  }
+  return tiles;
+}
+
 void RayImage::Initialise(const Volume& volume, const BlockOccupancy* blocks, int num_threads) {
   CHECK(volume.grid().dimensions() == grid_.dimensions());
   CHECK(blocks == nullptr ||
         (blocks->dimensions().array() ==
          (grid_.dimensions().array() + (BlockOccupancy::kSize - 1)) / BlockOccupancy::kSize)
             .all());
-  if (blocks != nullptr && num_threads > 1) {
-    // Each ray writes only its own key; the arrivals, shared bits, are marked after the join.
-    const int pixels = num_pixels();
-    const int per_thread = (pixels + num_threads - 1) / num_threads;
-    std::vector<std::thread> workers;
-    for (int t = 0; t < num_threads; ++t) {
-      const int begin = t * per_thread, end = std::min(pixels, begin + per_thread);
-      if (begin >= end) break;
-      workers.emplace_back([this, &volume, blocks, begin, end]() {
-        for (int pixel = begin; pixel < end; ++pixel) {
-          InitialiseRay(pixel);
-          if (keys_[pixel] != kInactive) keys_[pixel] = FirstSolid(pixel, volume, *blocks);
-        }
-      });
-    }
-    for (std::thread& worker : workers) worker.join();
-    for (int pixel = 0; pixel < pixels; ++pixel) {
-      if (keys_[pixel] != kInactive) MarkArrival(grid_.Index(Unpack(keys_[pixel])));
+  if (blocks == nullptr) {
+    for (int pixel = 0; pixel < num_pixels(); ++pixel) {
+      InitialiseRay(pixel);
+      Advance(pixel, volume);
     }
     return;
   }
-  for (int pixel = 0; pixel < num_pixels(); ++pixel) {
-    InitialiseRay(pixel);
-    if (keys_[pixel] == kInactive) continue;
-    if (blocks != nullptr) {
-      keys_[pixel] = FirstSolid(pixel, volume, *blocks);
-      if (keys_[pixel] != kInactive) MarkArrival(grid_.Index(Unpack(keys_[pixel])));
-    } else {
-      Advance(pixel, volume);
+  const std::vector<uint8_t> tiles = ReachableTiles(*blocks);
+  const int across = tiles_across();
+  // Rows [first, last): each ray writes only its own key.
+  auto trace_rows = [&](int first, int last) {
+    for (int row = first; row < last; ++row) {
+      const uint8_t* row_tiles = tiles.data() + static_cast<size_t>(row >> kTileShift) * across;
+      for (int col = 0, pixel = row * width_; col < width_; ++col, ++pixel) {
+        if (row_tiles[col >> kTileShift] == 0) {
+          keys_[pixel] = kInactive;
+          continue;
+        }
+        InitialiseRay(pixel);
+        if (keys_[pixel] != kInactive) keys_[pixel] = FirstSolid(pixel, volume, *blocks);
+      }
     }
+  };
+  if (num_threads > 1) {
+    const int per_thread = (height_ + num_threads - 1) / num_threads;
+    std::vector<std::thread> workers;
+    for (int t = 0; t < num_threads; ++t) {
+      const int first = t * per_thread, last = std::min(height_, first + per_thread);
+      if (first >= last) break;
+      workers.emplace_back(trace_rows, first, last);
+    }
+    for (std::thread& worker : workers) worker.join();
+  } else {
+    trace_rows(0, height_);
+  }
+  // The arrivals, bits shared between rays, are marked after the rays are traced.
+  for (int pixel = 0; pixel < num_pixels(); ++pixel) {
+    if (keys_[pixel] != kInactive) MarkArrival(grid_.Index(Unpack(keys_[pixel])));
   }
 }
 
 int64_t RayImage::Step(int pixel,
-                       const Volume& volume,
+                       const uint64_t* solid,
                        int voxel[3],
                        bool skip_current,
                        const int lo[3],
@@ -155,7 +209,6 @@ int64_t RayImage::Step(int pixel,
   const int64_t stride_y = n.x(), stride_z = static_cast<int64_t>(n.x()) * n.y();
   int x = voxel[0], y = voxel[1], z = voxel[2];
   int64_t index = x + stride_y * y + stride_z * z;
-  const uint64_t* solid = volume.solid_bits().data();
   const auto is_solid = [solid](int64_t i) { return ((solid[i >> 6] >> (i & 63)) & 1) != 0; };
   if (!skip_current && is_solid(index)) return index;
   const Eigen::Vector3d d = GridDirection(pixel);
@@ -302,7 +355,8 @@ uint32_t RayImage::FirstSolid(int pixel, const Volume& volume, const BlockOccupa
       lo[axis] = (voxel[axis] >> kShift) << kShift;
       hi[axis] = std::min(lo[axis] + kSize, n[axis]);
     }
-    if (Step(pixel, volume, voxel, /*skip_current=*/false, lo, hi) != kNoVoxel) {
+    if (Step(pixel, volume.solid_bits().data(), voxel, /*skip_current=*/false, lo, hi) !=
+        kNoVoxel) {
       return Key(Eigen::Vector3i(voxel[0], voxel[1], voxel[2]));
     }
     for (int axis = 0; axis < 3; ++axis) {
@@ -318,7 +372,8 @@ int64_t RayImage::Advance(int pixel, const Volume& volume) {
   int voxel[3] = {start.x(), start.y(), start.z()};
   const Eigen::Vector3i& n = grid_.dimensions();
   const int end[3] = {n.x(), n.y(), n.z()};
-  const int64_t index = Step(pixel, volume, voxel, /*skip_current=*/false, kZero, end);
+  const int64_t index =
+      Step(pixel, volume.solid_bits().data(), voxel, /*skip_current=*/false, kZero, end);
   if (index == kNoVoxel) {
     keys_[pixel] = kInactive;
   } else {
@@ -335,7 +390,7 @@ int64_t RayImage::PeekBeyondCurrent(int pixel, const Volume& volume) const {
   int voxel[3] = {start.x(), start.y(), start.z()};
   const Eigen::Vector3i& n = grid_.dimensions();
   const int end[3] = {n.x(), n.y(), n.z()};
-  return Step(pixel, volume, voxel, /*skip_current=*/true, kZero, end);
+  return Step(pixel, volume.solid_bits().data(), voxel, /*skip_current=*/true, kZero, end);
 }
 
 }  // namespace raycarve

@@ -51,7 +51,9 @@ class RayImage {
   // Moves every ray to the first solid voxel of `volume` along it (until then every ray is
   // gone). With `blocks` (made from `volume`), empty blocks are crossed a block at a time: the
   // same voxels (up to rays through exact block edges, which may start in either voxel they
-  // touch), at a fraction of the steps where much of the volume is empty.
+  // touch), at a fraction of the steps where much of the volume is empty; and the pixels of
+  // tiles that no boundary block projects onto are not traced at all (their rays miss every
+  // occupied block): most of a photo, where the object is small in it or the box ends.
   // With `blocks`, `num_threads` > 1 splits the pixels among that many threads (the same rays).
   void Initialise(const Volume& volume, const BlockOccupancy* blocks = nullptr,
                   int num_threads = 1);
@@ -107,6 +109,14 @@ class RayImage {
   }
 
   void InitialiseRay(int pixel);
+  // Per tile of kTileSize x kTileSize pixels (row-major, tiles_across() wide), whether a ray
+  // through one of its pixels may hit an occupied block of `blocks`: the tiles under each
+  // boundary block's projected corners' bounding box, with a pixel to spare (all tiles where a
+  // block reaches the camera's plane).
+  static constexpr int kTileShift = 3;
+  static constexpr int kTileSize = 1 << kTileShift;
+  int tiles_across() const { return (width_ + kTileSize - 1) >> kTileShift; }
+  std::vector<uint8_t> ReachableTiles(const BlockOccupancy& blocks) const;
   void MarkArrival(int64_t voxel) {
     if (!arrived_.empty()) arrived_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
   }
@@ -114,7 +124,7 @@ class RayImage {
   // of the region [lo, hi) of voxel coordinates (kNoVoxel; `voxel` is then the first voxel
   // outside it). With `skip_current`, the starting voxel counts as empty.
   int64_t Step(int pixel,
-               const Volume& volume,
+               const uint64_t* solid,
                int voxel[3],
                bool skip_current,
                const int lo[3],
@@ -130,6 +140,7 @@ class RayImage {
   VoxelGrid grid_;
   Eigen::Matrix3d world_from_pixel_;
   Eigen::Matrix3d grid_from_pixel_;  // world_from_pixel_ in voxel units, for stepping
+  Eigen::Matrix3d pixel_from_grid_;  // its inverse: grid offsets from the centre to pixels
   double inverse_width_;             // row = floor((pixel + 0.5) * inverse_width_), exactly
   Eigen::Vector3d centre_grid_;  // camera centre in grid coordinates
   int width_;

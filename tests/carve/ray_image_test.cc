@@ -167,9 +167,11 @@ TEST(RayImage, CrossingEmptyBlocksReachesTheSameFirstSolidVoxelsAsSteppingEveryV
   for (int trial = 0; trial < 20; ++trial) {
     const Volume volume = RandomBalls(grid, trial % 5 == 0 ? 0 : 2 + trial % 7, &random);
     const BlockOccupancy blocks(volume);
-    // A 40x30 camera somewhere around the box, looking at a random point inside it.
+    // A 40x30 camera somewhere around the box, looking at a random point inside it; every
+    // fourth inside the box, where blocks reach behind the camera (pixels are then traced
+    // everywhere, not only under the blocks' projections).
     Eigen::Vector3d centre(uniform(random), uniform(random), uniform(random));
-    centre = 3.0 * centre.normalized();
+    centre = (trial % 4 == 3 ? 0.4 : 3.0) * centre.normalized();
     const Eigen::Vector3d target(0.8 * uniform(random), 0.5 * uniform(random), 0.4 * uniform(random));
     const Eigen::Vector3d forward = (target - centre).normalized();
     const Eigen::Vector3d right = forward.cross(Eigen::Vector3d(0.3, 0.1, 1)).normalized();

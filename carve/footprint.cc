@@ -19,15 +19,24 @@ Footprint ComputeFootprint(const Eigen::Matrix<double, 3, 4>& P,
   const Eigen::Vector3d base = P * grid.Corner(voxel, 0).homogeneous();
   const double s = grid.voxel_size() * span;
   const Eigen::Vector3d ex = s * P.col(0), ey = s * P.col(1), ez = s * P.col(2);
+  // The corners as three arrays of 8, summed in the same order as one corner at a time would
+  // be, so that the compiler can work on several at once.
+  double hx[8], hy[8], hz[8];
+  for (int c = 0; c < 8; ++c) {
+    hx[c] = base.x();
+    hy[c] = base.y();
+    hz[c] = base.z();
+    if (c & 1) hx[c] += ex.x(), hy[c] += ex.y(), hz[c] += ex.z();
+    if (c & 2) hx[c] += ey.x(), hy[c] += ey.y(), hz[c] += ey.z();
+    if (c & 4) hx[c] += ez.x(), hy[c] += ez.y(), hz[c] += ez.z();
+  }
+  bool in_front = true;
+  for (int c = 0; c < 8; ++c) in_front &= hz[c] > 0.0;
+  if (!in_front) return Footprint();
   double x_min = INFINITY, x_max = -INFINITY, y_min = INFINITY, y_max = -INFINITY;
   for (int c = 0; c < 8; ++c) {
-    Eigen::Vector3d h = base;
-    if (c & 1) h += ex;
-    if (c & 2) h += ey;
-    if (c & 4) h += ez;
-    if (!(h.z() > 0.0)) return Footprint();
-    const double inverse_depth = 1.0 / h.z();
-    const double x = h.x() * inverse_depth, y = h.y() * inverse_depth;
+    const double inverse_depth = 1.0 / hz[c];
+    const double x = hx[c] * inverse_depth, y = hy[c] * inverse_depth;
     x_min = std::min(x_min, x);
     x_max = std::max(x_max, x);
     y_min = std::min(y_min, y);

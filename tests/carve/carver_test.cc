@@ -118,6 +118,33 @@ TEST(CarveVolume, AThresholdSoLooseThatEverythingIsConsistentCarvesNothing) {
   EXPECT_EQ(result.volume.num_solid(), result.volume.grid().num_voxels());
 }
 
+TEST(CarveVolume, AVoxelSeenByMoreThan65535PixelsOfAViewIsColouredAsOneAtATimeColoursIt) {
+  // Batches keep a view's colour sums as 32-bit integers, split where a voxel has more pixels
+  // in a view than a sum of squares holds; one voxel at a time keeps doubles. A coarse grid on
+  // large photos: voxels hundreds of pixels wide. Nothing is carved (the threshold admits
+  // everything), so both colour the same surface.
+  const SyntheticScene scene = Scene(2, 1600, 1200);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  CarveOptions options = Options(3, 1e9);
+  options.lod_levels = 1;
+  const CarveResult batched = CarveVolume(views, scene.object_box, options);
+  options.batch_voxels = 1;
+  const CarveResult single = CarveVolume(views, scene.object_box, options);
+  ASSERT_EQ(batched.surface.size(), single.surface.size());
+  int most_pixels = 0;
+  for (size_t i = 0; i < single.surface.size(); ++i) {
+    const ColouredVoxel& a = batched.surface[i];
+    const ColouredVoxel& b = single.surface[i];
+    ASSERT_EQ(a.index, b.index);
+    EXPECT_EQ(a.num_pixels, b.num_pixels) << "voxel " << a.index;
+    EXPECT_EQ(a.num_views, b.num_views) << "voxel " << a.index;
+    EXPECT_EQ(a.colour, b.colour) << "voxel " << a.index;
+    most_pixels = std::max(most_pixels, b.num_pixels);
+  }
+  // Two views: some voxel has more than 65535 pixels in one of them.
+  EXPECT_GT(most_pixels, 2 * 65535);
+}
+
 TEST(CarveVolume, AThresholdSoTightThatNothingIsConsistentCarvesEverythingSeenTwice) {
   const SyntheticScene scene = Scene(4, 80, 60);
   const CarveResult result =

@@ -19,12 +19,12 @@
 // and a last table gives per configuration the median convergence time and its speed-up over
 // the first thread count's median.
 #include <algorithm>
-#include <map>
-#include <tuple>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "calib/calibrated_view.h"
@@ -240,15 +240,13 @@ int main(int argc, char** argv) {
     std::printf("\nmedian of %d runs\n%-10s %-6s %-10s %-5s %-7s %10s %9s\n", repeats, "resolution",
                 "levels", "vis", "batch", "threads", "converge s", "speed-up");
     for (const Key& key : key_order) {
-      Key first_threads = key;
-      std::get<4>(first_threads) = std::get<4>(key_order.front());
-      for (const Key& other : key_order) {
-        if (std::get<0>(other) == std::get<0>(key) && std::get<1>(other) == std::get<1>(key) &&
-            std::get<2>(other) == std::get<2>(key) && std::get<3>(other) == std::get<3>(key)) {
-          first_threads = other;  // the first thread count run for this configuration
-          break;
-        }
-      }
+      // The first thread count run for this configuration (key itself, if no other).
+      const auto same_configuration = [&key](const Key& other) {
+        return std::get<0>(other) == std::get<0>(key) && std::get<1>(other) == std::get<1>(key) &&
+               std::get<2>(other) == std::get<2>(key) && std::get<3>(other) == std::get<3>(key);
+      };
+      const Key& first_threads =
+          *std::find_if(key_order.begin(), key_order.end(), same_configuration);
       const double seconds = median(convergence[key]);
       std::printf("%-10d %-6d %-10s %-5d %-7d %10.2f %8.2fx\n", std::get<0>(key), std::get<1>(key),
                   std::get<2>(key).c_str(), std::get<3>(key), std::get<4>(key), seconds,

@@ -706,7 +706,7 @@ bool IncrementalCarver::BehindKnownSurface(int64_t voxel,
 }
 
 void IncrementalCarver::FormBatch(Batch* batch) {
-  batch->Clear();
+  batch->entries.clear();
   while (static_cast<int>(batch->entries.size()) < batch_voxels_ && !queue_.empty()) {
     const int64_t voxel = queue_.front();
     queue_.pop_front();
@@ -752,7 +752,7 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       std::vector<Footprint>& footprints = buffers.footprints;
       footprints.resize(num_entries);
       for (int k = 0; k < num_entries; ++k) {
-        footprints[k] = ray_visibility_->VisFootprint(finding->coordinates[k], view);
+        footprints[k] = ray_visibility_->VisFootprint(finding->entries[k].coordinates, view);
       }
       const cv::Mat& photo = views_[view].image;
       const uint8_t* image = photo.data;
@@ -768,7 +768,7 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
         }
         Span& span = spans[k];
         span.begin = static_cast<uint32_t>(vis.size());
-        ray_visibility_->AppendVis(footprints[k], finding->coordinates[k], view, &vis);
+        ray_visibility_->AppendVis(footprints[k], finding->entries[k].coordinates, view, &vis);
         span.end = static_cast<uint32_t>(vis.size());
         if (span.end == span.begin) continue;  // most views see none of a voxel
         for (uint32_t first = span.begin; first < span.end; first += kMaxHitPixels) {
@@ -879,7 +879,7 @@ void IncrementalCarver::ReturnPendingBatch() {
   for (auto entry = entries.rbegin(); entry != entries.rend(); ++entry) {
     queue_.push_front(entry->voxel);
   }
-  batches_[current_].Clear();
+  batches_[current_].entries.clear();
   batch_found_ = false;
 }
 
@@ -1141,7 +1141,7 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
     constexpr size_t kChunk = 4096;
     Batch& chunk = batches_[current_];
     for (size_t first = 0; first < voxels.size(); first += kChunk) {
-      chunk.Clear();
+      chunk.entries.clear();
       for (size_t i = first; i < std::min(voxels.size(), first + kChunk); ++i) {
         chunk.Add(voxels[i], volume_.grid());
       }
@@ -1153,7 +1153,7 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
         explained += entry.num_pixels;
       }
     }
-    chunk.Clear();
+    chunk.entries.clear();
   } else {
     for (int64_t voxel : volume_.SurfaceVoxels()) {
       const Consistency consistency = Evaluate(voxel);

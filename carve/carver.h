@@ -430,18 +430,10 @@ class IncrementalCarver {
   };
   struct Batch {
     std::vector<BatchEntry> entries;
-    // The entries' coordinates again, packed: what the workers read of a batch (a few cache
-    // lines to fetch from the thread that formed it, not one per entry).
-    std::vector<Eigen::Vector3i> coordinates;
     void Add(int64_t voxel, const VoxelGrid& grid) {
       entries.emplace_back();
       entries.back().voxel = voxel;
       entries.back().coordinates = grid.Voxel(voxel);
-      coordinates.push_back(entries.back().coordinates);
-    }
-    void Clear() {
-      entries.clear();
-      coordinates.clear();
     }
   };
   // Where a voxel's pixels lie in one view's buffer: [begin, end). A view has fewer pixels than

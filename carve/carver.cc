@@ -730,8 +730,9 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       buffers.reached_spans.clear();
       for (int k : batch_carved_) {
         const size_t begin = buffers.reached.size();
-        ray_visibility_->AdvanceRays(vis.data() + spans[k].begin, vis.data() + spans[k].end,
-                                     &buffers.reached);
+        ray_visibility_->AdvanceRaysFrom(carving->entries[k].coordinates,
+                                         vis.data() + spans[k].begin, vis.data() + spans[k].end,
+                                         &buffers.reached);
         const size_t kept =
             KeepFirstOccurrences(buffers.reached.data() + begin, buffers.reached.size() - begin);
         buffers.reached.resize(begin + kept);

@@ -143,6 +143,15 @@ void RayCastVisibility::AdvanceRays(const PixelRef* begin,
   }
 }
 
+void RayCastVisibility::AdvanceRaysFrom(const Eigen::Vector3i& voxel,
+                                        const PixelRef* begin,
+                                        const PixelRef* end,
+                                        std::vector<int64_t>* reached) {
+  CHECK(ViewParallel());
+  if (begin == end) return;
+  rays_[begin->view]->AdvanceFromCarved(voxel, begin, end, volume_, reached);
+}
+
 void RayCastVisibility::UpdateAfterCarve(int64_t voxel,
                                          const std::vector<PixelRef>& vis,
                                          const std::vector<int64_t>& /*newly_exposed*/,

@@ -73,6 +73,11 @@ class RayCastVisibility : public Visibility {
   // Steps the rays of pixels [begin, end) (their voxel was carved) and appends the solid voxel
   // each reaches, as UpdateAfterCarve reports them (footprint lookup, no counts: CHECKed).
   void AdvanceRays(const PixelRef* begin, const PixelRef* end, std::vector<int64_t>* reached);
+  // AdvanceRays for pixels [begin, end) of one view, all of which ended in `voxel` (the same).
+  void AdvanceRaysFrom(const Eigen::Vector3i& voxel,
+                       const PixelRef* begin,
+                       const PixelRef* end,
+                       std::vector<int64_t>* reached);
 
  private:
   // Ray lists: a ray's global id is view_offset_[view] + pixel.

@@ -197,69 +197,126 @@ void RayImage::Initialise(const Volume& volume, const BlockOccupancy* blocks, in
   }
 }
 
+namespace {
+
+// One axis of an Amanatides-Woo traversal: the ray parameter where the ray leaves the current
+// voxel through that axis's far face (infinite along an axis plane: that axis never steps), the
+// parameter length of one voxel, the step, its index stride and the coordinate that means the
+// ray has left the region.
+struct WalkAxis {
+  double t_max;
+  double t_delta;
+  int step;
+  int end;
+  int64_t index_step;
+};
+
+// The axis's state for a ray of direction component `d` in a voxel whose low and high faces along
+// it are `face_low` and `face_high` (offsets from the camera centre); `stride` is the axis's
+// index stride and [lo, hi) the region's coordinates along it.
+inline WalkAxis StartAxis(double d, double face_low, double face_high, int64_t stride, int lo,
+                          int hi) {
+  const double inverse = 1.0 / d;
+  const bool up = d > 0.0;
+  return {d == 0.0 ? kInfinity : (up ? face_high : face_low) * inverse, std::abs(inverse),
+          up ? 1 : -1, up ? hi : lo - 1, up ? stride : -stride};
+}
+
+// The hottest loop of ray-cast carving: from voxel (x, y, z) at `index`, not solid, steps until a
+// solid voxel (its index returned; x, y, z updated) or the edge of the region (kNoVoxel; x, y, z
+// the first voxel outside it). Scalars rather than arrays indexed by the chosen axis, so that
+// the state stays in registers.
+inline __attribute__((always_inline)) int64_t Walk(const uint64_t* solid, int64_t index, int* x,
+                                                   int* y, int* z, WalkAxis ax, WalkAxis ay,
+                                                   WalkAxis az) {
+  int vx = *x, vy = *y, vz = *z;
+  while (true) {
+    if (ax.t_max < ay.t_max && ax.t_max < az.t_max) {
+      vx += ax.step;
+      if (vx == ax.end) break;
+      ax.t_max += ax.t_delta;
+      index += ax.index_step;
+    } else if (!(ax.t_max < ay.t_max) && ay.t_max < az.t_max) {
+      vy += ay.step;
+      if (vy == ay.end) break;
+      ay.t_max += ay.t_delta;
+      index += ay.index_step;
+    } else {
+      vz += az.step;
+      if (vz == az.end) break;
+      az.t_max += az.t_delta;
+      index += az.index_step;
+    }
+    if (((solid[index >> 6] >> (index & 63)) & 1) != 0) {
+      *x = vx;
+      *y = vy;
+      *z = vz;
+      return index;
+    }
+  }
+  *x = vx;
+  *y = vy;
+  *z = vz;
+  return RayImage::kNoVoxel;
+}
+
+}  // namespace
+
 int64_t RayImage::Step(int pixel,
                        const uint64_t* solid,
                        int voxel[3],
                        bool skip_current,
                        const int lo[3],
                        const int hi[3]) const {
-  // The hottest loop of ray-cast carving: per axis scalars rather than arrays indexed by the
-  // chosen axis, so that the state stays in registers.
   const Eigen::Vector3i& n = grid_.dimensions();
   const int64_t stride_y = n.x(), stride_z = static_cast<int64_t>(n.x()) * n.y();
   int x = voxel[0], y = voxel[1], z = voxel[2];
-  int64_t index = x + stride_y * y + stride_z * z;
-  const auto is_solid = [solid](int64_t i) { return ((solid[i >> 6] >> (i & 63)) & 1) != 0; };
-  if (!skip_current && is_solid(index)) return index;
+  const int64_t index = x + stride_y * y + stride_z * z;
+  if (!skip_current && ((solid[index >> 6] >> (index & 63)) & 1) != 0) return index;
   const Eigen::Vector3d d = GridDirection(pixel);
-  // Amanatides-Woo state of the current voxel, per axis: the ray parameter where the ray leaves
-  // it through that axis's far face (infinite along an axis plane: that axis never steps), the
-  // parameter length of one voxel, the step, its index stride and the coordinate that means
-  // the ray has left the region.
-  const auto axis_state = [&](int axis, int coordinate, int64_t stride, double* t_max,
-                              double* t_delta, int* step, int64_t* index_step, int* end) {
-    const double inverse = 1.0 / d[axis];
-    const bool up = d[axis] > 0.0;
-    *t_max = d[axis] == 0.0 ? kInfinity : (coordinate + (up ? 1 : 0) - centre_grid_[axis]) * inverse;
-    *t_delta = std::abs(inverse);
-    *step = up ? 1 : -1;
-    *index_step = up ? stride : -stride;
-    *end = up ? hi[axis] : lo[axis] - 1;
-  };
-  double tx, ty, tz, dx, dy, dz;
-  int step_x, step_y, step_z, end_x, end_y, end_z;
-  int64_t index_x, index_y, index_z;
-  axis_state(0, x, 1, &tx, &dx, &step_x, &index_x, &end_x);
-  axis_state(1, y, stride_y, &ty, &dy, &step_y, &index_y, &end_y);
-  axis_state(2, z, stride_z, &tz, &dz, &step_z, &index_z, &end_z);
-  while (true) {
-    if (tx < ty && tx < tz) {
-      x += step_x;
-      if (x == end_x) break;
-      tx += dx;
-      index += index_x;
-    } else if (!(tx < ty) && ty < tz) {
-      y += step_y;
-      if (y == end_y) break;
-      ty += dy;
-      index += index_y;
-    } else {
-      z += step_z;
-      if (z == end_z) break;
-      tz += dz;
-      index += index_z;
-    }
-    if (is_solid(index)) {
-      voxel[0] = x;
-      voxel[1] = y;
-      voxel[2] = z;
-      return index;
-    }
-  }
+  const Eigen::Vector3d& c = centre_grid_;
+  const int64_t reached =
+      Walk(solid, index, &x, &y, &z, StartAxis(d.x(), x - c.x(), (x + 1) - c.x(), 1, lo[0], hi[0]),
+           StartAxis(d.y(), y - c.y(), (y + 1) - c.y(), stride_y, lo[1], hi[1]),
+           StartAxis(d.z(), z - c.z(), (z + 1) - c.z(), stride_z, lo[2], hi[2]));
   voxel[0] = x;
   voxel[1] = y;
   voxel[2] = z;
-  return kNoVoxel;
+  return reached;
+}
+
+void RayImage::AdvanceFromCarved(const Eigen::Vector3i& voxel,
+                                 const PixelRef* begin,
+                                 const PixelRef* end,
+                                 const Volume& volume,
+                                 std::vector<int64_t>* reached) {
+  const Eigen::Vector3i& n = grid_.dimensions();
+  const int64_t stride_y = n.x(), stride_z = static_cast<int64_t>(n.x()) * n.y();
+  const int64_t start = voxel.x() + stride_y * voxel.y() + stride_z * voxel.z();
+  const uint64_t* solid = volume.solid_bits().data();
+  DCHECK(((solid[start >> 6] >> (start & 63)) & 1) == 0) << "AdvanceFromCarved: voxel is solid";
+  // The voxel's faces as offsets from the camera centre, as Step works them out per ray.
+  const Eigen::Vector3d& c = centre_grid_;
+  const double low_x = voxel.x() - c.x(), high_x = (voxel.x() + 1) - c.x();
+  const double low_y = voxel.y() - c.y(), high_y = (voxel.y() + 1) - c.y();
+  const double low_z = voxel.z() - c.z(), high_z = (voxel.z() + 1) - c.z();
+  for (const PixelRef* ref = begin; ref != end; ++ref) {
+    const int pixel = static_cast<int>(ref->pixel);
+    DCHECK_EQ(keys_[pixel], Key(voxel));
+    const Eigen::Vector3d d = GridDirection(pixel);
+    int x = voxel.x(), y = voxel.y(), z = voxel.z();
+    const int64_t index =
+        Walk(solid, start, &x, &y, &z, StartAxis(d.x(), low_x, high_x, 1, 0, n.x()),
+             StartAxis(d.y(), low_y, high_y, stride_y, 0, n.y()),
+             StartAxis(d.z(), low_z, high_z, stride_z, 0, n.z()));
+    if (index == kNoVoxel) {
+      keys_[pixel] = kInactive;
+      continue;
+    }
+    keys_[pixel] = Key(Eigen::Vector3i(x, y, z));
+    MarkArrival(index);
+    reached->push_back(index);
+  }
 }
 
 bool RayImage::SkipEmptyBlocks(int pixel, const BlockOccupancy& blocks, int voxel[3]) const {

@@ -242,6 +242,61 @@ TEST(RayImage, ArrivalBitsSayExactlyWhichSolidVoxelsSomeRayEndsIn) {
   }
 }
 
+TEST(RayImage, AdvancingACarvedVoxelsRaysTogetherReachesWhatAdvancingEachOneDoes) {
+  const VoxelGrid grid(
+      Eigen::AlignedBox3d(Eigen::Vector3d(-1, -0.7, -0.5), Eigen::Vector3d(1, 0.7, 0.6)), 23);
+  std::mt19937_64 random(5);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  int64_t rays_stepped = 0, rays_gone = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    Volume volume = RandomBalls(grid, 2 + trial % 5, &random);
+    // A 40x30 camera around the box (every third inside it) looking at a point inside.
+    Eigen::Vector3d centre(uniform(random), uniform(random), uniform(random));
+    centre = (trial % 3 == 2 ? 0.4 : 3.0) * centre.normalized();
+    const Eigen::Vector3d target(0.8 * uniform(random), 0.5 * uniform(random), 0.4 * uniform(random));
+    const Eigen::Vector3d forward = (target - centre).normalized();
+    const Eigen::Vector3d right = forward.cross(Eigen::Vector3d(0.3, 0.1, 1)).normalized();
+    const Eigen::Vector3d down = forward.cross(right);
+    Eigen::Matrix3d world_from_pixel;
+    world_from_pixel.col(0) = right / 25.0;
+    world_from_pixel.col(1) = down / 25.0;
+    world_from_pixel.col(2) = forward - 20.0 * right / 25.0 - 15.0 * down / 25.0;
+    RayImage one_by_one(grid, world_from_pixel, centre, 40, 30);
+    RayImage together(grid, world_from_pixel, centre, 40, 30);
+    one_by_one.Initialise(volume);
+    together.Initialise(volume);
+    for (int carving = 0; carving < 200; ++carving) {
+      const int pixel = static_cast<int>(random() % (40 * 30));
+      const int64_t voxel = one_by_one.CurrentVoxel(pixel);
+      if (voxel == RayImage::kNoVoxel) continue;
+      volume.Carve(voxel, nullptr);
+      std::vector<PixelRef> refs;
+      std::vector<int64_t> expected, reached;
+      for (int other = 0; other < 40 * 30; ++other) {
+        if (one_by_one.CurrentVoxel(other) != voxel) continue;
+        refs.emplace_back(0, other);
+        const int64_t next = one_by_one.Advance(other, volume);
+        if (next != RayImage::kNoVoxel) expected.push_back(next);
+        rays_gone += next == RayImage::kNoVoxel;
+      }
+      together.AdvanceFromCarved(grid.Voxel(voxel), refs.data(), refs.data() + refs.size(),
+                                 volume, &reached);
+      rays_stepped += static_cast<int64_t>(refs.size());
+      ASSERT_EQ(reached, expected) << "trial " << trial << " carving " << carving;
+      for (int other = 0; other < 40 * 30; ++other) {
+        ASSERT_EQ(together.CurrentVoxel(other), one_by_one.CurrentVoxel(other))
+            << "trial " << trial << " carving " << carving << " pixel " << other;
+      }
+    }
+    for (int64_t voxel = 0; voxel < grid.num_voxels(); ++voxel) {
+      ASSERT_EQ(together.MayEndIn(voxel), one_by_one.MayEndIn(voxel)) << "voxel " << voxel;
+    }
+  }
+  // Many rays stepped, some of them out of the box.
+  EXPECT_GT(rays_stepped, 2000);
+  EXPECT_GT(rays_gone, 0);
+}
+
 TEST(RayImage, RaysMissingTheBoxOrMaskedOutHaveNoVoxel) {
   Volume volume(kGrid);
   Eigen::Matrix3d away = Eigen::Matrix3d::Zero();

@@ -55,11 +55,6 @@ Eigen::Vector3d VoxelGrid::Centre(const Eigen::Vector3i& voxel) const {
   return origin_ + voxel_size_ * (voxel.cast<double>().array() + 0.5).matrix();
 }
 
-Eigen::Vector3d VoxelGrid::Corner(const Eigen::Vector3i& voxel, int c) const {
-  const Eigen::Vector3d offset(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-  return origin_ + voxel_size_ * (voxel.cast<double>() + offset);
-}
-
 bool ClipRayToBox(const Eigen::Vector3d& origin,
                   const Eigen::Vector3d& direction,
                   const Eigen::AlignedBox3d& box,

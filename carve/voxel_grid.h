@@ -39,8 +39,12 @@ class VoxelGrid {
   // The voxel holding a world point (floor of grid coordinates; may lie outside the grid).
   Eigen::Vector3i VoxelOf(const Eigen::Vector3d& world) const;
   Eigen::Vector3d Centre(const Eigen::Vector3i& voxel) const;
-  // Corner c (bit 0: +x, bit 1: +y, bit 2: +z) of a voxel, in world coordinates.
-  Eigen::Vector3d Corner(const Eigen::Vector3i& voxel, int c) const;
+  // Corner c (bit 0: +x, bit 1: +y, bit 2: +z) of a voxel, in world coordinates. (Inline: every
+  // footprint starts from one.)
+  Eigen::Vector3d Corner(const Eigen::Vector3i& voxel, int c) const {
+    const Eigen::Vector3d offset(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    return origin_ + voxel_size_ * (voxel.cast<double>() + offset);
+  }
 
  private:
   Eigen::Vector3d origin_;

@@ -53,5 +53,21 @@ TEST(Footprint, IsClippedToTheImageAndEmptyBehindTheCamera) {
   EXPECT_TRUE(ComputeFootprint(Camera(), 100, 100, outside, Eigen::Vector3i(0, 0, 0)).empty());
 }
 
+TEST(Footprint, AVoxelAlmostOnTheCamerasPlaneCoversThePhotoItStraddles) {
+  // Corners at depth 1e-9: projected 1e11 pixels from the principal point, beyond any int. The
+  // voxel straddles the optical axis, so it covers the whole photo; one beside the axis covers
+  // none of it.
+  const VoxelGrid grid(
+      Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, 1e-9), Eigen::Vector3d(1, 1, 2 + 1e-9)), 1);
+  const Footprint straddling = ComputeFootprint(Camera(), 100, 100, grid, Eigen::Vector3i(0, 0, 0));
+  EXPECT_EQ(straddling.col_min, 0);
+  EXPECT_EQ(straddling.col_max, 99);
+  EXPECT_EQ(straddling.row_min, 0);
+  EXPECT_EQ(straddling.row_max, 99);
+  const VoxelGrid beside(
+      Eigen::AlignedBox3d(Eigen::Vector3d(1, 1, 1e-9), Eigen::Vector3d(3, 3, 2 + 1e-9)), 1);
+  EXPECT_TRUE(ComputeFootprint(Camera(), 100, 100, beside, Eigen::Vector3i(0, 0, 0)).empty());
+}
+
 }  // namespace
 }  // namespace raycarve

@@ -730,6 +730,11 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       buffers.reached_spans.clear();
       for (int k : batch_carved_) {
         const size_t begin = buffers.reached.size();
+        if (spans[k].begin == spans[k].end) {  // most views see none of a voxel
+          buffers.reached_spans.push_back(
+              {static_cast<uint32_t>(begin), static_cast<uint32_t>(begin)});
+          continue;
+        }
         ray_visibility_->AdvanceRaysFrom(carving->entries[k].coordinates,
                                          vis.data() + spans[k].begin, vis.data() + spans[k].end,
                                          &buffers.reached);
@@ -750,16 +755,23 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       spans.resize(num_entries);
       // The footprints first, so that the rays and photo rows of the voxels a few ahead can be
       // fetched while a voxel's are scanned: the scans wait on memory more than they compute.
+      // Most views see none of a voxel (no ray of theirs ends in it: an empty footprint); only
+      // the others are scanned, and fetched ahead.
       std::vector<Footprint>& footprints = buffers.footprints;
+      std::vector<int>& seen = buffers.seen;
       footprints.resize(num_entries);
+      seen.clear();
       for (int k = 0; k < num_entries; ++k) {
         footprints[k] = ray_visibility_->VisFootprint(finding->entries[k].coordinates, view);
+        if (!footprints[k].empty()) seen.push_back(k);
       }
       const cv::Mat& photo = views_[view].image;
       const uint8_t* image = photo.data;
-      for (int k = 0; k < num_entries; ++k) {
-        if (k + kPrefetchAhead < num_entries) {
-          const Footprint& ahead = footprints[k + kPrefetchAhead];
+      const int num_seen = static_cast<int>(seen.size());
+      int unseen = 0;  // entries before it not seen by the view have their (empty) spans
+      for (int i = 0; i < num_seen; ++i) {
+        if (i + kPrefetchAhead < num_seen) {
+          const Footprint& ahead = footprints[seen[i + kPrefetchAhead]];
           ray_visibility_->PrefetchRays(ahead, view);
           for (int row = ahead.row_min; row <= ahead.row_max; ++row) {
             const uint8_t* line = photo.ptr<uint8_t>(row);
@@ -767,11 +779,15 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
             __builtin_prefetch(line + 3 * ahead.col_max + 2);
           }
         }
+        const int k = seen[i];
+        const uint32_t before = static_cast<uint32_t>(vis.size());
+        for (; unseen < k; ++unseen) spans[unseen] = {before, before};
+        unseen = k + 1;
         Span& span = spans[k];
-        span.begin = static_cast<uint32_t>(vis.size());
+        span.begin = before;
         ray_visibility_->AppendVis(footprints[k], finding->entries[k].coordinates, view, &vis);
         span.end = static_cast<uint32_t>(vis.size());
-        if (span.end == span.begin) continue;  // most views see none of a voxel
+        if (span.end == span.begin) continue;
         for (uint32_t first = span.begin; first < span.end; first += kMaxHitPixels) {
           const uint32_t last = std::min(span.end, first + kMaxHitPixels);
           uint32_t sum[3] = {0, 0, 0}, sum_squares[3] = {0, 0, 0};
@@ -791,6 +807,8 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
           }
         }
       }
+      const uint32_t after = static_cast<uint32_t>(vis.size());
+      for (; unseen < num_entries; ++unseen) spans[unseen] = {after, after};
     }
     buffers.nanoseconds += ElapsedNanoseconds(start);
   };

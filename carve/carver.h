@@ -466,6 +466,7 @@ class IncrementalCarver {
     std::vector<Span> spans[2];
     std::vector<BatchHit> hits[2];
     std::vector<Footprint> footprints;
+    std::vector<int> seen;  // the batch's voxels with a non-empty footprint in the view
     std::vector<int64_t> reached;
     std::vector<Span> reached_spans;
     int64_t nanoseconds = 0;

@@ -157,29 +157,39 @@ Volume RandomBalls(const VoxelGrid& grid, int balls, std::mt19937_64* random) {
   return Volume(grid, std::move(solid));
 }
 
+// A 40x30 camera `distance` from the origin in a random direction, looking at a random point of
+// the box (-0.8, -0.5, -0.4) .. (0.8, 0.5, 0.4): its world_from_pixel (pixel (u, v, 1) ->
+// forward + (u - 20) right + (v - 15) down, right and down 1/25 long) and its `centre`.
+Eigen::Matrix3d RandomLookAt(double distance, std::mt19937_64* random, Eigen::Vector3d* centre) {
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  *centre = Eigen::Vector3d(uniform(*random), uniform(*random), uniform(*random));
+  *centre = distance * centre->normalized();
+  const Eigen::Vector3d target(0.8 * uniform(*random), 0.5 * uniform(*random),
+                               0.4 * uniform(*random));
+  const Eigen::Vector3d forward = (target - *centre).normalized();
+  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d(0.3, 0.1, 1)).normalized();
+  const Eigen::Vector3d down = forward.cross(right);
+  Eigen::Matrix3d world_from_pixel;
+  world_from_pixel.col(0) = right / 25.0;
+  world_from_pixel.col(1) = down / 25.0;
+  world_from_pixel.col(2) = forward - 20.0 * right / 25.0 - 15.0 * down / 25.0;
+  return world_from_pixel;
+}
+
 TEST(RayImage, CrossingEmptyBlocksReachesTheSameFirstSolidVoxelsAsSteppingEveryVoxel) {
   const VoxelGrid grid(
       Eigen::AlignedBox3d(Eigen::Vector3d(-1, -0.7, -0.5), Eigen::Vector3d(1, 0.7, 0.6)), 23);
   ASSERT_EQ(grid.dimensions(), Eigen::Vector3i(23, 17, 13));
   std::mt19937_64 random(7);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   int64_t hits = 0, rays_compared = 0;
   for (int trial = 0; trial < 20; ++trial) {
     const Volume volume = RandomBalls(grid, trial % 5 == 0 ? 0 : 2 + trial % 7, &random);
     const BlockOccupancy blocks(volume);
-    // A 40x30 camera somewhere around the box, looking at a random point inside it; every
-    // fourth inside the box, where blocks reach behind the camera (pixels are then traced
-    // everywhere, not only under the blocks' projections).
-    Eigen::Vector3d centre(uniform(random), uniform(random), uniform(random));
-    centre = (trial % 4 == 3 ? 0.4 : 3.0) * centre.normalized();
-    const Eigen::Vector3d target(0.8 * uniform(random), 0.5 * uniform(random), 0.4 * uniform(random));
-    const Eigen::Vector3d forward = (target - centre).normalized();
-    const Eigen::Vector3d right = forward.cross(Eigen::Vector3d(0.3, 0.1, 1)).normalized();
-    const Eigen::Vector3d down = forward.cross(right);
-    Eigen::Matrix3d world_from_pixel;  // pixel (u, v, 1) -> forward + (u - 20) r + (v - 15) d
-    world_from_pixel.col(0) = right / 25.0;
-    world_from_pixel.col(1) = down / 25.0;
-    world_from_pixel.col(2) = forward - 20.0 * right / 25.0 - 15.0 * down / 25.0;
+    // A camera somewhere around the box; every fourth inside it, where blocks reach behind the
+    // camera (pixels are then traced everywhere, not only under the blocks' projections).
+    Eigen::Vector3d centre;
+    const Eigen::Matrix3d world_from_pixel =
+        RandomLookAt(trial % 4 == 3 ? 0.4 : 3.0, &random, &centre);
     RayImage every_voxel(grid, world_from_pixel, centre, 40, 30);
     RayImage by_blocks(grid, world_from_pixel, centre, 40, 30);
     RayImage threaded(grid, world_from_pixel, centre, 40, 30);
@@ -246,21 +256,13 @@ TEST(RayImage, AdvancingACarvedVoxelsRaysTogetherReachesWhatAdvancingEachOneDoes
   const VoxelGrid grid(
       Eigen::AlignedBox3d(Eigen::Vector3d(-1, -0.7, -0.5), Eigen::Vector3d(1, 0.7, 0.6)), 23);
   std::mt19937_64 random(5);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   int64_t rays_stepped = 0, rays_gone = 0;
   for (int trial = 0; trial < 12; ++trial) {
     Volume volume = RandomBalls(grid, 2 + trial % 5, &random);
-    // A 40x30 camera around the box (every third inside it) looking at a point inside.
-    Eigen::Vector3d centre(uniform(random), uniform(random), uniform(random));
-    centre = (trial % 3 == 2 ? 0.4 : 3.0) * centre.normalized();
-    const Eigen::Vector3d target(0.8 * uniform(random), 0.5 * uniform(random), 0.4 * uniform(random));
-    const Eigen::Vector3d forward = (target - centre).normalized();
-    const Eigen::Vector3d right = forward.cross(Eigen::Vector3d(0.3, 0.1, 1)).normalized();
-    const Eigen::Vector3d down = forward.cross(right);
-    Eigen::Matrix3d world_from_pixel;
-    world_from_pixel.col(0) = right / 25.0;
-    world_from_pixel.col(1) = down / 25.0;
-    world_from_pixel.col(2) = forward - 20.0 * right / 25.0 - 15.0 * down / 25.0;
+    // A camera around the box (every third inside it).
+    Eigen::Vector3d centre;
+    const Eigen::Matrix3d world_from_pixel =
+        RandomLookAt(trial % 3 == 2 ? 0.4 : 3.0, &random, &centre);
     RayImage one_by_one(grid, world_from_pixel, centre, 40, 30);
     RayImage together(grid, world_from_pixel, centre, 40, 30);
     one_by_one.Initialise(volume);

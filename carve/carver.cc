@@ -752,7 +752,7 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       vis.clear();
       hits.clear();
       const int num_entries = static_cast<int>(finding->entries.size());
-      spans.resize(num_entries);
+      spans.assign(num_entries, Span{});  // empty, unless the view sees the voxel
       // The footprints first, so that the rays and photo rows of the voxels a few ahead can be
       // fetched while a voxel's are scanned: the scans wait on memory more than they compute.
       // Most views see none of a voxel (no ray of theirs ends in it: an empty footprint); only
@@ -768,7 +768,6 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       const cv::Mat& photo = views_[view].image;
       const uint8_t* image = photo.data;
       const int num_seen = static_cast<int>(seen.size());
-      int unseen = 0;  // entries before it not seen by the view have their (empty) spans
       for (int i = 0; i < num_seen; ++i) {
         if (i + kPrefetchAhead < num_seen) {
           const Footprint& ahead = footprints[seen[i + kPrefetchAhead]];
@@ -780,11 +779,8 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
           }
         }
         const int k = seen[i];
-        const uint32_t before = static_cast<uint32_t>(vis.size());
-        for (; unseen < k; ++unseen) spans[unseen] = {before, before};
-        unseen = k + 1;
         Span& span = spans[k];
-        span.begin = before;
+        span.begin = static_cast<uint32_t>(vis.size());
         ray_visibility_->AppendVis(footprints[k], finding->entries[k].coordinates, view, &vis);
         span.end = static_cast<uint32_t>(vis.size());
         if (span.end == span.begin) continue;
@@ -807,8 +803,6 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
           }
         }
       }
-      const uint32_t after = static_cast<uint32_t>(vis.size());
-      for (; unseen < num_entries; ++unseen) spans[unseen] = {after, after};
     }
     buffers.nanoseconds += ElapsedNanoseconds(start);
   };

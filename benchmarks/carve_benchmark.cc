@@ -18,14 +18,27 @@
 // machine's speed drifts within seconds: runs side by side compare, runs minutes apart do not),
 // and a last table gives per configuration the median convergence time and its speed-up over
 // the first thread count's median.
+// Before each run (--core_check 1, the default), a pointer chase over 8 MiB on each core the
+// process may use: its nanoseconds per load, the last column and "core_latency_ns". On a virtual
+// machine whose cores share their caches with other tenants, one core's figure can be several
+// times the other's, and for minutes; the two-thread times then lose what the table says
+// (README, "Threads"). Runs compare when their cores' figures do.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <numeric>
+#include <random>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <vector>
+
+#if defined(__linux__)
+#include <sched.h>
+#endif
 
 #include "calib/calibrated_view.h"
 #include "carve/carver.h"
@@ -41,6 +54,54 @@ double PeakResidentMiB() {
     if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
   }
   return -1.0;
+}
+
+// A cycle through `bytes` of memory, one step per 64-byte line, in a random order: each load's
+// address is the previous load's value, so the loads cannot overlap (a cache or memory latency).
+std::vector<uint64_t> MakeChase(size_t bytes) {
+  const size_t lines = bytes / 64, stride = 64 / sizeof(uint64_t);
+  std::vector<uint64_t> order(lines);
+  std::iota(order.begin(), order.end(), uint64_t{0});
+  std::shuffle(order.begin(), order.end(), std::mt19937_64(1));
+  std::vector<uint64_t> chase(lines * stride, 0);
+  for (size_t i = 0; i < lines; ++i) chase[order[i] * stride] = order[(i + 1) % lines] * stride;
+  return chase;
+}
+
+// Nanoseconds per load of `chase` on each core this process may use (in core order), each on a
+// thread pinned to it: one warm-up lap, then `loads` loads. Empty where cores cannot be listed.
+std::vector<double> CoreLatencies(const std::vector<uint64_t>& chase, int loads) {
+  std::vector<double> nanoseconds;
+#if defined(__linux__)
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof(allowed), &allowed) != 0) return nanoseconds;
+  const size_t lines = chase.size() / (64 / sizeof(uint64_t));
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+    if (!CPU_ISSET(cpu, &allowed)) continue;
+    double result = -1.0;
+    std::thread probe([&] {
+      cpu_set_t one;
+      CPU_ZERO(&one);
+      CPU_SET(cpu, &one);
+      if (sched_setaffinity(0, sizeof(one), &one) != 0) return;
+      uint64_t at = 0;
+      for (size_t i = 0; i < lines; ++i) at = chase[at];
+      const auto start = std::chrono::steady_clock::now();
+      for (int i = 0; i < loads; ++i) at = chase[at];
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      // `at` is used, so the loads are not optimised away.
+      result = at == chase.size() ? -2.0 : 1e9 * seconds / loads;
+    });
+    probe.join();
+    nanoseconds.push_back(result);
+  }
+#else
+  (void)chase;
+  (void)loads;
+#endif
+  return nanoseconds;
 }
 
 struct Quality {
@@ -101,6 +162,7 @@ int main(int argc, char** argv) {
   std::vector<int> level_counts = {1, raycarve::kAutomaticLevels};
   std::vector<int> batch_sizes = {raycarve::CarveOptions().batch_voxels};
   int repeats = 1;
+  bool core_check = true;
   if (raycarve::ResolveNumThreads(-1) > 1) thread_counts.push_back(raycarve::ResolveNumThreads(-1));
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
@@ -110,6 +172,7 @@ int main(int argc, char** argv) {
     else if (flag == "--threshold") threshold = std::stod(value);
     else if (flag == "--repeats") repeats = std::max(1, std::stoi(value));
     else if (flag == "--incremental_statistics") incremental_statistics = std::stoi(value) != 0;
+    else if (flag == "--core_check") core_check = std::stoi(value) != 0;
     else if (flag == "--vis_lookup") {
       raycarve::VisLookup lookup;
       if (value != "both" && !raycarve::VisLookupFromString(value, &lookup)) {
@@ -149,10 +212,12 @@ int main(int argc, char** argv) {
   }
 
   const std::vector<Eigen::Vector3d> truth = raycarve::SampleTrueSurface(scene, 20000, 5, 2);
-  std::printf("%-10s %-10s %-5s %-7s %-6s %-14s %8s %10s %8s %10s %10s %10s %12s %12s %9s %12s   %s\n",
+  std::printf("%-10s %-10s %-5s %-7s %-6s %-14s %8s %10s %8s %10s %10s %10s %12s %12s %9s %12s   %s   %s\n",
               "resolution", "vis", "batch", "threads", "levels", "grid", "set-up s", "converge s",
               "colour s", "parallel s", "memory MiB", "peak RSS", "carved", "evaluated",
-              "precision", "completeness", "work s / wait s per thread");
+              "precision", "completeness", "work s / wait s per thread", "ns per load per core");
+  const std::vector<uint64_t> chase =
+      core_check ? MakeChase(size_t{8} << 20) : std::vector<uint64_t>();
   std::ostringstream json;
   json << "[";
   bool first = true;
@@ -180,6 +245,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "resolution %d: %s\n", resolutions[k], reason.c_str());
       return 1;
     }
+    const std::vector<double> latencies =
+        core_check ? CoreLatencies(chase, 1 << 20) : std::vector<double>();
     const raycarve::CarveResult result = raycarve::CarveVolume(views, scene.object_box, options);
     const raycarve::CarveStatistics& s = result.statistics;
     char grid[32];
@@ -196,12 +263,20 @@ int main(int argc, char** argv) {
                     t == 0 ? "" : ", ", work, wait);
       threads_json += entry;
     }
-    std::printf("%-10d %-10s %-5d %-7d %-6d %-14s %8.2f %10.2f %8.2f %10.2f %10.1f %10.1f %12lld %12lld %8.1f%% %11.1f%%   %s\n",
+    std::string latency_text, latency_json;
+    for (size_t c = 0; c < latencies.size(); ++c) {
+      char entry[32];
+      std::snprintf(entry, sizeof(entry), "%s%.0f", c == 0 ? "" : "/", latencies[c]);
+      latency_text += entry;
+      std::snprintf(entry, sizeof(entry), "%s%.1f", c == 0 ? "" : ", ", latencies[c]);
+      latency_json += entry;
+    }
+    std::printf("%-10d %-10s %-5d %-7d %-6d %-14s %8.2f %10.2f %8.2f %10.2f %10.1f %10.1f %12lld %12lld %8.1f%% %11.1f%%   %s   %s\n",
                 resolutions[k], vis.c_str(), batch, s.threads, static_cast<int>(s.levels.size()),
                 grid, s.setup_seconds, s.carve_seconds, s.colour_seconds, s.parallel_seconds,
                 memory, PeakResidentMiB(), static_cast<long long>(s.carved),
                 static_cast<long long>(s.evaluated), 100.0 * quality.precision,
-                100.0 * quality.completeness, threads_text.c_str());
+                100.0 * quality.completeness, threads_text.c_str(), latency_text.c_str());
     std::fflush(stdout);
     const Key key{resolutions[k], static_cast<int>(s.levels.size()), vis, batch, s.threads};
     if (convergence.count(key) == 0) key_order.push_back(key);
@@ -220,6 +295,7 @@ int main(int argc, char** argv) {
          << ", \"parallel_seconds\": " << s.parallel_seconds
          << ", \"parallel_runs\": " << s.parallel_runs << ", \"inline_runs\": " << s.inline_runs
          << ", \"per_thread\": [" << threads_json << "]"
+         << ", \"core_latency_ns\": [" << latency_json << "]"
          << ", \"memory_mib\": " << memory
          << ", \"peak_rss_mib\": " << PeakResidentMiB() << ", \"carved\": " << s.carved
          << ", \"evaluated\": " << s.evaluated << ", \"precision\": " << quality.precision

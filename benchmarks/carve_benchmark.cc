@@ -20,9 +20,9 @@
 // the first thread count's median.
 // Before each run (--core_check 1, the default), a pointer chase over 8 MiB on each core the
 // process may use: its nanoseconds per load, the last column and "core_latency_ns". On a virtual
-// machine whose cores share their caches with other tenants, one core's figure can be several
-// times the other's, and for minutes; the two-thread times then lose what the table says
-// (README, "Threads"). Runs compare when their cores' figures do.
+// machine whose cores share their last-level cache with other tenants, a core's figure moves
+// from run to run (20-150 ns measured on this 2-core VM, the two cores rarely alike), and the
+// carve's times with it (README, "Threads"): runs compare when their cores' figures do.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

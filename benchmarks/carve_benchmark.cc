@@ -22,8 +22,11 @@
 // process may use: its nanoseconds per load, the last column and "core_latency_ns". On a virtual
 // machine whose cores share their last-level cache with other tenants, a core's figure moves
 // from run to run (20-150 ns measured on this 2-core VM, the two cores rarely alike), and the
-// carve's times with it (README, "Threads"): runs compare when their cores' figures do.
+// carve's times with it (README, "Threads"): runs compare when their cores' figures do. Then
+// the round trip of a cache line between the first two cores ("trip", "core_round_trip_ns"):
+// the least a hand-over between the carve's threads costs.
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -102,6 +105,59 @@ std::vector<double> CoreLatencies(const std::vector<uint64_t>& chase, int loads)
   (void)loads;
 #endif
   return nanoseconds;
+}
+
+// Nanoseconds for a write on the first core this process may use to be seen on the second and
+// answered (a cache line's trip there and back: what every hand-over between the carve's threads
+// costs at least), the median of 16 rounds of 4096 trips, each side on a thread pinned to its core.
+// Negative where the process has fewer than two cores.
+double CoreRoundTrip() {
+#if defined(__linux__)
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof(allowed), &allowed) != 0 || CPU_COUNT(&allowed) < 2) return -1.0;
+  int cores[2] = {-1, -1};
+  for (int cpu = 0, found = 0; cpu < CPU_SETSIZE && found < 2; ++cpu) {
+    if (CPU_ISSET(cpu, &allowed)) cores[found++] = cpu;
+  }
+  constexpr int kTrips = 4096, kRounds = 16;
+  alignas(64) std::atomic<int> flag{0};
+  const auto pin = [](int cpu) {
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(cpu, &one);
+    sched_setaffinity(0, sizeof(one), &one);
+  };
+  std::thread answer([&] {
+    pin(cores[1]);
+    for (int i = 0; i < kTrips * kRounds; ++i) {
+      while (flag.load(std::memory_order_acquire) != 2 * i + 1) {
+      }
+      flag.store(2 * i + 2, std::memory_order_release);
+    }
+  });
+  std::vector<double> rounds;
+  std::thread ask([&] {
+    pin(cores[0]);
+    for (int round = 0; round < kRounds; ++round) {
+      const auto start = std::chrono::steady_clock::now();
+      for (int i = round * kTrips; i < (round + 1) * kTrips; ++i) {
+        flag.store(2 * i + 1, std::memory_order_release);
+        while (flag.load(std::memory_order_acquire) != 2 * i + 2) {
+        }
+      }
+      rounds.push_back(1e9 / kTrips *
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+                           .count());
+    }
+  });
+  ask.join();
+  answer.join();
+  std::sort(rounds.begin(), rounds.end());
+  return rounds[kRounds / 2];
+#else
+  return -1.0;
+#endif
 }
 
 struct Quality {
@@ -215,7 +271,8 @@ int main(int argc, char** argv) {
   std::printf("%-10s %-10s %-5s %-7s %-6s %-14s %8s %10s %8s %10s %10s %10s %12s %12s %9s %12s   %s   %s\n",
               "resolution", "vis", "batch", "threads", "levels", "grid", "set-up s", "converge s",
               "colour s", "parallel s", "memory MiB", "peak RSS", "carved", "evaluated",
-              "precision", "completeness", "work s / wait s per thread", "ns per load per core");
+              "precision", "completeness", "work s / wait s per thread",
+              "ns per load per core, round trip");
   const std::vector<uint64_t> chase =
       core_check ? MakeChase(size_t{8} << 20) : std::vector<uint64_t>();
   std::ostringstream json;
@@ -247,6 +304,7 @@ int main(int argc, char** argv) {
     }
     const std::vector<double> latencies =
         core_check ? CoreLatencies(chase, 1 << 20) : std::vector<double>();
+    const double round_trip = core_check ? CoreRoundTrip() : -1.0;
     const raycarve::CarveResult result = raycarve::CarveVolume(views, scene.object_box, options);
     const raycarve::CarveStatistics& s = result.statistics;
     char grid[32];
@@ -270,6 +328,11 @@ int main(int argc, char** argv) {
       latency_text += entry;
       std::snprintf(entry, sizeof(entry), "%s%.1f", c == 0 ? "" : ", ", latencies[c]);
       latency_json += entry;
+    }
+    if (round_trip > 0.0) {
+      char entry[32];
+      std::snprintf(entry, sizeof(entry), ", trip %.0f", round_trip);
+      latency_text += entry;
     }
     std::printf("%-10d %-10s %-5d %-7d %-6d %-14s %8.2f %10.2f %8.2f %10.2f %10.1f %10.1f %12lld %12lld %8.1f%% %11.1f%%   %s   %s\n",
                 resolutions[k], vis.c_str(), batch, s.threads, static_cast<int>(s.levels.size()),
@@ -296,6 +359,7 @@ int main(int argc, char** argv) {
          << ", \"parallel_runs\": " << s.parallel_runs << ", \"inline_runs\": " << s.inline_runs
          << ", \"per_thread\": [" << threads_json << "]"
          << ", \"core_latency_ns\": [" << latency_json << "]"
+         << ", \"core_round_trip_ns\": " << round_trip
          << ", \"memory_mib\": " << memory
          << ", \"peak_rss_mib\": " << PeakResidentMiB() << ", \"carved\": " << s.carved
          << ", \"evaluated\": " << s.evaluated << ", \"precision\": " << quality.precision

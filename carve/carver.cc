@@ -706,7 +706,7 @@ bool IncrementalCarver::BehindKnownSurface(int64_t voxel,
 }
 
 void IncrementalCarver::FormBatch(Batch* batch) {
-  batch->entries.clear();
+  batch->Clear();
   while (static_cast<int>(batch->entries.size()) < batch_voxels_ && !queue_.empty()) {
     const int64_t voxel = queue_.front();
     queue_.pop_front();
@@ -735,7 +735,7 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
               {static_cast<uint32_t>(begin), static_cast<uint32_t>(begin)});
           continue;
         }
-        ray_visibility_->AdvanceRaysFrom(carving->entries[k].coordinates,
+        ray_visibility_->AdvanceRaysFrom(carving->coordinates[k],
                                          vis.data() + spans[k].begin, vis.data() + spans[k].end,
                                          &buffers.reached);
         const size_t kept =
@@ -762,7 +762,7 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       footprints.resize(num_entries);
       seen.clear();
       for (int k = 0; k < num_entries; ++k) {
-        footprints[k] = ray_visibility_->VisFootprint(finding->entries[k].coordinates, view);
+        footprints[k] = ray_visibility_->VisFootprint(finding->coordinates[k], view);
         if (!footprints[k].empty()) seen.push_back(k);
       }
       const cv::Mat& photo = views_[view].image;
@@ -781,7 +781,7 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
         const int k = seen[i];
         Span& span = spans[k];
         span.begin = static_cast<uint32_t>(vis.size());
-        ray_visibility_->AppendVis(footprints[k], finding->entries[k].coordinates, view, &vis);
+        ray_visibility_->AppendVis(footprints[k], finding->coordinates[k], view, &vis);
         span.end = static_cast<uint32_t>(vis.size());
         if (span.end == span.begin) continue;
         for (uint32_t first = span.begin; first < span.end; first += kMaxHitPixels) {
@@ -892,7 +892,7 @@ void IncrementalCarver::ReturnPendingBatch() {
   for (auto entry = entries.rbegin(); entry != entries.rend(); ++entry) {
     queue_.push_front(entry->voxel);
   }
-  batches_[current_].entries.clear();
+  batches_[current_].Clear();
   batch_found_ = false;
 }
 
@@ -1154,7 +1154,7 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
     constexpr size_t kChunk = 4096;
     Batch& chunk = batches_[current_];
     for (size_t first = 0; first < voxels.size(); first += kChunk) {
-      chunk.entries.clear();
+      chunk.Clear();
       for (size_t i = first; i < std::min(voxels.size(), first + kChunk); ++i) {
         chunk.Add(voxels[i], volume_.grid());
       }
@@ -1166,7 +1166,7 @@ std::vector<ColouredVoxel> IncrementalCarver::ColourSurface() {
         explained += entry.num_pixels;
       }
     }
-    chunk.entries.clear();
+    chunk.Clear();
   } else {
     for (int64_t voxel : volume_.SurfaceVoxels()) {
       const Consistency consistency = Evaluate(voxel);

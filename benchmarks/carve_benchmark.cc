@@ -71,65 +71,69 @@ std::vector<uint64_t> MakeChase(size_t bytes) {
   return chase;
 }
 
-// Nanoseconds per load of `chase` on each core this process may use (in core order), each on a
-// thread pinned to it: one warm-up lap, then `loads` loads. Empty where cores cannot be listed.
-std::vector<double> CoreLatencies(const std::vector<uint64_t>& chase, int loads) {
-  std::vector<double> nanoseconds;
+// The cores this process may run on, in order (empty where the system cannot list them).
+std::vector<int> AllowedCores() {
+  std::vector<int> cores;
 #if defined(__linux__)
   cpu_set_t allowed;
   CPU_ZERO(&allowed);
-  if (sched_getaffinity(0, sizeof(allowed), &allowed) != 0) return nanoseconds;
-  const size_t lines = chase.size() / (64 / sizeof(uint64_t));
+  if (sched_getaffinity(0, sizeof(allowed), &allowed) != 0) return cores;
   for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
-    if (!CPU_ISSET(cpu, &allowed)) continue;
+    if (CPU_ISSET(cpu, &allowed)) cores.push_back(cpu);
+  }
+#endif
+  return cores;
+}
+
+// Binds the calling thread to `core`; false where it cannot.
+bool PinToCore(int core) {
+#if defined(__linux__)
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  CPU_SET(core, &one);
+  return sched_setaffinity(0, sizeof(one), &one) == 0;
+#else
+  (void)core;
+  return false;
+#endif
+}
+
+// Nanoseconds per load of `chase` on each core this process may use (AllowedCores' order), each
+// on a thread pinned to it: one warm-up lap, then `loads` loads (-1 where it could not be pinned).
+std::vector<double> CoreLatencies(const std::vector<uint64_t>& chase, int loads) {
+  std::vector<double> nanoseconds;
+  const size_t lines = chase.size() / (64 / sizeof(uint64_t));
+  for (const int core : AllowedCores()) {
     double result = -1.0;
     std::thread probe([&] {
-      cpu_set_t one;
-      CPU_ZERO(&one);
-      CPU_SET(cpu, &one);
-      if (sched_setaffinity(0, sizeof(one), &one) != 0) return;
+      if (!PinToCore(core)) return;
       uint64_t at = 0;
       for (size_t i = 0; i < lines; ++i) at = chase[at];
       const auto start = std::chrono::steady_clock::now();
       for (int i = 0; i < loads; ++i) at = chase[at];
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      // `at` is used, so the loads are not optimised away.
-      result = at == chase.size() ? -2.0 : 1e9 * seconds / loads;
+      volatile uint64_t sink = at;  // the loads' result is used: they are not optimised away
+      (void)sink;
+      result = 1e9 * seconds / loads;
     });
     probe.join();
     nanoseconds.push_back(result);
   }
-#else
-  (void)chase;
-  (void)loads;
-#endif
   return nanoseconds;
 }
 
 // Nanoseconds for a write on the first core this process may use to be seen on the second and
 // answered (a cache line's trip there and back: what every hand-over between the carve's threads
-// costs at least), the median of 16 rounds of 4096 trips, each side on a thread pinned to its core.
-// Negative where the process has fewer than two cores.
+// costs at least), the median of 16 rounds of 4096 trips, each side on a thread pinned to its
+// core. Negative where the process has fewer than two cores.
 double CoreRoundTrip() {
-#if defined(__linux__)
-  cpu_set_t allowed;
-  CPU_ZERO(&allowed);
-  if (sched_getaffinity(0, sizeof(allowed), &allowed) != 0 || CPU_COUNT(&allowed) < 2) return -1.0;
-  int cores[2] = {-1, -1};
-  for (int cpu = 0, found = 0; cpu < CPU_SETSIZE && found < 2; ++cpu) {
-    if (CPU_ISSET(cpu, &allowed)) cores[found++] = cpu;
-  }
+  const std::vector<int> cores = AllowedCores();
+  if (cores.size() < 2) return -1.0;
   constexpr int kTrips = 4096, kRounds = 16;
   alignas(64) std::atomic<int> flag{0};
-  const auto pin = [](int cpu) {
-    cpu_set_t one;
-    CPU_ZERO(&one);
-    CPU_SET(cpu, &one);
-    sched_setaffinity(0, sizeof(one), &one);
-  };
   std::thread answer([&] {
-    pin(cores[1]);
+    PinToCore(cores[1]);
     for (int i = 0; i < kTrips * kRounds; ++i) {
       while (flag.load(std::memory_order_acquire) != 2 * i + 1) {
       }
@@ -138,7 +142,7 @@ double CoreRoundTrip() {
   });
   std::vector<double> rounds;
   std::thread ask([&] {
-    pin(cores[0]);
+    PinToCore(cores[0]);
     for (int round = 0; round < kRounds; ++round) {
       const auto start = std::chrono::steady_clock::now();
       for (int i = round * kTrips; i < (round + 1) * kTrips; ++i) {
@@ -155,9 +159,6 @@ double CoreRoundTrip() {
   answer.join();
   std::sort(rounds.begin(), rounds.end());
   return rounds[kRounds / 2];
-#else
-  return -1.0;
-#endif
 }
 
 struct Quality {

@@ -130,12 +130,15 @@ bool Batched(const CarveOptions& options) {
 
 // Calls work(view) for every view on `workers`, the groups claiming views one at a time: each
 // group first its own (view v belongs to group v mod G, so that a view's rays stay in one core's
-// cache from task to task), then any left, in `order` (the costliest first).
-template <typename Work>
+// cache from task to task), then any left, in `order` (the costliest first). Each group first
+// calls lead(group), which must touch nothing another group's calls do (while the calling
+// thread's group 0 leads, the others claim the views it would have taken).
+template <typename Work, typename Lead>
 void ClaimViews(ViewWorkers& workers, const std::vector<int>& order,
-                std::atomic<uint8_t>* claimed, Work work) {
+                std::atomic<uint8_t>* claimed, Work work, Lead lead) {
   for (int view : order) claimed[view].store(0, std::memory_order_relaxed);
   auto task = [&](int group) {
+    lead(group);
     for (int pass = 0; pass < 2; ++pass) {
       for (int view : order) {
         if (pass == 0 && workers.GroupOf(view) != group) continue;
@@ -707,7 +710,13 @@ bool IncrementalCarver::BehindKnownSurface(int64_t voxel,
 
 void IncrementalCarver::FormBatch(Batch* batch) {
   batch->Clear();
-  while (static_cast<int>(batch->entries.size()) < batch_voxels_ && !queue_.empty()) {
+  while (static_cast<int>(batch->entries.size()) < batch_voxels_) {
+    if (queue_.empty()) {
+      // The arrivals still to be queued go behind what was queued: needed only now.
+      if (pending_slot_ < 0) break;
+      QueuePendingArrivals();
+      continue;
+    }
     const int64_t voxel = queue_.front();
     queue_.pop_front();
     if (!volume_.IsSolid(voxel)) {
@@ -718,6 +727,33 @@ void IncrementalCarver::FormBatch(Batch* batch) {
   }
 }
 
+void IncrementalCarver::QueuePendingArrivals() {
+  if (pending_slot_ < 0) return;
+  const int slot = pending_slot_;
+  pending_slot_ = -1;
+  // Carved voxel by carved voxel, view by view: the same order for any number of groups.
+  const int num_views = static_cast<int>(views_.size());
+  for (size_t j = 0; j < pending_carved_; ++j) {
+    for (int view = 0; view < num_views; ++view) {
+      const ViewBuffers& buffers = view_buffers_[view];
+      const Span& span = buffers.reached_spans[slot][j];
+      const int64_t* reached = buffers.reached[slot].data();
+      for (uint32_t p = span.begin; p < span.end; ++p) {
+        const int64_t voxel = reached[p];
+        uint64_t& word = queued_[voxel >> 6];
+        const uint64_t bit = uint64_t{1} << (voxel & 63);
+        if (word & bit) continue;
+        // A voxel carved since it was reached was queued then and has since been taken from the
+        // queue by FormBatch, which found it empty (see StepBatch): not queued again.
+        if (!volume_.IsSolid(voxel)) continue;
+        word |= bit;
+        queue_.push_back(voxel);
+      }
+    }
+  }
+  pending_carved_ = 0;
+}
+
 void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* finding,
                                     int finding_slot) {
   auto work = [&](int view) {
@@ -726,22 +762,22 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
     if (carving != nullptr) {
       const std::vector<PixelRef>& vis = buffers.vis[carving_slot];
       const std::vector<Span>& spans = buffers.spans[carving_slot];
-      buffers.reached.clear();
-      buffers.reached_spans.clear();
+      std::vector<int64_t>& reached = buffers.reached[carving_slot];
+      std::vector<Span>& reached_spans = buffers.reached_spans[carving_slot];
+      reached.clear();
+      reached_spans.clear();
       for (int k : batch_carved_) {
-        const size_t begin = buffers.reached.size();
+        const size_t begin = reached.size();
         if (spans[k].begin == spans[k].end) {  // most views see none of a voxel
-          buffers.reached_spans.push_back(
-              {static_cast<uint32_t>(begin), static_cast<uint32_t>(begin)});
+          reached_spans.push_back({static_cast<uint32_t>(begin), static_cast<uint32_t>(begin)});
           continue;
         }
         ray_visibility_->AdvanceRaysFrom(carving->coordinates[k],
                                          vis.data() + spans[k].begin, vis.data() + spans[k].end,
-                                         &buffers.reached);
-        const size_t kept =
-            KeepFirstOccurrences(buffers.reached.data() + begin, buffers.reached.size() - begin);
-        buffers.reached.resize(begin + kept);
-        buffers.reached_spans.push_back(
+                                         &reached);
+        const size_t kept = KeepFirstOccurrences(reached.data() + begin, reached.size() - begin);
+        reached.resize(begin + kept);
+        reached_spans.push_back(
             {static_cast<uint32_t>(begin), static_cast<uint32_t>(begin + kept)});
       }
     }
@@ -806,7 +842,13 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
     }
     buffers.nanoseconds += ElapsedNanoseconds(start);
   };
-  ClaimViews(workers_, claim_order_, view_claimed_.get(), work);
+  // The calling thread queues the last task's arrivals (in the other slot) while the others
+  // take its views.
+  if (pending_slot_ == carving_slot) QueuePendingArrivals();
+  ClaimViews(workers_, claim_order_, view_claimed_.get(), work,
+             [this](int group) {
+               if (group == 0) QueuePendingArrivals();
+             });
   if (++tasks_since_sort_ >= kSortTasks) SortViewsByCost();
 }
 
@@ -886,6 +928,7 @@ void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
 }
 
 void IncrementalCarver::ReturnPendingBatch() {
+  QueuePendingArrivals();
   if (!batch_found_) return;
   // The queued bits are still set: the voxels go back to the front, in their order.
   const std::vector<BatchEntry>& entries = batches_[current_].entries;
@@ -909,7 +952,6 @@ bool IncrementalCarver::StepBatch() {
   batch_carved_.clear();
   for (int k = 0; k < static_cast<int>(current.entries.size()); ++k) {
     const BatchEntry& entry = current.entries[k];
-    queued_[entry.voxel >> 6] &= ~(uint64_t{1} << (entry.voxel & 63));
     protected_kept_ += entry.kept_protected;
     if (entry.carve) batch_carved_.push_back(k);
   }
@@ -919,24 +961,30 @@ bool IncrementalCarver::StepBatch() {
   }
   carved_ += static_cast<int64_t>(batch_carved_.size());
   // The rays that ended in the carved voxels step on (through all of them), and the next batch's
-  // Vis is found after them, view by view in one task.
+  // Vis is found after them, view by view in one task; in it the calling thread queues the
+  // voxels the last task's rays reached (QueuePendingArrivals). The queue is as if they had been
+  // queued before this batch was judged, as the FIFO order has it: the next batch comes from the
+  // queue's front, and they go to its back (FormBatch queues them first where the queue runs
+  // out); this batch's voxels keep their queued bits until then, so that they are not queued
+  // again (judged with the rays as the last carve left them); a voxel carved since it was reached
+  // was queued then and, taken by FormBatch, skipped (QueuePendingArrivals checks).
   const int next_slot = 1 - current_;
   Batch& next = batches_[next_slot];
   FormBatch(&next);
   if (!batch_carved_.empty() || !next.entries.empty()) {
     RunViewTask(batch_carved_.empty() ? nullptr : &current, current_,
                 next.entries.empty() ? nullptr : &next, next_slot);
-  }
-  // Queued carved voxel by carved voxel, view by view: the same for any number of groups.
-  const int num_views = static_cast<int>(views_.size());
-  for (size_t j = 0; j < batch_carved_.size(); ++j) {
-    for (int view = 0; view < num_views; ++view) {
-      const ViewBuffers& buffers = view_buffers_[view];
-      const Span& span = buffers.reached_spans[j];
-      for (uint32_t p = span.begin; p < span.end; ++p) Enqueue(buffers.reached[p]);
-    }
+  } else {
+    QueuePendingArrivals();
   }
   max_queue_ = std::max(max_queue_, queue_size() + next.entries.size());
+  for (const BatchEntry& entry : current.entries) {
+    queued_[entry.voxel >> 6] &= ~(uint64_t{1} << (entry.voxel & 63));
+  }
+  if (!batch_carved_.empty()) {
+    pending_slot_ = current_;
+    pending_carved_ = batch_carved_.size();
+  }
   current_ = next_slot;
   batch_found_ = !next.entries.empty();
   return true;

@@ -343,6 +343,7 @@ class IncrementalCarver {
   bool IsProtected(int64_t voxel) const {
     return !protected_.empty() && ((protected_[voxel >> 6] >> (voxel & 63)) & 1) != 0;
   }
+  // The CVSVL's voxels (in batched carving, the last batch's arrivals join it in the next Step).
   size_t queue_size() const {
     return queue_.size() + heap_.size() + (batch_found_ ? batches_[current_].entries.size() : 0);
   }
@@ -476,15 +477,18 @@ class IncrementalCarver {
     std::vector<BatchHit> hits[2];
     std::vector<Footprint> footprints;
     std::vector<int> seen;  // the batch's voxels with a non-empty footprint in the view
-    std::vector<int64_t> reached;
-    std::vector<Span> reached_spans;
+    std::vector<int64_t> reached[2];  // by the carved batch's slot
+    std::vector<Span> reached_spans[2];
     int64_t nanoseconds = 0;
   };
   // Batched carving is a pipeline of two batches: batches_[current_] has its Vis found (when
   // batch_found_) and is judged and carved next; in the same task that steps its carved voxels'
   // rays, each view then finds the Vis of the next batch (taken from the queue after the carve,
-  // before the arrivals are queued; its voxels keep their queued bits until judged, so that
-  // arrivals do not queue them again: their Vis already holds the new pixels).
+  // before the arrivals are queued; its voxels keep their queued bits until the arrivals of the
+  // carve before their judging are queued, so that these do not queue them again: their Vis
+  // already holds the new pixels). A batch's arrivals are queued in the next task, by the
+  // calling thread while the others step rays and find Vis (QueuePendingArrivals): the same
+  // queue as queueing them at once (see StepBatch).
   // Up to `batch_voxels_` solid voxels from the queue into `batch`, their queued bits left set.
   void FormBatch(Batch* batch);
   // One task over the views: steps the rays of `carving`'s carved voxels (when not null; Vis in
@@ -502,9 +506,14 @@ class IncrementalCarver {
   // Every kSortTasks tasks: sorts claim_order_ by the views' time since the last sorting, the
   // costliest first.
   void SortViewsByCost();
-  // Puts a batch found but not yet judged back at the front of the queue (before carving
-  // outside the pipeline: its Vis would go stale).
+  // Queues the voxels that the rays of the last carved batch reached (in slot pending_slot_,
+  // from pending_carved_ carved voxels), unless queued already or empty.
+  void QueuePendingArrivals();
+  // Queues the pending arrivals, then puts a batch found but not yet judged back at the front of
+  // the queue (before carving outside the pipeline: its Vis would go stale).
   void ReturnPendingBatch();
+  int pending_slot_ = -1;  // -1: no arrivals pending
+  size_t pending_carved_ = 0;
   Batch batches_[2];
   std::vector<int> batch_carved_;  // indices into the current batch, in queue order
   int current_ = 0;

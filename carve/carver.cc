@@ -731,14 +731,21 @@ void IncrementalCarver::QueuePendingArrivals() {
   if (pending_slot_ < 0) return;
   const int slot = pending_slot_;
   pending_slot_ = -1;
-  // Carved voxel by carved voxel, view by view: the same order for any number of groups.
+  // Carved voxel by carved voxel, view by view: the same order for any number of groups. Each
+  // view's runs are walked alongside, in carved order.
   const int num_views = static_cast<int>(views_.size());
+  std::vector<size_t>& next_run = pending_next_run_;
+  next_run.assign(num_views, 0);
   for (size_t j = 0; j < pending_carved_; ++j) {
     for (int view = 0; view < num_views; ++view) {
       const ViewBuffers& buffers = view_buffers_[view];
-      const Span& span = buffers.reached_spans[slot][j];
+      const std::vector<ReachedRun>& runs = buffers.reached_runs[slot];
+      const size_t run = next_run[view];
+      if (run == runs.size() || runs[run].j != j) continue;
+      next_run[view] = run + 1;
       const int64_t* reached = buffers.reached[slot].data();
-      for (uint32_t p = span.begin; p < span.end; ++p) {
+      const uint32_t first = run == 0 ? 0 : runs[run - 1].end;
+      for (uint32_t p = first; p < runs[run].end; ++p) {
         const int64_t voxel = reached[p];
         uint64_t& word = queued_[voxel >> 6];
         const uint64_t bit = uint64_t{1} << (voxel & 63);
@@ -763,22 +770,21 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       const std::vector<PixelRef>& vis = buffers.vis[carving_slot];
       const std::vector<Span>& spans = buffers.spans[carving_slot];
       std::vector<int64_t>& reached = buffers.reached[carving_slot];
-      std::vector<Span>& reached_spans = buffers.reached_spans[carving_slot];
+      std::vector<ReachedRun>& runs = buffers.reached_runs[carving_slot];
       reached.clear();
-      reached_spans.clear();
-      for (int k : batch_carved_) {
+      runs.clear();
+      for (size_t j = 0; j < batch_carved_.size(); ++j) {
+        const int k = batch_carved_[j];
+        if (spans[k].begin == spans[k].end) continue;  // most views see none of a voxel
         const size_t begin = reached.size();
-        if (spans[k].begin == spans[k].end) {  // most views see none of a voxel
-          reached_spans.push_back({static_cast<uint32_t>(begin), static_cast<uint32_t>(begin)});
-          continue;
-        }
         ray_visibility_->AdvanceRaysFrom(carving->coordinates[k],
                                          vis.data() + spans[k].begin, vis.data() + spans[k].end,
                                          &reached);
         const size_t kept = KeepFirstOccurrences(reached.data() + begin, reached.size() - begin);
         reached.resize(begin + kept);
-        reached_spans.push_back(
-            {static_cast<uint32_t>(begin), static_cast<uint32_t>(begin + kept)});
+        if (kept > 0) {
+          runs.push_back({static_cast<uint32_t>(j), static_cast<uint32_t>(begin + kept)});
+        }
       }
     }
     if (finding != nullptr) {

@@ -471,14 +471,23 @@ class IncrementalCarver {
   // the judging needs. (A record per view and voxel of the batch, which the judging read and the
   // next task wrote over, had the two cores trade its cache lines: two threads did 40-50% more
   // work than one.)
+  // A carved voxel whose rays in a view reached voxels: its index in batch_carved_, and where
+  // they end in the view's reached voxels (they begin where the run before ends).
+  struct ReachedRun {
+    uint32_t j = 0;
+    uint32_t end = 0;
+  };
   struct alignas(64) ViewBuffers {
     std::vector<PixelRef> vis[2];
     std::vector<Span> spans[2];
     std::vector<BatchHit> hits[2];
     std::vector<Footprint> footprints;
     std::vector<int> seen;  // the batch's voxels with a non-empty footprint in the view
-    std::vector<int64_t> reached[2];  // by the carved batch's slot
-    std::vector<Span> reached_spans[2];
+    // By the carved batch's slot: the voxels reached, and where each carved voxel's end (only
+    // those whose rays reached any: a record per carved voxel, mostly empty, had the other
+    // thread's reading cost this one's next writing a cache line's round trip each).
+    std::vector<int64_t> reached[2];
+    std::vector<ReachedRun> reached_runs[2];
     int64_t nanoseconds = 0;
   };
   // Batched carving is a pipeline of two batches: batches_[current_] has its Vis found (when
@@ -514,6 +523,7 @@ class IncrementalCarver {
   void ReturnPendingBatch();
   int pending_slot_ = -1;  // -1: no arrivals pending
   size_t pending_carved_ = 0;
+  std::vector<size_t> pending_next_run_;  // QueuePendingArrivals: per view, its next run
   Batch batches_[2];
   std::vector<int> batch_carved_;  // indices into the current batch, in queue order
   int current_ = 0;

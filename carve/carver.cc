@@ -484,6 +484,7 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
   if (view_parallel_ || batched_) groups_.resize(workers_.num_groups());
   if (batched_) {
     view_buffers_.resize(views.size());
+    view_outputs_.resize(views.size());
     view_claimed_ = std::make_unique<std::atomic<uint8_t>[]>(views.size());
     claim_order_.resize(views.size());
     std::iota(claim_order_.begin(), claim_order_.end(), 0);
@@ -738,12 +739,12 @@ void IncrementalCarver::QueuePendingArrivals() {
   next_run.assign(num_views, 0);
   for (size_t j = 0; j < pending_carved_; ++j) {
     for (int view = 0; view < num_views; ++view) {
-      const ViewBuffers& buffers = view_buffers_[view];
-      const std::vector<ReachedRun>& runs = buffers.reached_runs[slot];
+      const ViewOutput& output = view_outputs_[view];
+      const ReachedRun* runs = output.runs[slot];
       const size_t run = next_run[view];
-      if (run == runs.size() || runs[run].j != j) continue;
+      if (run == output.num_runs[slot] || runs[run].j != j) continue;
       next_run[view] = run + 1;
-      const int64_t* reached = buffers.reached[slot].data();
+      const int64_t* reached = output.reached[slot];
       const uint32_t first = run == 0 ? 0 : runs[run - 1].end;
       for (uint32_t p = first; p < runs[run].end; ++p) {
         const int64_t voxel = reached[p];
@@ -786,6 +787,10 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
           runs.push_back({static_cast<uint32_t>(j), static_cast<uint32_t>(begin + kept)});
         }
       }
+      ViewOutput& output = view_outputs_[view];
+      output.reached[carving_slot] = reached.data();
+      output.runs[carving_slot] = runs.data();
+      output.num_runs[carving_slot] = static_cast<uint32_t>(runs.size());
     }
     if (finding != nullptr) {
       std::vector<PixelRef>& vis = buffers.vis[finding_slot];
@@ -845,6 +850,9 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
           }
         }
       }
+      ViewOutput& output = view_outputs_[view];
+      output.hits[finding_slot] = hits.data();
+      output.num_hits[finding_slot] = static_cast<uint32_t>(hits.size());
     }
     buffers.nanoseconds += ElapsedNanoseconds(start);
   };
@@ -874,21 +882,19 @@ void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
     std::vector<const BatchHit*>& next = groups_[group].next_hit;
     next.resize(num_views);
     for (int view = 0; view < num_views; ++view) {
-      const std::vector<BatchHit>& hits = view_buffers_[view].hits[slot];
-      next[view] = hits.data() + (std::lower_bound(hits.begin(), hits.end(), first,
-                                                   [](const BatchHit& h, int key) {
-                                                     return h.k < key;
-                                                   }) -
-                                  hits.begin());
+      const ViewOutput& output = view_outputs_[view];
+      next[view] = std::lower_bound(output.hits[slot], output.hits[slot] + output.num_hits[slot],
+                                    first,
+                                    [](const BatchHit& h, int key) { return h.k < key; });
     }
     for (int k = first; k < last; ++k) {
       stats.clear();
       BatchEntry& entry = batch->entries[k];
       entry.num_pixels = 0;
       for (int view = 0; view < num_views; ++view) {
-        const std::vector<BatchHit>& hits = view_buffers_[view].hits[slot];
+        const ViewOutput& output = view_outputs_[view];
         const BatchHit* hit = next[view];
-        const BatchHit* end = hits.data() + hits.size();
+        const BatchHit* end = output.hits[slot] + output.num_hits[slot];
         if (hit == end || hit->k != k) continue;
         ViewColourStats& view_stats = stats.emplace_back();
         view_stats.view = view;

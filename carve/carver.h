@@ -477,6 +477,18 @@ class IncrementalCarver {
     uint32_t j = 0;
     uint32_t end = 0;
   };
+  // What a view's task hands the calling thread (JudgeEntries, QueuePendingArrivals), per
+  // slot, on a cache line of its own, written once a task: the vectors' own fields share lines
+  // with the rest of ViewBuffers, which the view's thread writes all through its task (each
+  // push_back), so the calling thread's reading them cost the view's thread a round trip
+  // between the cores on its next write.
+  struct alignas(64) ViewOutput {
+    const BatchHit* hits[2] = {nullptr, nullptr};
+    const int64_t* reached[2] = {nullptr, nullptr};
+    const ReachedRun* runs[2] = {nullptr, nullptr};
+    uint32_t num_hits[2] = {0, 0};
+    uint32_t num_runs[2] = {0, 0};
+  };
   struct alignas(64) ViewBuffers {
     std::vector<PixelRef> vis[2];
     std::vector<Span> spans[2];
@@ -529,6 +541,7 @@ class IncrementalCarver {
   int current_ = 0;
   bool batch_found_ = false;
   std::vector<ViewBuffers> view_buffers_;
+  std::vector<ViewOutput> view_outputs_;
   std::vector<int> claim_order_;  // views, costliest first
   std::unique_ptr<std::atomic<uint8_t>[]> view_claimed_;
   int tasks_since_sort_ = 0;

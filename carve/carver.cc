@@ -354,8 +354,13 @@ std::string CarveStatistics::Summary() const {
   text << visibility << " carving of a " << dimensions.x() << "x" << dimensions.y() << "x"
        << dimensions.z() << " grid: " << carved << " voxels carved, " << evaluated
        << " evaluated in " << carve_seconds << " s on " << threads
-       << (threads == 1 ? " thread" : " threads") << " (set-up " << setup_seconds << " s), "
-       << final_surface << " surface voxels (" << visible_surface << " seen), peak memory "
+       << (threads == 1 ? " thread" : " threads");
+  if (threads > 1 && inline_runs > 0 && parallel_runs > 0) {
+    // ViewWorkers left the workers idle while they held the runs up (their cores busy).
+    text << " (the calling thread alone for " << 100.0 * inline_runs / parallel_runs
+         << "% of the parallel runs: the other cores were busy)";
+  }
+  text << " (set-up " << setup_seconds << " s), " << final_surface << " surface voxels (" << visible_surface << " seen), peak memory "
        << peak_memory_bytes / (1024.0 * 1024.0) << " MiB";
   return text.str();
 }

@@ -22,6 +22,11 @@ constexpr int kYields = 64;
 // Runs per judgement of the workers, and runs on the calling thread alone before trying again.
 constexpr int kWindowRuns = 256;
 constexpr int kInlineRuns = 8192;
+constexpr int kMaxInlineRuns = 16 * kInlineRuns;
+// Account: threads busy on average below which (two windows in a row) the workers are left
+// idle, and runs the workers held up in a window that leave them at once.
+constexpr double kMinBusyThreads = 1.0;
+constexpr int kMaxLostRuns = 4;
 
 int64_t NowNanoseconds() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -86,6 +91,7 @@ ViewWorkers::Times ViewWorkers::times() const {
   Times times;
   times.runs = runs_;
   times.inline_runs = inline_total_;
+  times.fallbacks = fallbacks_;
   times.wall_seconds = 1e-9 * static_cast<double>(wall_nanoseconds_);
   for (const Busy& busy : busy_) times.busy_seconds.push_back(1e-9 * busy.nanoseconds);
   return times;
@@ -104,6 +110,10 @@ void ViewWorkers::RunErased(void (*call)(void*, int), void* task) {
     wall_nanoseconds_ += elapsed;
     busy_[0].nanoseconds += elapsed;
     return;
+  }
+  if (window_runs_ == 0) {
+    window_busy_start_ = 0;
+    for (const Busy& busy : busy_) window_busy_start_ += busy.nanoseconds;
   }
   const int64_t start = NowNanoseconds();
   call_ = call;
@@ -131,15 +141,55 @@ void ViewWorkers::RunErased(void (*call)(void*, int), void* task) {
 }
 
 void ViewWorkers::Account(int64_t own_nanoseconds, int64_t wait_nanoseconds) {
+  // On the calling thread alone a run would cost about num_groups x its own share; on the
+  // workers it cost own + wait. A run that lost so (its workers held it up) is a hiccup when
+  // alone; kMaxLostRuns in a window are a worker without a core: each such run waits for the
+  // worker's next time slice (measured beside a busy loop on two cores: about a millisecond a
+  // run, against 50-100 microseconds of work), so the workers are left at once.
+  const bool lost = wait_nanoseconds > 2 * (num_groups_ - 1) * own_nanoseconds;
+  window_lost_ += lost ? 1 : 0;
   window_own_ += own_nanoseconds;
   window_wait_ += wait_nanoseconds;
+  if (window_lost_ >= kMaxLostRuns) {
+      LeaveWorkers();
+    return;
+  }
   if (++window_runs_ < kWindowRuns) return;
-  // On the calling thread alone a run would cost about num_groups x its own share; on the
-  // workers it cost own + wait. Only a clear loss counts (twice that), not a worker's hiccup.
-  if (window_wait_ > 2 * (num_groups_ - 1) * window_own_) inline_runs_left_ = kInlineRuns;
+  // Only a clear loss over the window counts (twice that).
+  const bool losing = window_wait_ > 2 * (num_groups_ - 1) * window_own_;
+  // The threads' work together against the runs' wall time: the threads busy on average. Below
+  // one, the runs took longer than their work would on one thread (which does less work than
+  // two: no cross-core traffic, README "Threads"). Measured on two quiet cores: 1.8-1.9, and
+  // a single window below one in a few hundred (the machine's hiccups); beside a busy loop
+  // 0.85-0.9 window after window. Two windows in a row count.
+  int64_t busy = -window_busy_start_;
+  for (const Busy& group_busy : busy_) busy += group_busy.nanoseconds;
+  const int64_t wall = window_own_ + window_wait_;
+  const bool starved = static_cast<double>(busy) < kMinBusyThreads * static_cast<double>(wall);
+  if (losing || (starved && starved_before_)) {
+      LeaveWorkers();
+    return;
+  }
+  starved_before_ = starved;
+  if (!starved) trying_ = false;
   window_runs_ = 0;
   window_own_ = 0;
   window_wait_ = 0;
+  window_lost_ = 0;
+}
+
+void ViewWorkers::LeaveWorkers() {
+  // Workers left again in the first window after a while without them: their cores are still
+  // taken, and each try costs runs held up; try half as often, up to kMaxInlineRuns.
+  inline_period_ = trying_ ? std::min(2 * inline_period_, kMaxInlineRuns) : kInlineRuns;
+  inline_runs_left_ = inline_period_;
+  trying_ = true;
+  ++fallbacks_;
+  starved_before_ = false;
+  window_runs_ = 0;
+  window_own_ = 0;
+  window_wait_ = 0;
+  window_lost_ = 0;
 }
 
 void ViewWorkers::WorkerLoop(int group) {

@@ -26,8 +26,12 @@ namespace raycarve {
 //
 // Fork-join this fine-grained only pays while every thread has a core. When the workers fall
 // behind (more threads than cores, or other busy processes: measured, 4 threads on 2 cores
-// made a carve 27x slower), Run notices that waiting for them costs more than their share of
-// the work would, and for a while runs every group on the calling thread, then tries again.
+// made a carve 27x slower, and a busy loop beside a carve on 2 cores made two threads 1.3-2x
+// slower than one), Run notices and for a while runs every group on the calling thread, then
+// tries again: after a few runs in a window that waited on the workers longer than the calling
+// thread alone would have taken (each waits for a worker's next time slice), or after two
+// windows in a row in which the threads together worked too little of the runs' wall time to
+// beat one thread (see Account).
 // Which thread runs a group never changes what the task computes.
 //
 // Tasks for different groups must touch disjoint data (each group its own views' structures and
@@ -58,6 +62,7 @@ class ViewWorkers {
   struct Times {
     int64_t runs = 0;
     int64_t inline_runs = 0;  // runs done on the calling thread alone (see above)
+    int64_t fallbacks = 0;    // times the workers were left idle for a while
     double wall_seconds = 0.0;
     std::vector<double> busy_seconds;  // per group
   };
@@ -68,15 +73,23 @@ class ViewWorkers {
   void WorkerLoop(int group);
   // After a run on the workers: the calling thread's own time and its wait for the others.
   void Account(int64_t own_nanoseconds, int64_t wait_nanoseconds);
+  // Runs the next kInlineRuns on the calling thread alone and starts a new window.
+  void LeaveWorkers();
 
   int num_views_;
   int num_groups_;
   // Runs left to do on the calling thread alone (0: use the workers), and the current window's
   // tally of parallel runs.
   int inline_runs_left_ = 0;
+  int inline_period_ = 0;  // the last such while, in runs (see LeaveWorkers)
+  bool trying_ = false;    // the workers are back after a while without them, for a window
   int window_runs_ = 0;
   int64_t window_own_ = 0;
   int64_t window_wait_ = 0;
+  int64_t window_busy_start_ = 0;  // the groups' busy time summed, before the window's runs
+  int window_lost_ = 0;            // runs the workers held up (see Account)
+  bool starved_before_ = false;    // the window before had too few threads busy
+  int64_t fallbacks_ = 0;
   std::vector<std::thread> threads_;
   int64_t runs_ = 0;
   int64_t inline_total_ = 0;

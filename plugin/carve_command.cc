@@ -532,6 +532,8 @@ std::string CarveReportJson(const CarveRequest& request, const CarveRun& run) {
       .Key("passes").Value(s.passes)
       .Key("threads").Value(s.threads)
       .Key("parallel_seconds").Value(s.parallel_seconds)
+      .Key("parallel_runs").Value(s.parallel_runs)
+      .Key("inline_runs").Value(s.inline_runs)
       .Key("thread_work_seconds").Value(s.thread_work_seconds)
       .Key("reprojection_error_before").Value(s.reprojection_error_before)
       .Key("reprojection_error_after").Value(s.reprojection_error_after)
@@ -996,13 +998,22 @@ int RunCarve(int argc, char** argv) {
     floater_text = ", " + std::to_string(s.unsupported_component_carved) + " in " +
                    std::to_string(s.unsupported_components) + " floaters without sparse points";
   }
+  std::string thread_text =
+      std::to_string(s.threads) + (s.threads == 1 ? " thread" : " threads");
+  if (s.threads > 1 && s.inline_runs > 0 && s.parallel_runs > 0) {
+    char share[160];
+    std::snprintf(share, sizeof(share),
+                  " (one alone for %.0f%% of the parallel runs: the other cores were busy)",
+                  100.0 * static_cast<double>(s.inline_runs) / static_cast<double>(s.parallel_runs));
+    thread_text += share;
+  }
   std::printf(
       "\ncarved %s\n"
       "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
       "  carved          %lld voxels (%lld by the visual hull of %d masked views, %lld by the "
       "sparse points' sight lines, %lld in specks%s), %lld evaluations\n"
       "  levels          %zu (%s)\n"
-      "  convergence     %.2f s (+ %.2f s set-up) on %d %s, carving structures' peak %.1f MiB\n"
+      "  convergence     %.2f s (+ %.2f s set-up) on %s, carving structures' peak %.1f MiB\n"
       "  process memory  %.1f MiB at its peak (resident: photos, views, grid, mesh)\n"
       "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more\n"
       "  sparse points   %s\n"
@@ -1017,8 +1028,8 @@ int RunCarve(int argc, char** argv) {
       static_cast<long long>(s.free_space_level0_carved),
       static_cast<long long>(s.component_carved), floater_text.c_str(),
       static_cast<long long>(s.evaluated),
-      s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds, s.threads,
-      s.threads == 1 ? "thread" : "threads", s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
+      s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds,
+      thread_text.c_str(), s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,
       sparse_line.c_str(), mask_line.c_str(), silhouette_line.c_str(), run.output_path.c_str(),
       run.num_cloud_points,

@@ -61,14 +61,16 @@ TEST(ViewWorkers, WorkersThatFellAsleepWakeForTheNextRun) {
     // Longer than the workers spin: they sleep on the condition variable between runs.
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     auto task = [&](int group) {
-      // A slow worker group: the caller gives up spinning and sleeps until it is done.
-      if (group == 1) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      // A slower worker group: the caller gives up spinning and sleeps until it is done. (The
+      // caller works too, twice as long as it waits: runs the workers did not hold up.)
+      std::this_thread::sleep_for(std::chrono::milliseconds(group == 1 ? 6 : 4));
       ++calls[group];
     };
     workers.Run(task);
     EXPECT_EQ(calls[1], run + 1);
   }
   EXPECT_EQ(calls, std::vector<int>(2, 5));
+  EXPECT_EQ(workers.times().inline_runs, 0);
 }
 
 TEST(ViewWorkers, TheTimesSayHowLongEachGroupWorkedAndHowLongTheRunsTook) {
@@ -89,6 +91,28 @@ TEST(ViewWorkers, TheTimesSayHowLongEachGroupWorkedAndHowLongTheRunsTook) {
   // The runs lasted as long as the slower group worked, at least.
   EXPECT_GE(times.wall_seconds, times.busy_seconds[1]);
   EXPECT_LE(times.busy_seconds[1], times.wall_seconds);
+}
+
+TEST(ViewWorkers, WorkersThatHoldUpTheRunsAreLeftForTheCallingThread) {
+  // Group 1 takes 2 ms a run and group 0 nothing: every run waits on the worker, as when a busy
+  // process beside takes its core. After a few such runs the calling thread runs both groups.
+  ViewWorkers workers(4, 2);
+  const std::thread::id caller = std::this_thread::get_id();
+  int group1_on_caller = 0;
+  for (int run = 0; run < 12; ++run) {
+    auto task = [&](int group) {
+      if (group != 1) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      if (std::this_thread::get_id() == caller) ++group1_on_caller;
+    };
+    workers.Run(task);
+  }
+  const ViewWorkers::Times times = workers.times();
+  EXPECT_EQ(times.runs, 12);
+  EXPECT_EQ(times.fallbacks, 1);
+  // Four runs held up, then the rest on the calling thread.
+  EXPECT_EQ(times.inline_runs, 8);
+  EXPECT_EQ(group1_on_caller, 8);
 }
 
 }  // namespace

@@ -19,10 +19,12 @@ namespace {
 // waited for may need it), then sleeping (an idle pool costs nothing).
 constexpr int kSpins = 256;
 constexpr int kYields = 64;
-// Runs per judgement of the workers, and runs on the calling thread alone before trying again.
+// Runs per judgement of the workers, and runs on the calling thread alone before trying again
+// (doubled while tries fail, up to kMaxInlineRuns: see LeaveWorkers). A short first while: a
+// hiccup of the machine can leave the workers for nothing.
 constexpr int kWindowRuns = 256;
-constexpr int kInlineRuns = 8192;
-constexpr int kMaxInlineRuns = 16 * kInlineRuns;
+constexpr int kInlineRuns = 1024;
+constexpr int kMaxInlineRuns = 128 * kInlineRuns;
 // Account: threads busy on average below which (two windows in a row) the workers are left
 // idle, and runs the workers held up in a window that leave them at once.
 constexpr double kMinBusyThreads = 1.0;

@@ -73,7 +73,7 @@ class ViewWorkers {
   void WorkerLoop(int group);
   // After a run on the workers: the calling thread's own time and its wait for the others.
   void Account(int64_t own_nanoseconds, int64_t wait_nanoseconds);
-  // Runs the next kInlineRuns on the calling thread alone and starts a new window.
+  // Runs the next inline_period_ runs on the calling thread alone and starts a new window.
   void LeaveWorkers();
 
   int num_views_;

@@ -495,9 +495,9 @@ class IncrementalCarver {
     std::vector<BatchHit> hits[2];
     std::vector<Footprint> footprints;
     std::vector<int> seen;  // the batch's voxels with a non-empty footprint in the view
-    // By the carved batch's slot: the voxels reached, and where each carved voxel's end (only
-    // those whose rays reached any: a record per carved voxel, mostly empty, had the other
-    // thread's reading cost this one's next writing a cache line's round trip each).
+    // By the carved batch's slot: the voxels reached, and the runs of them per carved voxel
+    // (only for those whose rays reached any: a record per carved voxel, mostly empty, had the
+    // other thread's reading cost this one's next writing a cache line's round trip each).
     std::vector<int64_t> reached[2];
     std::vector<ReachedRun> reached_runs[2];
     int64_t nanoseconds = 0;

@@ -153,7 +153,7 @@ void ViewWorkers::Account(int64_t own_nanoseconds, int64_t wait_nanoseconds) {
   window_own_ += own_nanoseconds;
   window_wait_ += wait_nanoseconds;
   if (window_lost_ >= kMaxLostRuns) {
-      LeaveWorkers();
+    LeaveWorkers();
     return;
   }
   if (++window_runs_ < kWindowRuns) return;
@@ -169,7 +169,7 @@ void ViewWorkers::Account(int64_t own_nanoseconds, int64_t wait_nanoseconds) {
   const int64_t wall = window_own_ + window_wait_;
   const bool starved = static_cast<double>(busy) < kMinBusyThreads * static_cast<double>(wall);
   if (losing || (starved && starved_before_)) {
-      LeaveWorkers();
+    LeaveWorkers();
     return;
   }
   starved_before_ = starved;

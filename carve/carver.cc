@@ -353,16 +353,21 @@ std::string CarveStatistics::Summary() const {
   text.precision(3);
   text << visibility << " carving of a " << dimensions.x() << "x" << dimensions.y() << "x"
        << dimensions.z() << " grid: " << carved << " voxels carved, " << evaluated
-       << " evaluated in " << carve_seconds << " s on " << threads
-       << (threads == 1 ? " thread" : " threads");
-  if (threads > 1 && inline_runs > 0 && parallel_runs > 0) {
-    // ViewWorkers left the workers idle while they held the runs up (their cores busy).
-    text << " (the calling thread alone for " << 100.0 * inline_runs / parallel_runs
-         << "% of the parallel runs: the other cores were busy)";
-  }
-  text << " (set-up " << setup_seconds << " s), " << final_surface << " surface voxels (" << visible_surface << " seen), peak memory "
+       << " evaluated in " << carve_seconds << " s on " << ThreadsText() << " (set-up "
+       << setup_seconds << " s), " << final_surface << " surface voxels (" << visible_surface
+       << " seen), peak memory "
        << peak_memory_bytes / (1024.0 * 1024.0) << " MiB";
   return text.str();
+}
+
+std::string CarveStatistics::ThreadsText() const {
+  std::string text = std::to_string(threads) + (threads == 1 ? " thread" : " threads");
+  if (threads > 1 && inline_runs > 0 && parallel_runs > 0) {
+    const double share = 100.0 * static_cast<double>(inline_runs) / parallel_runs;
+    text += " (one alone for " + std::to_string(static_cast<int>(std::lround(share))) +
+            "% of the parallel runs: the other cores were busy)";
+  }
+  return text;
 }
 
 BoxCoverage MeasureBoxCoverage(const std::vector<CalibratedView>& views,
@@ -753,14 +758,9 @@ void IncrementalCarver::QueuePendingArrivals() {
       const uint32_t first = run == 0 ? 0 : runs[run - 1].end;
       for (uint32_t p = first; p < runs[run].end; ++p) {
         const int64_t voxel = reached[p];
-        uint64_t& word = queued_[voxel >> 6];
-        const uint64_t bit = uint64_t{1} << (voxel & 63);
-        if (word & bit) continue;
         // A voxel carved since it was reached was queued then and has since been taken from the
         // queue by FormBatch, which found it empty (see StepBatch): not queued again.
-        if (!volume_.IsSolid(voxel)) continue;
-        word |= bit;
-        queue_.push_back(voxel);
+        if (volume_.IsSolid(voxel)) Enqueue(voxel);
       }
     }
   }

@@ -256,6 +256,9 @@ struct CarveStatistics {
   double reprojection_error_after = -1.0;
 
   std::string Summary() const;
+  // "2 threads", with the share of the parallel runs the calling thread ran alone where the
+  // workers were left (ViewWorkers: the other cores were busy).
+  std::string ThreadsText() const;
 };
 
 struct ColouredVoxel {

@@ -998,15 +998,6 @@ int RunCarve(int argc, char** argv) {
     floater_text = ", " + std::to_string(s.unsupported_component_carved) + " in " +
                    std::to_string(s.unsupported_components) + " floaters without sparse points";
   }
-  std::string thread_text =
-      std::to_string(s.threads) + (s.threads == 1 ? " thread" : " threads");
-  if (s.threads > 1 && s.inline_runs > 0 && s.parallel_runs > 0) {
-    char share[160];
-    std::snprintf(share, sizeof(share),
-                  " (one alone for %.0f%% of the parallel runs: the other cores were busy)",
-                  100.0 * static_cast<double>(s.inline_runs) / static_cast<double>(s.parallel_runs));
-    thread_text += share;
-  }
   std::printf(
       "\ncarved %s\n"
       "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
@@ -1029,7 +1020,7 @@ int RunCarve(int argc, char** argv) {
       static_cast<long long>(s.component_carved), floater_text.c_str(),
       static_cast<long long>(s.evaluated),
       s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds,
-      thread_text.c_str(), s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
+      s.ThreadsText().c_str(), s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,
       sparse_line.c_str(), mask_line.c_str(), silhouette_line.c_str(), run.output_path.c_str(),
       run.num_cloud_points,

@@ -777,6 +777,12 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       const std::vector<Span>& spans = buffers.spans[carving_slot];
       std::vector<int64_t>& reached = buffers.reached[carving_slot];
       std::vector<ReachedRun>& runs = buffers.reached_runs[carving_slot];
+      if (workers_.num_groups() > 1) {
+        // The calling thread read both when it queued the arrivals of the batch last carved
+        // from this slot.
+        PrefetchForWriting(reached.data(), reached.size() * sizeof(int64_t));
+        PrefetchForWriting(runs.data(), runs.size() * sizeof(ReachedRun));
+      }
       reached.clear();
       runs.clear();
       for (size_t j = 0; j < batch_carved_.size(); ++j) {
@@ -801,6 +807,10 @@ void IncrementalCarver::RunViewTask(Batch* carving, int carving_slot, Batch* fin
       std::vector<PixelRef>& vis = buffers.vis[finding_slot];
       std::vector<Span>& spans = buffers.spans[finding_slot];
       std::vector<BatchHit>& hits = buffers.hits[finding_slot];
+      if (workers_.num_groups() > 1) {
+        // The calling thread read them when it judged the batch last found in this slot.
+        PrefetchForWriting(hits.data(), hits.size() * sizeof(BatchHit));
+      }
       vis.clear();
       hits.clear();
       const int num_entries = static_cast<int>(finding->entries.size());
@@ -962,6 +972,13 @@ bool IncrementalCarver::StepBatch() {
     FormBatch(&current);
     if (current.entries.empty()) return false;
     RunViewTask(nullptr, 0, &current, current_);
+  }
+  if (workers_.num_groups() > 1) {
+    // The next batch's coordinates are written after the judging, and the other threads read
+    // them last (see PrefetchForWriting).
+    const std::vector<Eigen::Vector3i>& next_coordinates = batches_[1 - current_].coordinates;
+    PrefetchForWriting(next_coordinates.data(),
+                       next_coordinates.capacity() * sizeof(Eigen::Vector3i));
   }
   // Every voxel judged against the rays as they stood before any of the batch was carved.
   JudgeEntries(&current, current_, /*colouring=*/false);

@@ -8,6 +8,7 @@
 #endif
 
 #if defined(__x86_64__) || defined(__i386__)
+#include <cpuid.h>
 #include <immintrin.h>
 #endif
 
@@ -51,7 +52,30 @@ inline bool KeepWaiting(int round) {
   return false;
 }
 
+#if defined(__x86_64__) || defined(__i386__)
+// PREFETCHW: on every AMD64 processor and Intel's since Broadwell (CPUID 0x80000001, ECX bit 8).
+bool HasPrefetchForWriting() {
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  return __get_cpuid(0x80000001, &eax, &ebx, &ecx, &edx) != 0 && (ecx & bit_PRFCHW) != 0;
+}
+
+#endif
+
 }  // namespace
+
+void PrefetchForWriting(const void* data, size_t bytes) {
+  const char* begin = static_cast<const char*>(data);
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool supported = HasPrefetchForWriting();
+  if (!supported) return;
+  // In assembly: a compiler may drop a call whose only effect is a prefetch.
+  for (size_t offset = 0; offset < bytes; offset += 64) {
+    asm volatile("prefetchw %0" : : "m"(*(begin + offset)));
+  }
+#else
+  for (size_t offset = 0; offset < bytes; offset += 64) __builtin_prefetch(begin + offset, 1);
+#endif
+}
 
 int ResolveNumThreads(int num_threads) {
   if (num_threads >= 1) return num_threads;

@@ -403,7 +403,11 @@ class IncrementalCarver {
   struct alignas(64) GroupBuffers {
     std::vector<PixelRef> vis;
     std::vector<ViewColourStats> stats;
-    std::vector<const BatchHit*> next_hit;  // JudgeEntries: per view, its next hit
+    // JudgeEntries: the entries' sums per view, entry by entry (entry i's from view_sums_begin[i]
+    // on), and per entry the views gathered so far.
+    std::vector<ViewColourStats> view_sums;
+    std::vector<uint32_t> view_sums_begin;
+    std::vector<uint32_t> view_sums_count;
     std::vector<int64_t> changed;
     std::vector<size_t> vis_end;
     std::vector<size_t> stats_end;

@@ -929,22 +929,31 @@ void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
       count[i] = 0;
     }
     // ...then their sums, view by view.
+    // A voxel's hits in a view (more than one where it has more than kMaxHitPixels pixels there)
+    // are summed as integers, exactly, and written once.
     view_sums.resize(total);
     for (int view = 0; view < num_views; ++view) {
       auto [hit, end] = hits_from(view);
-      for (int previous = -1; hit != end && hit->k < last; ++hit) {
-        const int i = hit->k - first;
-        if (hit->k != previous) {
-          ViewColourStats& fresh = view_sums[begin[i] + count[i]++];
-          fresh = ViewColourStats();
-          fresh.view = view;
-          previous = hit->k;
+      while (hit != end && hit->k < last) {
+        const int k = hit->k;
+        uint64_t pixels = 0, sum[3] = {0, 0, 0}, sum_squares[3] = {0, 0, 0};
+        for (; hit != end && hit->k == k; ++hit) {
+          pixels += hit->count;
+          for (int c = 0; c < 3; ++c) {
+            sum[c] += hit->sum[c];
+            sum_squares[c] += hit->sum_squares[c];
+          }
         }
-        ViewColourStats& view_stats = view_sums[begin[i] + count[i] - 1];
-        view_stats.count += static_cast<int>(hit->count);
-        view_stats.sum += Eigen::Vector3d(hit->sum[0], hit->sum[1], hit->sum[2]);
-        view_stats.sum_squares +=
-            Eigen::Vector3d(hit->sum_squares[0], hit->sum_squares[1], hit->sum_squares[2]);
+        const int i = k - first;
+        ViewColourStats& view_stats = view_sums[begin[i] + count[i]++];
+        view_stats.view = view;
+        view_stats.count = static_cast<int>(pixels);
+        view_stats.sum = Eigen::Vector3d(static_cast<double>(sum[0]), static_cast<double>(sum[1]),
+                                         static_cast<double>(sum[2]));
+        view_stats.sum_squares =
+            Eigen::Vector3d(static_cast<double>(sum_squares[0]),
+                            static_cast<double>(sum_squares[1]),
+                            static_cast<double>(sum_squares[2]));
       }
     }
     for (int k = first; k < last; ++k) {

@@ -747,6 +747,17 @@ void IncrementalCarver::QueuePendingArrivals() {
   const int num_views = static_cast<int>(views_.size());
   std::vector<size_t>& next_run = pending_next_run_;
   next_run.assign(num_views, 0);
+  if (workers_.num_groups() > 1) {
+    // Written by the views' threads; read below a little of every view at a time.
+    for (int view = 0; view < num_views; ++view) {
+      const ViewOutput& output = view_outputs_[view];
+      const uint32_t num_runs = output.num_runs[slot];
+      if (num_runs == 0) continue;
+      PrefetchForReading(output.runs[slot], num_runs * sizeof(ReachedRun));
+      PrefetchForReading(output.reached[slot],
+                         output.runs[slot][num_runs - 1].end * sizeof(int64_t));
+    }
+  }
   for (size_t j = 0; j < pending_carved_; ++j) {
     for (int view = 0; view < num_views; ++view) {
       const ViewOutput& output = view_outputs_[view];
@@ -914,6 +925,13 @@ void IncrementalCarver::JudgeEntries(Batch* batch, int slot, bool colouring) {
     };
     // The views of each entry (a voxel's hits in one view are consecutive)...
     count.assign(num_entries + 1, 0);
+    if (first == 0 && workers_.num_groups() > 1) {
+      // Written by the views' threads: fetched at once rather than a view's stream at a time.
+      for (int view = 0; view < num_views; ++view) {
+        const ViewOutput& output = view_outputs_[view];
+        PrefetchForReading(output.hits[slot], output.num_hits[slot] * sizeof(BatchHit));
+      }
+    }
     for (int view = 0; view < num_views; ++view) {
       auto [hit, end] = hits_from(view);
       for (int previous = -1; hit != end && hit->k < last; ++hit) {

@@ -77,6 +77,17 @@ void PrefetchForWriting(const void* data, size_t bytes) {
 #endif
 }
 
+void PrefetchForReading(const void* data, size_t bytes) {
+  const char* begin = static_cast<const char*>(data);
+  for (size_t offset = 0; offset < bytes; offset += 64) {
+#if defined(__x86_64__) || defined(__i386__)
+    asm volatile("prefetcht0 %0" : : "m"(*(begin + offset)));  // as PrefetchForWriting
+#else
+    __builtin_prefetch(begin + offset);
+#endif
+  }
+}
+
 int ResolveNumThreads(int num_threads) {
   if (num_threads >= 1) return num_threads;
 #if defined(__linux__)

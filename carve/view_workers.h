@@ -123,6 +123,10 @@ class ViewWorkers {
 // for at once, the round trips overlap, and with the work done before the writing. A hint: it
 // changes nothing that the program computes.
 void PrefetchForWriting(const void* data, size_t bytes);
+// Fetches the cache lines of [data, data + bytes) ahead of reading them: for what another thread
+// wrote, read in short runs from many buffers at once (a run per view), which the processor's
+// own prefetching does not see coming.
+void PrefetchForReading(const void* data, size_t bytes);
 
 // Threads a pool would use for `num_threads` (< 1: the cores this process may run on, from its
 // CPU affinity where the system reports one, else the hardware's threads).

@@ -1047,10 +1047,8 @@ bool IncrementalCarver::StepBatch() {
     protected_kept_ += entry.kept_protected;
     if (entry.carve) batch_carved_.push_back(k);
   }
-  for (int k : batch_carved_) {
-    exposed_.clear();
-    volume_.Carve(current.entries[k].voxel, &exposed_);
-  }
+  // The voxels a carve exposes are queued as rays reach them (QueuePendingArrivals), not here.
+  for (int k : batch_carved_) volume_.Carve(current.entries[k].voxel, nullptr);
   carved_ += static_cast<int64_t>(batch_carved_.size());
   // The rays that ended in the carved voxels step on (through all of them), and the next batch's
   // Vis is found after them, view by view in one task; in it the calling thread queues the

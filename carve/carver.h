@@ -63,6 +63,8 @@ constexpr double kKnownSurfaceRadiusVoxels = 2.0;
 // same cover of the photo.
 constexpr double kKnownSurfaceRadiusSpacings = 1.0;
 constexpr double kKnownSurfaceMarginVoxels = 1.0;
+// The largest consistent error (RGB units) where none is given or can be chosen from the data.
+constexpr double kDefaultThreshold = 30.0;
 
 struct CarveOptions {
   // The smallest shorter side of a photo reduced for a coarse level of detail.
@@ -75,7 +77,7 @@ struct CarveOptions {
   ConsistencyMethod consistency = ConsistencyMethod::kMeanColour;
   // Largest consistent error, in RGB units (0-255). Negative: nothing is consistent, so every
   // voxel seen by min_views views is carved.
-  double threshold = 30.0;
+  double threshold = kDefaultThreshold;
   // consistency kPatchCorrelation: a voxel that passes the colour test but whose views see
   // texture is carved when 1 - NCC of their patterns exceeds this (0..2).
   double pattern_threshold = 0.5;
@@ -152,7 +154,7 @@ struct CarveOptions {
   // of work handed to the threads, so it does not depend on their number and neither does the
   // carving. 1: the seed paper's one voxel at a time (its threads then share each voxel's views:
   // a hand-over per voxel, which costs more than it saves on fine grids). Measured in
-  // docs/carving.md.
+  // docs/studies/carving.md.
   int batch_voxels = 64;
   // Ray casting: keep colour statistics per voxel and view incrementally (voxel_colour_sums.h):
   // evaluating a voxel reads its sums, and Vis(V) is found only for voxels carved (or judged by

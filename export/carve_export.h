@@ -53,7 +53,7 @@ struct ModelMeshOptions {
   // precision, four give 95.9% and 91.1%. On the Middlebury sets the passes do not converge as
   // fast (the mean |offset| stays above 0.1 voxel for 4-7 passes over their plain surfaces) and
   // passes beyond four cost held-out PSNR (dinoRing at 256 voxels: 21.00 dB after 4, 20.70 after
-  // 7), so four is the most (docs/mesh.md).
+  // 7), so four is the most (docs/studies/mesh.md).
   int refine_passes = 4;
   double refine_converged_voxels = 0.1;
   // After refinement, each vertex moves towards the mesh smoothed again (windowed sinc, this
@@ -62,7 +62,7 @@ struct ModelMeshOptions {
   // minimum) it stays; over plain surfaces and where too few photos see it, the voxels' bumps
   // the carve left are smoothed out. 0: none. Held-out PSNR of the mesh at 128 voxels, defaults
   // otherwise: +0.09 to +0.58 dB on the six Middlebury models; on the generated scenes the
-  // objects' precision rises at 128 voxels and falls at 256 (docs/mesh.md).
+  // objects' precision rises at 128 voxels and falls at 256 (docs/studies/mesh.md).
   int final_smoothing_iterations = 40;
   // Pieces of the iso-surface with fewer vertices than this go before refinement: specks, and
   // the parts of specks that flying edges splits where voxels touch only along an edge or at a

@@ -11,8 +11,12 @@
 #include "export/line_plot.h"
 #include "export/point_cloud_compare.h"
 #include "export/point_cloud_io.h"
+#include "pipeline/carve_pipeline.h"
+#include "plugin/carve_flags.h"
 #include "plugin/commands.h"
-#include "plugin/json_writer.h"
+#include "plugin/option_parser.h"
+#include "pipeline/json_writer.h"
+#include "pipeline/output_files.h"
 
 namespace raycarve {
 namespace {
@@ -65,20 +69,30 @@ int RunBenchmark(int argc, char** argv) {
   request.options.lod_levels = 1;  // the paper's Table 1 carves in one level, as it ends
   request.options.min_component_voxels = 0;
   AddCarveFlags(&parser, &request, &text);
+  parser.BeginGroup("Benchmark");
   parser.AddDefault("methods", &methods_text, "comma-separated: ray, gvc_ldi, gvc");
   parser.AddDefault("reference", &reference,
                     "optional reference PLY (e.g. synth's truth.ply): accuracy and completeness "
                     "of each method's cloud");
   parser.AddDefault("reference_threshold", &reference_threshold,
                     "completeness distance for --reference (0: two voxels)");
+  parser.SetBasicOptions({"workspace_path", "output_path", "methods", "reference", "resolution",
+                          "num_threads"});
+  parser.AddExample("raycarve benchmark --workspace_path P --reference P/truth.ply",
+                    "the paper's Table 1 and Figure 6 on P, each cloud against a true surface");
   if (!parser.Parse(argc, argv)) return 0;
   ApplyCarveFlags(text, &request);
   const std::vector<CarveMethod> methods = ParseMethods(methods_text);
 
-  const LoadedProject project =
-      LoadProject("benchmark", request.workspace_path, request.input_path, request.image_path,
-                  request.output_path, request.bounds, request.view_options, /*min_images=*/2,
-                  request.model_index, ColourCalibrationModeOf(request));
+  // The carve pipeline's stages up to the carve, once; then a carve per method of the same views.
+  PipelineScope scope;
+  scope.command = "benchmark";
+  CarvePipeline pipeline(request, scope);
+  pipeline.LoadViews();
+  pipeline.AgreeMasks();
+  pipeline.CheckVolume();
+  const LoadedProject& project = pipeline.project();
+  const std::vector<CalibratedView>& views = pipeline.carved_views();
   std::vector<Eigen::Vector3f> reference_points;
   if (!reference.empty()) reference_points = exporter::ReadComparablePoints(reference, 200000);
   const std::filesystem::path out = std::filesystem::path(project.output_path) / "benchmark";
@@ -90,11 +104,6 @@ int RunBenchmark(int argc, char** argv) {
   for (const CarveMethod method : methods) {
     CarveOptions options = request.options;
     options.method = method;
-    options.surface_points = project.surface_points;
-    std::string reason;
-    if (!CheckCarveFits(project.views, project.bounds.box, options, &reason)) {
-      throw InputError("raycarve benchmark: " + CarveMethodToString(method) + ": " + reason);
-    }
     LOG(INFO) << "benchmark: carving with " << CarveMethodToString(method);
     auto progress = [&](const CarveProgress& p) {
       LOG(INFO) << CarveMethodToString(method) << " " << p.seconds << " s: evaluated "
@@ -102,8 +111,7 @@ int RunBenchmark(int argc, char** argv) {
     };
     MethodRun run;
     run.method = method;
-    run.result = std::make_unique<CarveResult>(
-        CarveVolume(project.views, project.bounds.box, options, progress, 5.0));
+    run.result = std::make_unique<CarveResult>(pipeline.CarveWith(options, progress, 5.0));
     LOG(INFO) << run.result->statistics.Summary();
     const std::vector<exporter::ColouredPoint> points =
         exporter::SurfacePoints(*run.result, options.min_views);
@@ -151,7 +159,7 @@ int RunBenchmark(int argc, char** argv) {
   JsonWriter json;
   json.BeginObject()
       .Key("model_path").Value(project.model_path)
-      .Key("num_views").Value(static_cast<int>(project.views.size()))
+      .Key("num_views").Value(static_cast<int>(views.size()))
       .Key("resolution").Value(request.options.resolution)
       .Key("grid").Value(std::vector<double>{static_cast<double>(first.dimensions.x()),
                                               static_cast<double>(first.dimensions.y()),
@@ -222,7 +230,7 @@ int RunBenchmark(int argc, char** argv) {
     series.push_back(std::move(line));
   }
   std::ostringstream title;
-  title << "Voxels carved against time: " << project.views.size() << " views, "
+  title << "Voxels carved against time: " << views.size() << " views, "
         << first.dimensions.x() << "x" << first.dimensions.y() << "x" << first.dimensions.z()
         << " voxels";
   WriteImageAtomically((out / "figure6.png").string(),

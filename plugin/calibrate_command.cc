@@ -12,9 +12,13 @@
 #include "calib/model_reader.h"
 #include "calib/view_reader.h"
 #include "plugin/calibrate.h"
+#include "pipeline/project.h"
+#include "plugin/carve_flags.h"
 #include "plugin/commands.h"
-#include "plugin/json_writer.h"
-#include "plugin/workspace.h"
+#include "plugin/option_parser.h"
+#include "pipeline/json_writer.h"
+#include "pipeline/output_files.h"
+#include "pipeline/workspace.h"
 
 namespace raycarve {
 namespace {
@@ -158,17 +162,14 @@ int RunCalibrate(int argc, char** argv) {
   std::string workspace_path, input_path, image_path, output_path;
   bool write_undistorted = true;
   ViewReaderOptions view_options;
-  BoundsFlags bounds_flags;
+  BoundsRequest bounds_flags;
   OptionParser parser(
       "calibrate",
       "Turns every registered image of a COLMAP project into a calibrated view (undistorted "
       "photo, 3x4 projection), bounds the volume, checks the sparse points' reprojection through "
       "the views, and writes undistorted photos, views and a report.");
-  parser.AddDefault("workspace_path", &workspace_path,
-                    "COLMAP project (sparse/0 or sparse or dense/sparse, with images/)");
-  parser.AddDefault("input_path", &input_path, "model folder, overriding the workspace's");
-  parser.AddDefault("image_path", &image_path, "photo folder, overriding the workspace's");
-  parser.AddDefault("output_path", &output_path, "output folder (default <workspace>/raycarve)");
+  AddWorkspaceFlags(&parser, {&workspace_path, &input_path, &image_path, &output_path});
+  parser.BeginGroup("Outputs");
   parser.AddDefault("write_undistorted", &write_undistorted,
                     "write the undistorted photos and their validity masks");
   parser.AddDefault("skip_missing_images", &view_options.skip_missing_images,
@@ -176,9 +177,16 @@ int RunCalibrate(int argc, char** argv) {
   AddBoundsFlags(&parser, &bounds_flags);
   if (!parser.Parse(argc, argv)) return 0;
 
-  const LoadedProject project =
-      LoadProject("calibrate", workspace_path, input_path, image_path, output_path, bounds_flags,
-                  view_options, /*min_images=*/1);
+  ProjectRequest load;
+  load.command = "calibrate";
+  load.workspace_path = workspace_path;
+  load.input_path = input_path;
+  load.image_path = image_path;
+  load.output_path = output_path;
+  load.bounds = bounds_flags;
+  load.view_options = view_options;
+  load.min_images = 1;
+  const LoadedProject project = LoadProject(load);
   output_path = project.output_path;
   const std::vector<CalibratedView>& views = project.views;
   const Bounds& bounds = project.bounds;

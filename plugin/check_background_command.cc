@@ -4,9 +4,12 @@
 #include "calib/model_reader.h"
 #include "export/background_check.h"
 #include "export/point_cloud_io.h"
+#include "calib/view_reader.h"
 #include "plugin/commands.h"
-#include "plugin/json_writer.h"
-#include "plugin/workspace.h"
+#include "plugin/option_parser.h"
+#include "pipeline/json_writer.h"
+#include "pipeline/output_files.h"
+#include "pipeline/workspace.h"
 
 namespace raycarve {
 

@@ -7,7 +7,9 @@
 #include "export/point_cloud_compare.h"
 #include "export/similarity_alignment.h"
 #include "plugin/commands.h"
-#include "plugin/json_writer.h"
+#include "plugin/option_parser.h"
+#include "pipeline/json_writer.h"
+#include "pipeline/output_files.h"
 
 namespace raycarve {
 

@@ -18,11 +18,83 @@
 #include "export/point_cloud_compare.h"
 #include "export/point_renderer.h"
 #include "export/volume_renderer.h"
+#include "pipeline/carve_pipeline.h"
+#include "pipeline/carve_report.h"
+#include "plugin/carve_flags.h"
 #include "plugin/commands.h"
-#include "plugin/json_writer.h"
-#include "plugin/version.h"
+#include "plugin/option_parser.h"
+#include "pipeline/json_writer.h"
+#include "pipeline/output_files.h"
+#include "pipeline/run_info.h"
 
 namespace raycarve {
+
+namespace {
+
+// The held-out views' masks replaced by those in `mask_path` (<photo name>.png, as --mask_path),
+// undistorted as the carve's are: to score automatic masks against exact ones.
+void ReplaceScoringMasks(const CarvePipeline& pipeline,
+                         const std::string& mask_path,
+                         std::vector<CalibratedView>* held_out) {
+  const LoadedProject& project = pipeline.project();
+  std::set<std::string> names;
+  for (const CalibratedView& view : *held_out) names.insert(view.name);
+  Reconstruction held_out_model = project.reconstruction;
+  held_out_model.images.clear();
+  for (const auto& [id, image] : project.reconstruction.images) {
+    if (names.count(image.name) > 0) held_out_model.images.emplace(id, image);
+  }
+  ViewReaderOptions options = pipeline.request().view_options;
+  options.mask_path = mask_path;
+  std::vector<CalibratedView> scored =
+      ReadCalibratedViews(held_out_model, project.image_path, options, nullptr);
+  std::map<std::string, cv::Mat> mask_of;
+  for (CalibratedView& view : scored) mask_of[view.name] = view.mask;
+  for (CalibratedView& view : *held_out) view.mask = mask_of.at(view.name);
+  LOG(INFO) << "held-out views scored against the masks in " << mask_path;
+}
+
+// Someone else's cloud (--model without faces) as splats of `splat_size` (0: 1.5 x its median
+// neighbour spacing), returned in *point_size.
+std::vector<exporter::ColouredPoint> CloudOf(const exporter::TriangleMesh& cloud,
+                                             const std::string& path,
+                                             double splat_size,
+                                             double* point_size) {
+  std::vector<exporter::ColouredPoint> points;
+  std::vector<Eigen::Vector3f> xyz;
+  for (size_t i = 0; i < cloud.vertices.size(); ++i) {
+    exporter::ColouredPoint point;
+    point.xyz = cloud.vertices[i];
+    point.rgb = cloud.colours[i];
+    points.push_back(point);
+    xyz.push_back(point.xyz);
+  }
+  *point_size = splat_size > 0.0 ? splat_size : 1.5 * exporter::MedianNeighbourSpacing(xyz);
+  if (!(*point_size > 0.0)) {
+    throw InputError(path + ": cannot tell the cloud's spacing; give --point_size");
+  }
+  LOG(INFO) << path << ": " << points.size() << " points, drawn as splats of " << *point_size;
+  return points;
+}
+
+// Each level's threshold (and pattern threshold with ncc), for the report.
+std::string ThresholdsText(const CarveOptions& options, const CarveStatistics& statistics) {
+  std::string thresholds;
+  for (const LevelStatistics& level : statistics.levels) {
+    char text[64];
+    if (options.consistency == ConsistencyMethod::kPatchCorrelation) {
+      std::snprintf(text, sizeof(text), "%s%d: %.1f / %.2f", thresholds.empty() ? "" : ", ",
+                    level.resolution, level.threshold, level.pattern_threshold);
+    } else {
+      std::snprintf(text, sizeof(text), "%s%d: %.1f", thresholds.empty() ? "" : ", ",
+                    level.resolution, level.threshold);
+    }
+    thresholds += text;
+  }
+  return thresholds;
+}
+
+}  // namespace
 
 int RunHoldout(int argc, char** argv) {
   CarveRequest request;
@@ -39,6 +111,7 @@ int RunHoldout(int argc, char** argv) {
       "there is a mask, else over the whole photo) and silhouette IoU; writes photo | render | "
       "error images to <output>/holdout/ and holdout.json.");
   AddCarveFlags(&parser, &request, &text);
+  parser.BeginGroup("Held-out photos");
   parser.AddDefault("every", &every, "leave out views 1, 1 + k, 1 + 2k, ... (k >= 2)");
   parser.AddDefault("render", &render,
                     "how the model is drawn: the smooth mesh coloured from the training photos "
@@ -55,119 +128,57 @@ int RunHoldout(int argc, char** argv) {
                     "score the held-out views against these masks (<photo name>.png, as "
                     "--mask_path) instead of the masks the carve uses: to compare automatic "
                     "masks with exact ones on the same footing");
+  parser.SetBasicOptions({"workspace_path", "output_path", "every", "render", "model",
+                          "score_mask_path", "resolution", "mask_path", "num_threads"});
+  parser.AddExample("raycarve holdout --workspace_path P",
+                    "carve without every 4th photo at carve's defaults; score the mesh in those photos");
+  parser.AddExample("raycarve holdout --workspace_path P --model P/dense/fused.ply",
+                    "score another model (COLMAP's fused cloud) on the same held-out photos");
   if (!parser.Parse(argc, argv)) return 0;
   ApplyCarveFlags(text, &request);
   if (every < 2) throw InputError("raycarve holdout: --every must be at least 2");
 
-  const LoadedProject project =
-      LoadProject("holdout", request.workspace_path, request.input_path, request.image_path,
-                  request.output_path, request.bounds, request.view_options, /*min_images=*/3,
-                  request.model_index, ColourCalibrationModeOf(request), every);
-  // Every k-th image in name order is held out; its observations left the sparse points before
-  // the bounds, the colour calibration and the surface evidence were taken from them.
-  const std::set<std::string> held_out_names(project.held_out.begin(), project.held_out.end());
-  std::vector<CalibratedView> training, held_out;
-  for (const CalibratedView& view : project.views) {
-    (held_out_names.count(view.name) > 0 ? held_out : training).push_back(view);
-  }
-  std::sort(held_out.begin(), held_out.end(),
-            [](const CalibratedView& a, const CalibratedView& b) { return a.name < b.name; });
-  if (!score_mask_path.empty()) {
-    // The held-out views again, with the scoring masks, undistorted as the carve's are.
-    Reconstruction held_out_model = project.reconstruction;
-    held_out_model.images.clear();
-    for (const auto& [id, image] : project.reconstruction.images) {
-      if (held_out_names.count(image.name) > 0) held_out_model.images.emplace(id, image);
-    }
-    ViewReaderOptions score_options = request.view_options;
-    score_options.mask_path = score_mask_path;
-    std::vector<CalibratedView> scored =
-        ReadCalibratedViews(held_out_model, project.image_path, score_options, nullptr);
-    std::map<std::string, cv::Mat> mask_of;
-    for (CalibratedView& view : scored) mask_of[view.name] = view.mask;
-    for (CalibratedView& view : held_out) view.mask = mask_of.at(view.name);
-    LOG(INFO) << "held-out views scored against the masks in " << score_mask_path;
-  }
-  if (training.size() < 2) {
-    throw InputError("raycarve holdout: only " + std::to_string(training.size()) +
-                     " views left to carve with; raise --every");
-  }
+  PipelineScope scope;
+  scope.command = "holdout";
+  scope.min_images = 3;
+  // Every k-th image in name order is held out; its observations leave the sparse points before
+  // the bounds, the colour calibration and the surface evidence are taken from them.
+  scope.hold_out_every = every;
+  CarvePipeline pipeline(request, scope);
+  pipeline.LoadViews();
+  const LoadedProject& project = pipeline.project();
+  const std::vector<CalibratedView>& training = pipeline.carved_views();
+  std::vector<CalibratedView> held_out = pipeline.held_out_views();
+  if (!score_mask_path.empty()) ReplaceScoringMasks(pipeline, score_mask_path, &held_out);
   // Block PSNR's block: about a voxel of the grid the carve uses (or would use).
   const VoxelGrid grid(project.bounds.box, request.options.resolution);
-  std::unique_ptr<CarveResult> result;
+  const CarveResult* result = nullptr;
   std::vector<exporter::ColouredPoint> points;
   double point_size = grid.voxel_size();
   exporter::ModelMesh model;
   std::string thresholds;
-  CarveOptions options = request.options;
   if (!other_path.empty()) {
-    // Someone else's model: nothing is carved; a mesh is drawn as it is, a cloud as splats.
     model.mesh = exporter::ReadMeshOrCloudPly(other_path);
     if (model.mesh.triangles.empty()) {
       render = "splats";
-      std::vector<Eigen::Vector3f> xyz;
-      for (size_t i = 0; i < model.mesh.vertices.size(); ++i) {
-        exporter::ColouredPoint point;
-        point.xyz = model.mesh.vertices[i];
-        point.rgb = model.mesh.colours[i];
-        points.push_back(point);
-        xyz.push_back(point.xyz);
-      }
-      point_size = splat_size > 0.0 ? splat_size : 1.5 * exporter::MedianNeighbourSpacing(xyz);
-      if (!(point_size > 0.0)) {
-        throw InputError(other_path + ": cannot tell the cloud's spacing; give --point_size");
-      }
-      LOG(INFO) << other_path << ": " << points.size() << " points, drawn as splats of "
-                << point_size;
+      points = CloudOf(model.mesh, other_path, splat_size, &point_size);
     } else {
       render = "mesh";
       LOG(INFO) << other_path << ": " << model.mesh.triangles.size() << " triangles";
     }
   } else {
-    std::string reason;
-    if (!CheckCarveFits(training, project.bounds.box, request.options, &reason)) {
-      throw InputError("raycarve holdout: " + reason);
-    }
-    CheckVolumeSeen("holdout", project, training, request.options.min_views, request.bounds);
-    // The training photos' masks agree among themselves; the held-out photos' are scored as
-    // made.
-    AgreeBackdropMasks(request, project.view_summary, project.bounds.box, &training);
-    LOG(INFO) << "carving with " << training.size() << " views, holding out " << held_out.size();
-    options.surface_points = SurfacePointsOf(project.reconstruction, training, project.bounds.box);
-    result = std::make_unique<CarveResult>(CarveVolume(training, project.bounds.box, options));
-    if (result->statistics.free_space_sight_lines > 0) {
-      LOG(INFO) << result->statistics.FreeSpaceSummary();
-    }
-    if (result->statistics.unsupported_components > 0) LOG(INFO) << result->statistics.FloaterSummary();
-    if (result->statistics.silhouette_repair.views > 0) {
-      LOG(INFO) << result->statistics.silhouette_repair.Summary();
-    }
-    for (const LevelStatistics& level : result->statistics.levels) {
-      char text[64];
-      if (options.consistency == ConsistencyMethod::kPatchCorrelation) {
-        std::snprintf(text, sizeof(text), "%s%d: %.1f / %.2f", thresholds.empty() ? "" : ", ",
-                      level.resolution, level.threshold, level.pattern_threshold);
-      } else {
-        std::snprintf(text, sizeof(text), "%s%d: %.1f", thresholds.empty() ? "" : ", ",
-                      level.resolution, level.threshold);
-      }
-      thresholds += text;
-      if (options.auto_threshold) LOG(INFO) << level.estimate.Summary();
-    }
-    LOG(INFO) << result->statistics.Summary();
+    // The same stages as carve's, on the training views: their masks agree among themselves
+    // (the held-out photos' are scored as made), the model coloured from them only.
+    pipeline.AgreeMasks();
+    pipeline.CheckVolume();
+    pipeline.Carve();
+    result = pipeline.run().result.get();
+    thresholds = ThresholdsText(request.options, result->statistics);
     points = exporter::SurfacePoints(*result, request.options.min_views);
     point_size = result->volume.grid().voxel_size();
     if (render == "mesh") {
-      // Coloured from the training views only: the held-out photos never reach the model.
-      exporter::ModelMeshOptions mesh_options = request.mesh;
-      for (const SurfacePoint& point : options.surface_points) mesh_options.sparse_points.push_back(point.xyz);
-      model = exporter::MeshCarvedModel(*result, training, mesh_options);
-      LOG(INFO) << model.geometry.Summary();
-      if (!model.mesh.empty()) LOG(INFO) << model.refinement.Summary();
-      if (!model.mesh.empty()) LOG(INFO) << exporter::FinalSmoothingSummary(model, request.mesh);
-      if (model.parts.removed > 0 || model.parts.anchored > 0) LOG(INFO) << model.parts.Summary();
-      if (model.silhouettes.passes > 0) LOG(INFO) << model.silhouettes.Summary();
-      if (!model.mesh.empty()) LOG(INFO) << model.colouring.Summary();
+      pipeline.MakeSurface();
+      model = pipeline.model();
     }
   }
 
@@ -176,12 +187,9 @@ int RunHoldout(int argc, char** argv) {
   StagedOutputs staged(final_out.string());
   const std::filesystem::path out(staged.path());
   JsonWriter json;
-  json.BeginObject()
-      .Key("raycarve_version").Value(Version())
-      .Key("commit").Value(BuildCommit())
-      .Key("command_line").Value(RunCommandLine())
-      .Key("start_time").Value(RunStartTime())
-      .Key("model_path").Value(project.model_path)
+  json.BeginObject();
+  WriteRunIdentity(json);
+  json.Key("model_path").Value(project.model_path)
       .Key("every").Value(every)
       .Key("score_mask_path").Value(score_mask_path)
       .Key("training_views").Value(static_cast<uint64_t>(training.size()))
@@ -197,7 +205,7 @@ int RunHoldout(int argc, char** argv) {
       .Key("threads").Value(result ? result->statistics.threads : 0)
       .Key("convergence_seconds").Value(result ? result->statistics.carve_seconds : 0.0)
       .Key("thresholds").Value(thresholds)
-      .Key("surface_points").Value(static_cast<uint64_t>(options.surface_points.size()));
+      .Key("surface_points").Value(static_cast<uint64_t>(other_path.empty() ? pipeline.surface_points().size() : 0));
   json.Key("views").BeginArray();
   double psnr_sum = 0.0, iou_sum = 0.0, volume_psnr_sum = 0.0, volume_iou_sum = 0.0;
   int iou_count = 0;

@@ -9,7 +9,7 @@
 
 #include "calib/input_error.h"
 #include "plugin/commands.h"
-#include "plugin/version.h"
+#include "pipeline/run_info.h"
 
 namespace {
 

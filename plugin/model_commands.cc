@@ -12,8 +12,11 @@
 #include "calib/middlebury.h"
 #include "calib/model_reader.h"
 #include "calib/model_writer.h"
+#include "pipeline/project.h"
+#include "plugin/carve_flags.h"
 #include "plugin/commands.h"
-#include "plugin/json_writer.h"
+#include "pipeline/json_writer.h"
+#include "pipeline/output_files.h"
 #include "plugin/option_parser.h"
 
 namespace raycarve {
@@ -40,114 +43,6 @@ PointStatistics ComputePointStatistics(const Reconstruction& reconstruction) {
 }
 
 }  // namespace
-
-void AddBoundsFlags(OptionParser* parser, BoundsFlags* flags) {
-  parser->AddDefault("min_track_length", &flags->options.min_track_length,
-                     "sparse points seen in fewer images are ignored when bounding the volume");
-  parser->AddDefault("max_reprojection_error", &flags->options.max_reprojection_error,
-                     "sparse points with a larger mean reprojection error (px) are ignored; "
-                     "<= 0 keeps all");
-  parser->AddDefault("min_framed_share", &flags->options.min_framed_share,
-                     "sparse points framed by fewer photos than this share of the best framed "
-                     "points' count are the room around the object, left out when they are more "
-                     "than twice --trim_fraction of the points (0 keeps all)");
-  parser->AddDefault("trim_fraction", &flags->options.trim_fraction,
-                     "fraction of points dropped at each end of each axis (outliers)");
-  parser->AddDefault("min_points", &flags->options.min_points,
-                     "fewest usable sparse points that may bound the volume (else --bbox is asked for)");
-  parser->AddDefault("margin", &flags->options.margin,
-                     "added on every side, as a fraction of the largest extent");
-  parser->AddDefault("bbox", &flags->bbox,
-                     "explicit volume min_x,min_y,min_z,max_x,max_y,max_z (world units); "
-                     "overrides the sparse points");
-}
-
-Bounds ResolveBounds(const Reconstruction& reconstruction,
-                     const BoundsFlags& flags,
-                     const std::string& source) {
-  if (!flags.bbox.empty()) {
-    std::vector<double> values;
-    std::stringstream stream(flags.bbox);
-    stream.imbue(std::locale::classic());
-    std::string item;
-    while (std::getline(stream, item, ',')) {
-      char* end = nullptr;
-      const double value = std::strtod(item.c_str(), &end);
-      if (item.empty() || end != item.c_str() + item.size()) {
-        throw InputError("--bbox: '" + item + "' is not a number");
-      }
-      values.push_back(value);
-    }
-    if (values.size() != 6) {
-      throw InputError("--bbox: expected 6 comma-separated numbers, found " +
-                       std::to_string(values.size()));
-    }
-    return ExplicitBounds(Eigen::Vector3d(values[0], values[1], values[2]),
-                          Eigen::Vector3d(values[3], values[4], values[5]));
-  }
-  std::string reason;
-  if (!flags.options.IsValid(&reason)) throw InputError("bounds options: " + reason);
-  return ComputeBounds(reconstruction, flags.options, source);
-}
-
-namespace {
-// No output replaces an option file that was read (--project_path).
-void CheckNotAnOptionFile(const std::string& output_path) {
-  if (output_path.empty()) return;
-  for (const std::string& file : OptionFilesRead()) {
-    if (std::filesystem::weakly_canonical(output_path) == std::filesystem::weakly_canonical(file)) {
-      throw InputError(output_path + ": the output is the option file (--project_path " + file +
-                       "); raycarve never overwrites its input, choose another --output_path");
-    }
-  }
-}
-}  // namespace
-
-void CheckOutputDoesNotOverwrite(const std::string& output_path,
-                                 const std::string& input_path,
-                                 const std::string& what) {
-  CheckNotAnOptionFile(output_path);
-  if (output_path.empty() || input_path.empty()) return;
-  if (std::filesystem::weakly_canonical(output_path) ==
-      std::filesystem::weakly_canonical(input_path)) {
-    throw InputError(output_path + ": the output is the " + what + " (" + input_path +
-                     "); raycarve never overwrites its input, choose another --output_path");
-  }
-}
-
-void CheckOutputFileOutside(const std::string& output_file,
-                            const std::string& input_path,
-                            const std::string& what) {
-  CheckNotAnOptionFile(output_file);
-  if (output_file.empty() || input_path.empty()) return;
-  namespace fs = std::filesystem;
-  const fs::path output = fs::weakly_canonical(output_file);
-  const fs::path input = fs::weakly_canonical(input_path);
-  // The output is the input, or lies inside it (a folder), through links, dots and slashes.
-  const auto [input_end, output_at] = std::mismatch(input.begin(), input.end(), output.begin(), output.end());
-  if (input_end == input.end()) {
-    throw InputError(output_file + ": the output " +
-                     (output == input ? std::string("is the ") : std::string("lies inside the ")) +
-                     what + " (" + input_path +
-                     "); raycarve never overwrites its input, choose another --output_path");
-  }
-}
-
-std::filesystem::path OutputFileInside(const std::string& folder,
-                                       const std::string& relative_name,
-                                       const std::vector<std::pair<std::string, std::string>>& inputs) {
-  namespace fs = std::filesystem;
-  const fs::path name(relative_name);
-  const fs::path root = fs::weakly_canonical(folder);
-  const fs::path path = fs::weakly_canonical(root / name);
-  const auto [root_end, path_at] = std::mismatch(root.begin(), root.end(), path.begin(), path.end());
-  if (name.is_absolute() || root_end != root.end() || path == root) {
-    throw InputError(folder + ": the image name '" + relative_name +
-                     "' would write outside this output folder; raycarve refuses it");
-  }
-  for (const auto& [input, what] : inputs) CheckOutputFileOutside(path.string(), input, what);
-  return path;
-}
 
 std::string DescribeModelText(const Reconstruction& reconstruction,
                               const std::string& model_path,
@@ -244,7 +139,7 @@ int RunModelInfo(int argc, char** argv) {
   std::string input_path;
   std::string format = "text";
   std::string output_path;
-  BoundsFlags bounds_flags;
+  BoundsRequest bounds_flags;
   OptionParser parser("model_info",
                       "Prints a COLMAP sparse model's cameras, images and points, and the volume "
                       "raycarve would carve.");

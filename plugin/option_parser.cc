@@ -10,6 +10,7 @@
 #include <glog/logging.h>
 
 #include "calib/input_error.h"
+#include "pipeline/output_files.h"
 
 namespace raycarve {
 namespace {
@@ -43,6 +44,7 @@ OptionParser::Option& OptionParser::Add(const std::string& name,
   Option option;
   option.name = name;
   option.help = help;
+  option.group = group_;
   option.default_text = std::move(default_text);
   options_.push_back(std::move(option));
   return options_.back();
@@ -100,17 +102,8 @@ void OptionParser::Assign(Option* option, const std::string& value) {
   option->set = true;
 }
 
-namespace {
-std::vector<std::string>& MutableOptionFilesRead() {
-  static std::vector<std::string> files;
-  return files;
-}
-}  // namespace
-
-const std::vector<std::string>& OptionFilesRead() { return MutableOptionFilesRead(); }
-
 void OptionParser::ReadProjectFile(const std::string& path) {
-  MutableOptionFilesRead().push_back(path);
+  ProtectInputFile(path, "option file (--project_path " + path + ")");
   std::error_code error;
   const uintmax_t size = std::filesystem::file_size(path, error);
   if (error || !std::filesystem::is_regular_file(path)) {
@@ -183,7 +176,11 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
   for (int i = first; i < argc; ++i) {
     std::string argument = argv[i];
     if (argument == "--help" || argument == "-h") {
-      std::cout << Help();
+      std::cout << Help(basic_.empty() || (i + 1 < argc && std::string(argv[i + 1]) == "all"));
+      return false;
+    }
+    if (argument == "--help_markdown") {
+      std::cout << Markdown();
       return false;
     }
     if (argument.rfind("--", 0) != 0) {
@@ -243,26 +240,115 @@ bool OptionParser::IsSet(const std::string& name) const {
   return false;
 }
 
-std::string OptionParser::Help() const {
-  std::ostringstream text;
-  text << "Usage: raycarve " << command_ << " [options]\n\n" << description_ << "\n\nOptions:\n";
+void OptionParser::BeginGroup(const std::string& title) { group_ = title; }
+
+void OptionParser::SetBasicOptions(std::vector<std::string> names) {
+  for (const std::string& name : names) {
+    CHECK(std::any_of(options_.begin(), options_.end(),
+                      [&](const Option& o) { return o.name == name; }))
+        << "basic option --" << name << " was never added";
+  }
+  basic_ = std::move(names);
+}
+
+void OptionParser::AddExample(const std::string& command_line, const std::string& what) {
+  examples_.emplace_back(command_line, what);
+}
+
+std::vector<std::string> OptionParser::Groups() const {
+  // In the order the groups were first added; the untitled group first.
+  std::vector<std::string> groups;
   for (const Option& option : options_) {
-    text << "  --" << option.name << "\n      " << option.help;
-    if (!option.allowed_values.empty() && !option.is_flag) {
-      text << "\n      allowed: ";
-      for (size_t k = 0; k < option.allowed_values.size(); ++k) {
-        text << (k ? ", " : "") << option.allowed_values[k];
+    if (std::find(groups.begin(), groups.end(), option.group) == groups.end()) {
+      groups.push_back(option.group);
+    }
+  }
+  std::stable_partition(groups.begin(), groups.end(), [](const std::string& g) { return g.empty(); });
+  return groups;
+}
+
+std::string OptionParser::OptionHelp(const Option& option) {
+  std::string text = "  --" + option.name + "\n      " + option.help;
+  if (!option.allowed_values.empty() && !option.is_flag) {
+    text += "\n      allowed: ";
+    for (size_t k = 0; k < option.allowed_values.size(); ++k) {
+      text += (k ? ", " : "") + option.allowed_values[k];
+    }
+  }
+  return text + (option.required ? "\n      (required)" : "\n      default: " + option.default_text) +
+         "\n";
+}
+
+std::string OptionParser::Help(bool all) const {
+  std::ostringstream text;
+  text << "Usage: raycarve " << command_ << " [options]\n\n" << description_ << "\n";
+  if (!all) {
+    text << "\nThe options changed most often (every option, by stage: --help all):\n";
+    for (const std::string& name : basic_) {
+      for (const Option& option : options_) {
+        if (option.name == name) text << OptionHelp(option);
       }
     }
-    text << (option.required ? "\n      (required)" : "\n      default: " + option.default_text)
-         << "\n";
+  } else {
+    for (const std::string& group : Groups()) {
+      text << "\n" << (group.empty() ? std::string("Options") : group + " options") << ":\n";
+      for (const Option& option : options_) {
+        if (option.group == group) text << OptionHelp(option);
+      }
+    }
+    for (const auto& [old_name, current] : deprecated_) {
+      text << "  --" << old_name << "\n      deprecated name of --" << current << "\n";
+    }
   }
-  for (const auto& [old_name, current] : deprecated_) {
-    text << "  --" << old_name << "\n      deprecated name of --" << current << "\n";
+  if (!examples_.empty()) {
+    text << "\nExamples:\n";
+    for (const auto& [line, what] : examples_) text << "  " << line << "\n      " << what << "\n";
   }
   text << "\nEvery command also takes --project_path FILE.ini (COLMAP's option files: key=value\n"
           "lines, [sections]; the command line overrides it) and glog's --log_to_stderr,\n"
           "--log_level and --v as COLMAP does.\n";
+  return text.str();
+}
+
+std::string OptionParser::Markdown() const {
+  // Table cells: pipes escaped, so that a value list stays in its cell.
+  const auto cell = [](const std::string& text) {
+    std::string escaped;
+    for (char c : text) {
+      escaped += c == '|' ? std::string("\\|")
+                 : c == '<' ? std::string("&lt;")
+                 : c == '>' ? std::string("&gt;")
+                            : std::string(1, c);
+    }
+    return escaped;
+  };
+  std::ostringstream text;
+  text << "## raycarve " << command_ << "\n\n" << description_ << "\n";
+  for (const std::string& group : Groups()) {
+    text << "\n" << (group.empty() ? std::string("**Options**") : "**" + group + "**") << "\n\n"
+         << "| option | default | what it does |\n|---|---|---|\n";
+    for (const Option& option : options_) {
+      if (option.group != group) continue;
+      std::string help = option.help;
+      if (!option.allowed_values.empty() && !option.is_flag) {
+        help += " (allowed: ";
+        for (size_t k = 0; k < option.allowed_values.size(); ++k) {
+          help += (k ? ", " : "") + option.allowed_values[k];
+        }
+        help += ")";
+      }
+      const bool basic = std::find(basic_.begin(), basic_.end(), option.name) != basic_.end();
+      text << "| `--" << option.name << "`" << (basic ? " *" : "") << " | "
+           << (option.required              ? std::string("required")
+               : option.default_text.empty() ? std::string("(none)")
+                                             : "`" + cell(option.default_text) + "`")
+           << " | " << cell(help) << " |\n";
+    }
+  }
+  if (!examples_.empty()) {
+    text << "\nExamples:\n\n";
+    for (const auto& [line, what] : examples_) text << "- `" << line << "`: " << what << "\n";
+  }
   return text.str();
 }
 

@@ -16,9 +16,10 @@ namespace raycarve {
 //
 // Parse throws InputError on an unknown option, a missing value, a value that does not parse as
 // the option's type or is not among its allowed values, or a missing required option. `--help`
-// makes Parse return false after printing the help to stdout.
-// The option files (--project_path) this process has read: inputs that no output may replace.
-const std::vector<std::string>& OptionFilesRead();
+// makes Parse return false after printing the help to stdout: the options a user changes first
+// when the command names them (SetBasicOptions), every option by group with `--help all`, and the
+// examples. `--help_markdown` prints every option as Markdown (docs/cli.md is made from it).
+// An option file read is protected as an input: no output may replace it (ProtectInputFile).
 
 class OptionParser {
  public:
@@ -37,13 +38,24 @@ class OptionParser {
   // An old name of an option: still accepted, with a warning that it is deprecated.
   void AddDeprecatedName(const std::string& old_name, const std::string& name);
 
+  // Options added from now on belong to the group `title` ("Carve", "Mesh", ...), which the help
+  // lists under that title; options added before any group are listed first, untitled.
+  void BeginGroup(const std::string& title);
+  // The options `--help` shows (the rest with `--help all`); none given: `--help` shows all.
+  void SetBasicOptions(std::vector<std::string> names);
+  // An example command line for the end of the help, with what it does.
+  void AddExample(const std::string& command_line, const std::string& what);
+
   // Parses argv[first..argc); returns false when --help was asked for.
   bool Parse(int argc, char** argv, int first = 2);
 
   // True when the option was given on the command line (not left at its default).
   bool IsSet(const std::string& name) const;
 
-  std::string Help() const;
+  // The help text: the basic options only, or every option by group (`all`).
+  std::string Help(bool all = true) const;
+  // Every option as a Markdown section: a table per group, then the examples.
+  std::string Markdown() const;
 
  private:
   struct Option {
@@ -55,7 +67,12 @@ class OptionParser {
     bool is_flag = false;  // bool: "--name" alone means true
     bool set = false;
     std::function<void(const std::string&)> assign;
+    std::string group;  // BeginGroup's title when it was added
   };
+  // One option's lines in the help text.
+  static std::string OptionHelp(const Option& option);
+  // The groups' titles in the order they were first added, the untitled group first.
+  std::vector<std::string> Groups() const;
   Option& Add(const std::string& name, const std::string& help, std::string default_text);
   // Checks `value` against the option's allowed values and assigns it.
   void Assign(Option* option, const std::string& value);
@@ -66,6 +83,9 @@ class OptionParser {
   std::string description_;
   std::vector<Option> options_;
   std::vector<std::pair<std::string, std::string>> deprecated_;  // old name, current name
+  std::string group_;                                             // the group being added
+  std::vector<std::string> basic_;                                // --help's options
+  std::vector<std::pair<std::string, std::string>> examples_;     // command line, what it does
 };
 
 }  // namespace raycarve

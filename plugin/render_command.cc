@@ -12,8 +12,11 @@
 #include "calib/model_reader.h"
 #include "export/point_cloud_io.h"
 #include "export/point_renderer.h"
+#include "calib/view_reader.h"
 #include "plugin/commands.h"
-#include "plugin/json_writer.h"
+#include "plugin/option_parser.h"
+#include "pipeline/json_writer.h"
+#include "pipeline/output_files.h"
 
 namespace raycarve {
 int RunRender(int argc, char** argv) {

@@ -12,7 +12,8 @@
 #include "calib/model_reader.h"
 #include "plugin/colmap_runner.h"
 #include "plugin/commands.h"
-#include "plugin/workspace.h"
+#include "plugin/option_parser.h"
+#include "pipeline/workspace.h"
 
 namespace raycarve {
 namespace {

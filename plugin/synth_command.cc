@@ -3,7 +3,9 @@
 #include <glog/logging.h>
 
 #include "calib/input_error.h"
+#include "calib/view_reader.h"
 #include "plugin/commands.h"
+#include "plugin/option_parser.h"
 #include "samples/synthetic_scene.h"
 
 namespace raycarve {

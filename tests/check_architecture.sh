@@ -1,28 +1,36 @@
 #!/usr/bin/env bash
 # Checks the dependency direction of ../shared/STYLE.md on the source tree given as $1:
-# calib <- carve <- export <- plugin; carve does no file I/O and uses no PCL; PCL only in
-# export/*.cc; Ceres only in .cc files. Prints every violation and exits 1 if there is any.
+# calib <- carve <- export <- pipeline <- plugin; carve does no file I/O and uses no PCL; PCL only
+# in export/*.cc; Ceres only in .cc files; carve's internal headers (the first line says
+# "Internal to carve/") are included only inside carve/ and its tests. Prints every violation and exits 1 if there is any.
 set -u
 root=${1:-.}
 cd "$root" || exit 2
 status=0
 report() { echo "dependency violation: $1"; echo "$2" | sed 's/^/    /'; status=1; }
 
-hits=$(grep -rnE '#include *"(carve|export|plugin|samples)/' calib 2>/dev/null)
+hits=$(grep -rnE '#include *"(carve|export|pipeline|plugin|samples)/' calib 2>/dev/null)
 [ -n "$hits" ] && report "calib/ may use nothing of ours" "$hits"
-hits=$(grep -rnE '#include *"(export|plugin|samples)/' carve 2>/dev/null)
+hits=$(grep -rnE '#include *"(export|pipeline|plugin|samples)/' carve 2>/dev/null)
 [ -n "$hits" ] && report "carve/ may use only calib/" "$hits"
-hits=$(grep -rnE '#include *"(plugin|samples)/' export 2>/dev/null)
+hits=$(grep -rnE '#include *"(pipeline|plugin|samples)/' export 2>/dev/null)
 [ -n "$hits" ] && report "export/ may use only carve/ and calib/" "$hits"
-hits=$(grep -rnE '#include *"plugin/' samples 2>/dev/null)
-[ -n "$hits" ] && report "samples/ may not use plugin/" "$hits"
+hits=$(grep -rnE '#include *"(plugin|samples)/' pipeline 2>/dev/null)
+[ -n "$hits" ] && report "pipeline/ may use only export/, carve/ and calib/" "$hits"
+hits=$(grep -rnE '#include *"(pipeline|plugin)/' samples 2>/dev/null)
+[ -n "$hits" ] && report "samples/ may not use pipeline/ or plugin/" "$hits"
+internal=$(grep -lE '^// Internal to carve/' carve/*.h 2>/dev/null | sed 's|^|#include "|; s|$|"|')
+if [ -n "$internal" ]; then
+  hits=$(grep -rnF "$internal" calib export pipeline plugin samples benchmarks tests/calib tests/export tests/plugin tests/samples 2>/dev/null)
+  [ -n "$hits" ] && report "carve's internal headers are included only in carve/ (and its tests)" "$hits"
+fi
 hits=$(grep -rnE 'imread|imwrite|std::ifstream|std::ofstream|std::filesystem|fopen\(|#include *<(fstream|filesystem)>|#include *<pcl/|std::cout|printf\(' carve 2>/dev/null)
 [ -n "$hits" ] && report "carve/ does no file I/O, no printing and no PCL" "$hits"
-hits=$(grep -rnE '#include *<pcl/' --include='*.h' . 2>/dev/null; grep -rlE '#include *<pcl/' --include='*.cc' calib carve plugin samples 2>/dev/null)
+hits=$(grep -rnE '#include *<pcl/' --include='*.h' . 2>/dev/null; grep -rlE '#include *<pcl/' --include='*.cc' calib carve pipeline plugin samples 2>/dev/null)
 [ -n "$hits" ] && report "PCL appears only in export/*.cc" "$hits"
-hits=$(grep -rnE '#include *<ceres/' --include='*.h' calib carve export plugin samples 2>/dev/null)
+hits=$(grep -rnE '#include *<ceres/' --include='*.h' calib carve export pipeline plugin samples 2>/dev/null)
 [ -n "$hits" ] && report "Ceres headers only inside .cc files" "$hits"
-hits=$(grep -rnE 'std::cout|std::cerr|printf\(' calib carve export 2>/dev/null | grep -v snprintf)
+hits=$(grep -rnE 'std::cout|std::cerr|printf\(' calib carve export pipeline 2>/dev/null | grep -v snprintf)
 [ -n "$hits" ] && report "no printing in library code (use glog)" "$hits"
 [ $status -eq 0 ] && echo "dependency direction holds"
 exit $status

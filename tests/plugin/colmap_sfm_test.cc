@@ -11,7 +11,7 @@
 
 #include "calib/model_reader.h"
 #include "export/similarity_alignment.h"
-#include "plugin/workspace.h"
+#include "pipeline/workspace.h"
 #include "tests/test_support.h"
 
 namespace raycarve {

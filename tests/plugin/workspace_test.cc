@@ -1,4 +1,4 @@
-#include "plugin/workspace.h"
+#include "pipeline/workspace.h"
 
 #include <filesystem>
 
@@ -6,6 +6,7 @@
 
 #include "calib/input_error.h"
 #include "calib/model_writer.h"
+#include "pipeline/project.h"
 #include "plugin/commands.h"
 #include "tests/test_support.h"
 

@@ -1,4 +1,5 @@
-#include "plugin/json_writer.h"
+#include "pipeline/json_writer.h"
+#include "pipeline/output_files.h"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "plugin/json_writer.h"
+#include "pipeline/json_writer.h"
 
 #include <cmath>
 #include <cstdio>
@@ -162,23 +162,6 @@ std::string JsonWriter::str() const {
   return out_.str() + "\n";
 }
 
-void WriteTextFileAtomically(const std::string& path, const std::string& text) {
-  const std::string temporary = TemporaryPathFor(path);
-  {
-    std::ofstream stream(temporary);
-    if (!stream) throw InputError(temporary + ": cannot open for writing");
-    stream << text;
-    if (!stream.flush()) throw InputError(temporary + ": write failed");
-  }
-  RenameIntoPlace(temporary, path);
-}
-
 std::vector<double> JsonArray(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
-void WriteImageAtomically(const std::string& path, const cv::Mat& image) {
-  const std::string temporary = TemporaryPathFor(path);
-  if (!cv::imwrite(temporary, image)) throw InputError(temporary + ": cannot write the image");
-  RenameIntoPlace(temporary, path);
-}
 
 }  // namespace raycarve

@@ -1,10 +1,10 @@
-#include "plugin/workspace.h"
+#include "pipeline/project.h"
 
 #include <algorithm>
-#include <iomanip>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
+#include <iomanip>
+#include <locale>
 #include <map>
 #include <set>
 #include <sstream>
@@ -12,120 +12,55 @@
 #include <glog/logging.h>
 #include <unistd.h>
 
-#include "calib/colour_calibration.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
 #include "carve/carver.h"
-#include "plugin/commands.h"
+#include "pipeline/output_files.h"
+#include "pipeline/workspace.h"
 
 namespace raycarve {
-namespace {
 
-bool HoldsModel(const std::filesystem::path& folder) {
-  return std::filesystem::exists(folder / "cameras.bin") ||
-         std::filesystem::exists(folder / "cameras.txt");
-}
-
-// Registered images of a model: images.bin's leading count, or half the lines of images.txt
-// after its comments.
-int64_t CountImages(const std::filesystem::path& model) {
-  std::ifstream binary(model / "images.bin", std::ios::binary);
-  if (binary) {
-    uint64_t count = 0;
-    binary.read(reinterpret_cast<char*>(&count), sizeof(count));
-    return binary ? static_cast<int64_t>(count) : 0;
-  }
-  std::ifstream text(model / "images.txt");
-  int64_t lines = 0;
-  std::string line;
-  // Two lines an image; the second (its points) is empty for an image without observations.
-  while (std::getline(text, line)) lines += line.empty() || line[0] != '#';
-  return lines / 2;
-}
-
-}  // namespace
-
-std::vector<ModelCandidate> NumberedModels(const std::string& sparse_path) {
-  std::vector<ModelCandidate> models;
-  std::error_code error;
-  if (!std::filesystem::is_directory(sparse_path, error)) return models;
-  for (const auto& entry : std::filesystem::directory_iterator(sparse_path, error)) {
-    const std::string name = entry.path().filename().string();
-    if (name.empty() || name.size() > 6 ||
-        name.find_first_not_of("0123456789") != std::string::npos || !HoldsModel(entry.path())) {
-      continue;
-    }
-    models.push_back({std::stoi(name), entry.path().string(), CountImages(entry.path())});
-  }
-  std::sort(models.begin(), models.end(),
-            [](const ModelCandidate& a, const ModelCandidate& b) { return a.index < b.index; });
-  return models;
-}
-
-WorkspacePaths ResolveWorkspace(const std::string& workspace_path,
-                                const std::string& input_path,
-                                const std::string& image_path,
-                                int model_index) {
-  WorkspacePaths paths;
-  if (!input_path.empty()) {
-    paths.model_path = input_path;
-    paths.layout = "explicit";
-    if (!image_path.empty()) {
-      paths.image_path = image_path;
-    } else if (!workspace_path.empty()) {
-      paths.image_path = (std::filesystem::path(workspace_path) / "images").string();
-    } else {
-      throw InputError("--input_path given without --image_path or --workspace_path: the "
-                       "photos' folder is unknown");
-    }
-    return paths;
-  }
-  if (workspace_path.empty()) {
-    throw InputError("give --workspace_path (a COLMAP project) or --input_path and --image_path");
-  }
-  const std::filesystem::path root(workspace_path);
-  if (!std::filesystem::is_directory(root)) {
-    throw InputError(workspace_path + ": workspace folder does not exist");
-  }
-  const std::vector<ModelCandidate> numbered = NumberedModels((root / "sparse").string());
-  if (model_index >= 0 || numbered.size() > 1) {
-    const ModelCandidate* chosen = nullptr;
-    for (const ModelCandidate& model : numbered) {
-      if (model_index >= 0 ? model.index == model_index
-                           : chosen == nullptr || model.num_images > chosen->num_images) {
-        chosen = &model;
+Bounds ResolveBounds(const Reconstruction& reconstruction,
+                     const BoundsRequest& flags,
+                     const std::string& source) {
+  if (!flags.bbox.empty()) {
+    std::vector<double> values;
+    std::stringstream stream(flags.bbox);
+    stream.imbue(std::locale::classic());
+    std::string item;
+    while (std::getline(stream, item, ',')) {
+      char* end = nullptr;
+      const double value = std::strtod(item.c_str(), &end);
+      if (item.empty() || end != item.c_str() + item.size()) {
+        throw InputError("--bbox: '" + item + "' is not a number");
       }
+      values.push_back(value);
     }
-    if (chosen == nullptr) {
-      throw InputError(workspace_path + ": --model_index " + std::to_string(model_index) +
-                       ": no model in sparse/" + std::to_string(model_index) + " (" +
-                       std::to_string(numbered.size()) + " numbered models in sparse/)");
+    if (values.size() != 6) {
+      throw InputError("--bbox: expected 6 comma-separated numbers, found " +
+                       std::to_string(values.size()));
     }
-    if (model_index < 0) {
-      LOG(INFO) << numbered.size() << " models in " << (root / "sparse").string() << ": taking "
-                << chosen->path << " (" << chosen->num_images
-                << " images, the most; --model_index chooses another)";
-    }
-    paths.model_path = chosen->path;
-    paths.image_path = image_path.empty() ? (root / "images").string() : image_path;
-    paths.layout = "sparse/" + std::to_string(chosen->index);
-    return paths;
+    return ExplicitBounds(Eigen::Vector3d(values[0], values[1], values[2]),
+                          Eigen::Vector3d(values[3], values[4], values[5]));
   }
-  const struct {
-    const char* model;
-    const char* images;
-  } layouts[] = {{"sparse/0", "images"}, {"sparse", "images"}, {"dense/sparse", "dense/images"}};
-  for (const auto& layout : layouts) {
-    if (HoldsModel(root / layout.model)) {
-      paths.model_path = (root / layout.model).string();
-      paths.image_path = image_path.empty() ? (root / layout.images).string() : image_path;
-      paths.layout = layout.model;
-      return paths;
-    }
-  }
-  throw InputError(workspace_path +
-                   ": no COLMAP model found in sparse/0, sparse or dense/sparse (looked for "
-                   "cameras.bin or cameras.txt); give --input_path");
+  std::string reason;
+  if (!flags.options.IsValid(&reason)) throw InputError("bounds options: " + reason);
+  return ComputeBounds(reconstruction, flags.options, source);
+}
+
+
+ProjectRequest ProjectRequestOf(const CarveRequest& request, const std::string& command) {
+  ProjectRequest project;
+  project.command = command;
+  project.workspace_path = request.workspace_path;
+  project.input_path = request.input_path;
+  project.image_path = request.image_path;
+  project.output_path = request.output_path;
+  project.bounds = request.bounds;
+  project.view_options = request.view_options;
+  project.model_index = request.model_index;
+  project.colour_calibration = ColourCalibrationModeOf(request);
+  return project;
 }
 
 void CheckPhotosFitInMemory(const Reconstruction& reconstruction, int max_image_size,
@@ -164,26 +99,16 @@ void CheckPhotosFitInMemory(const Reconstruction& reconstruction, int max_image_
   throw InputError(text.str());
 }
 
-LoadedProject LoadProject(const std::string& command,
-                          const std::string& workspace_path,
-                          const std::string& input_path,
-                          const std::string& image_path,
-                          const std::string& output_path,
-                          const BoundsFlags& bounds_flags,
-                          const ViewReaderOptions& view_options,
-                          int min_images,
-                          int model_index,
-                          ColourCalibrationMode colour_calibration,
-                          int hold_out_every) {
+LoadedProject LoadProject(const ProjectRequest& request) {
   LoadedProject project;
   const WorkspacePaths paths =
-      ResolveWorkspace(workspace_path, input_path, image_path, model_index);
+      ResolveWorkspace(request.workspace_path, request.input_path, request.image_path, request.model_index);
   project.model_path = paths.model_path;
   project.image_path = paths.image_path;
-  project.output_path = output_path;
+  project.output_path = request.output_path;
   if (project.output_path.empty()) {
-    if (workspace_path.empty()) throw InputError("raycarve " + command + ": give --output_path");
-    project.output_path = (std::filesystem::path(workspace_path) / "raycarve").string();
+    if (request.workspace_path.empty()) throw InputError("raycarve " + request.command + ": give --output_path");
+    project.output_path = (std::filesystem::path(request.workspace_path) / "raycarve").string();
   }
   CheckOutputDoesNotOverwrite(project.output_path, paths.model_path, "input model");
   CheckOutputDoesNotOverwrite(project.output_path, paths.image_path, "photo folder");
@@ -192,40 +117,40 @@ LoadedProject LoadProject(const std::string& command,
   project.reconstruction = ReadModel(paths.model_path);
   const size_t registered = project.reconstruction.images.size();
   if (registered == 0) throw InputError(paths.model_path + ": the model has no registered images");
-  if (static_cast<int>(registered) < min_images) {
+  if (static_cast<int>(registered) < request.min_images) {
     throw InputError(paths.model_path + ": the model has " + std::to_string(registered) +
-                     " registered images; raycarve " + command + " needs at least " +
-                     std::to_string(min_images));
+                     " registered images; raycarve " + request.command + " needs at least " +
+                     std::to_string(request.min_images));
   }
-  if (hold_out_every > 0) {
-    project.held_out = HoldOutImages(hold_out_every, &project.reconstruction);
+  if (request.hold_out_every > 0) {
+    project.held_out = HoldOutImages(request.hold_out_every, &project.reconstruction);
     LOG(INFO) << "holding out " << project.held_out.size() << " of " << registered
-              << " images (every " << hold_out_every << "th in name order); "
+              << " images (every " << request.hold_out_every << "th in name order); "
               << project.reconstruction.points3D.size()
               << " sparse points keep two or more observations without them";
   }
-  project.bounds = ResolveBounds(project.reconstruction, bounds_flags, paths.model_path);
+  project.bounds = ResolveBounds(project.reconstruction, request.bounds, paths.model_path);
   LOG(INFO) << project.bounds.Summary();
-  CheckPhotosFitInMemory(project.reconstruction, view_options.max_image_size);
+  CheckPhotosFitInMemory(project.reconstruction, request.view_options.max_image_size);
   LOG(INFO) << "loading and undistorting " << registered << " photos from " << paths.image_path;
-  ViewReaderOptions reader_options = view_options;
+  ViewReaderOptions reader_options = request.view_options;
   reader_options.volume = project.bounds.box;
   project.views = ReadCalibratedViews(project.reconstruction, paths.image_path, reader_options,
                                       &project.view_summary);
   LOG(INFO) << project.view_summary.Summary();
-  if (static_cast<int>(project.views.size()) < min_images) {
+  if (static_cast<int>(project.views.size()) < request.min_images) {
     throw InputError(paths.image_path + ": only " + std::to_string(project.views.size()) +
-                     " photos could be loaded; raycarve " + command + " needs at least " +
-                     std::to_string(min_images));
+                     " photos could be loaded; raycarve " + request.command + " needs at least " +
+                     std::to_string(request.min_images));
   }
-  if (colour_calibration != ColourCalibrationMode::kOff) {
+  if (request.colour_calibration != ColourCalibrationMode::kOff) {
     project.colour = EstimateColourCalibration(project.reconstruction, project.views);
     if (project.colour.points_used == 0) {
-      if (colour_calibration == ColourCalibrationMode::kOn) {
+      if (request.colour_calibration == ColourCalibrationMode::kOn) {
         LOG(WARNING) << "colour calibration: no sparse point is seen by 3 or more photos; the "
                         "photos are used as they are";
       }
-    } else if (colour_calibration == ColourCalibrationMode::kOn ||
+    } else if (request.colour_calibration == ColourCalibrationMode::kOn ||
                ColourCalibrationPays(project.colour)) {
       ApplyColourCalibration(project.colour, &project.views);
       project.colour.applied = true;
@@ -245,7 +170,7 @@ void CheckVolumeSeen(const std::string& command,
                      const LoadedProject& project,
                      const std::vector<CalibratedView>& views,
                      int min_views,
-                     const BoundsFlags& bounds_flags) {
+                     const BoundsRequest& bounds_flags) {
   const Eigen::AlignedBox3d& box = project.bounds.box;
   const BoxCoverage coverage = MeasureBoxCoverage(views, box, min_views);
   if (coverage.seen_share > 0.0) {
@@ -275,7 +200,7 @@ void CheckVolumeSeen(const std::string& command,
          << std::lround(100.0 * coverage.view_share[v]) << "%";
   }
   if (project.bounds.is_explicit) {
-    BoundsFlags from_points = bounds_flags;
+    BoundsRequest from_points = bounds_flags;
     from_points.bbox.clear();
     try {
       const Bounds own = ResolveBounds(project.reconstruction, from_points, project.model_path);

@@ -1,4 +1,4 @@
-#include "plugin/version.h"
+#include "pipeline/run_info.h"
 
 #include <ctime>
 

@@ -6,7 +6,6 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 namespace raycarve {
 
@@ -44,13 +43,6 @@ class JsonWriter {
   std::vector<bool> has_items_;  // per open container
   bool after_key_ = false;
 };
-
-// Writes `text` to `path` through a temporary file and a rename; throws InputError on failure.
-void WriteTextFileAtomically(const std::string& path, const std::string& text);
-
-// Writes an image in the format of the path's extension (cv::imwrite: BGR or grey), through a
-// temporary name and a rename; throws InputError naming the file on failure.
-void WriteImageAtomically(const std::string& path, const cv::Mat& image);
 
 // A 3-vector as the std::vector that JsonWriter::Value writes as a one-line array.
 std::vector<double> JsonArray(const Eigen::Vector3d& v);

@@ -1,0 +1,402 @@
+#include "pipeline/carve_pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include <glog/logging.h>
+
+#include "calib/input_error.h"
+#include "calib/model_writer.h"
+#include "pipeline/carve_report.h"
+#include "pipeline/output_files.h"
+
+namespace raycarve {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// True when `inner` is `outer` or lies inside it (both canonical).
+bool Within(const fs::path& inner, const fs::path& outer) {
+  const auto [outer_end, unused] = std::mismatch(outer.begin(), outer.end(), inner.begin(), inner.end());
+  return outer_end == outer.end();
+}
+
+// Logs what the sparse points are used for, when anything.
+void LogSurfacePointUses(const CarveOptions& options, size_t count) {
+  std::vector<std::string> uses;
+  if (options.auto_threshold) uses.push_back("choose the threshold");
+  if (options.protect_surface_points) uses.push_back("protect their voxels");
+  if (options.free_space_margin_voxels > 0.0) uses.push_back("carve their sight lines");
+  if (uses.empty()) return;
+  std::string joined;
+  for (size_t u = 0; u < uses.size(); ++u) {
+    joined += (u == 0 ? " " : (u + 1 == uses.size() ? " and " : ", ")) + uses[u];
+  }
+  LOG(INFO) << count << " reliable sparse points (seen by " << kMinSurfaceTrack
+            << "+ photos, error <= " << kMaxSurfaceError << " px) in the volume" << joined;
+}
+
+// Logs what the carve did beyond colouring: free space, floaters, repair, thresholds.
+void LogCarve(const CarveOptions& options, const CarveStatistics& s) {
+  if (s.free_space_sight_lines > 0) LOG(INFO) << s.FreeSpaceSummary();
+  if (s.unsupported_components > 0) LOG(INFO) << s.FloaterSummary();
+  if (s.silhouette_repair.views > 0) LOG(INFO) << s.silhouette_repair.Summary();
+  for (const LevelStatistics& level : s.levels) {
+    if (!options.auto_threshold) break;
+    if (level.threshold_from_data) {
+      LOG(INFO) << "level " << level.resolution << ": " << level.estimate.Summary();
+    } else {
+      LOG(WARNING) << "level " << level.resolution << ": only " << level.estimate.points_judged
+                   << " sparse points could be judged (" << kMinThresholdPoints
+                   << " needed) to choose the threshold; used " << level.threshold
+                   << " (give --threshold)";
+    }
+  }
+  LOG(INFO) << s.Summary();
+}
+
+}  // namespace
+
+CarvePipeline::CarvePipeline(CarveRequest request, PipelineScope scope)
+    : request_(std::move(request)), scope_(std::move(scope)) {}
+
+CarvePipeline::~CarvePipeline() = default;
+
+const CarveRun& CarvePipeline::Run() {
+  LoadViews();
+  AgreeMasks();
+  CheckVolume();
+  PlanOutputs();
+  Carve();
+  MakeSurface();
+  SampleCloud();
+  MeasureCloud();
+  WriteOutputs();
+  return run_;
+}
+
+void CarvePipeline::RecordSeconds(const std::string& stage, double seconds) {
+  run_.stage_seconds.emplace_back(stage, seconds);
+}
+
+void CarvePipeline::LoadViews() {
+  std::string reason;
+  if (!request_.options.IsValid(&reason)) {
+    throw InputError("raycarve " + scope_.command + ": " + reason);
+  }
+  const Clock::time_point start = Clock::now();
+  ProjectRequest load = ProjectRequestOf(request_, scope_.command);
+  load.min_images = scope_.min_images;
+  load.hold_out_every = scope_.hold_out_every;
+  project_ = LoadProject(load);
+  // The held-out photos are kept apart, in name order; the rest are carved in load order.
+  const std::set<std::string> held(project_.held_out.begin(), project_.held_out.end());
+  for (CalibratedView& view : project_.views) {
+    (held.count(view.name) > 0 ? held_out_ : carved_).push_back(std::move(view));
+  }
+  project_.views.clear();
+  std::sort(held_out_.begin(), held_out_.end(),
+            [](const CalibratedView& a, const CalibratedView& b) { return a.name < b.name; });
+  if (carved_.size() < 2) {
+    throw InputError("raycarve " + scope_.command + ": only " + std::to_string(carved_.size()) +
+                     " views left to carve with" +
+                     (scope_.hold_out_every > 0 ? "; raise --every" : ""));
+  }
+  // The sparse points as the carved views see them (the same as the project's without a hold-out).
+  surface_points_ = held_out_.empty()
+                        ? project_.surface_points
+                        : SurfacePointsOf(project_.reconstruction, carved_, project_.bounds.box);
+  run_.model_path = project_.model_path;
+  run_.image_path = project_.image_path;
+  run_.output_path = project_.output_path;
+  run_.bounds = project_.bounds;
+  run_.num_views = static_cast<int>(carved_.size());
+  run_.num_missing_images = static_cast<int>(project_.view_summary.missing.size());
+  run_.masks_from_files = project_.view_summary.masks_from_files;
+  run_.masks_from_backdrop = project_.view_summary.masks_from_backdrop;
+  run_.mask_photos = project_.view_summary.photos;
+  run_.colour = project_.colour;
+  for (const CalibratedView& view : carved_) run_.view_names.push_back(view.name);
+  loaded_ = true;
+  RecordSeconds("load_project", SecondsSince(start));
+}
+
+void CarvePipeline::AgreeMasks() {
+  CHECK(loaded_);
+  const ViewReaderSummary& summary = project_.view_summary;
+  if (!request_.agree_masks || summary.masks_from_backdrop == 0 || summary.masks_from_files > 0) {
+    return;
+  }
+  const Clock::time_point start = Clock::now();
+  MaskAgreementOptions options;
+  // The voting grid: at most 64 voxels a side. Its hull only sorts pixels, and a voxel's width
+  // is the margin kept inside its outline.
+  options.resolution = std::min(request_.options.resolution, 64);
+  options.num_threads = request_.options.num_threads;
+  options.colour_tolerance = request_.view_options.background.tolerance;
+  run_.mask_agreement = raycarve::AgreeMasks(project_.bounds.box, options, &carved_);
+  LOG(INFO) << run_.mask_agreement.Summary(run_.view_names);
+  if (run_.mask_agreement.views > 0) RecordSeconds("agree_masks", SecondsSince(start));
+}
+
+void CarvePipeline::CheckVolume() {
+  CHECK(loaded_);
+  std::string reason;
+  if (!CheckCarveFits(carved_, project_.bounds.box, request_.options, &reason)) {
+    throw InputError("raycarve " + scope_.command + ": " + reason);
+  }
+  CheckVolumeSeen(scope_.command, project_, carved_, request_.options.min_views, request_.bounds);
+}
+
+void CarvePipeline::PlanOutputs() {
+  CHECK(loaded_);
+  const fs::path out(run_.output_path);
+  // What the outputs must never land in, checked before the work starts: the masks written
+  // under <output>/masks must not replace the user's.
+  std::vector<std::pair<std::string, std::string>> inputs = {
+      {project_.model_path, "input model"}, {project_.image_path, "photo folder"}};
+  if (!request_.view_options.mask_path.empty()) {
+    inputs.emplace_back(request_.view_options.mask_path, "mask folder");
+  }
+  mask_targets_.assign(carved_.size(), fs::path());
+  bool any_mask = false;
+  for (size_t v = 0; v < carved_.size(); ++v) {
+    if (carved_[v].mask.empty()) continue;
+    any_mask = true;
+    mask_targets_[v] = OutputFileInside((out / "masks").string(), carved_[v].name + ".png", inputs);
+  }
+  // A masks folder already in the output that no earlier carve wrote (no report.json beside it)
+  // is the user's: it is never written into.
+  const bool ours = fs::exists(out / "report.json");
+  std::error_code ignored;
+  if (any_mask && !ours && fs::is_directory(out / "masks") && !fs::is_empty(out / "masks", ignored)) {
+    const std::string masks = (out / "masks").string();
+    throw InputError(masks + ": already holds files that raycarve did not write (no report.json "
+                     "beside it); carve would write its masks there: give another --output_path "
+                     "(or --mask_path " + masks + " to carve with them)");
+  }
+  // The output folder doubles as a COLMAP dense workspace, whose meshers read the sparse model
+  // from sparse/: written there unless an input is or holds that folder, or it holds files that
+  // no earlier carve wrote.
+  const fs::path sparse_folder = fs::weakly_canonical(out / "sparse");
+  for (const auto& [path, what] : inputs) {
+    const fs::path input = fs::weakly_canonical(path);
+    if (Within(input, sparse_folder) || Within(sparse_folder, input)) {
+      run_.dense_sparse_skipped = "the " + what + " (" + path + ") is there";
+    }
+  }
+  if (run_.dense_sparse_skipped.empty() && fs::is_directory(sparse_folder) &&
+      !fs::is_empty(sparse_folder, ignored) && !ours) {
+    run_.dense_sparse_skipped = "it holds files that raycarve did not write";
+  }
+  if (!run_.dense_sparse_skipped.empty()) {
+    LOG(INFO) << sparse_folder.string() << ": not written (" << run_.dense_sparse_skipped
+              << "); COLMAP's delaunay_mesher needs the sparse model there";
+  }
+  // Every output is written to a staging folder and moved into place together at the end,
+  // report.json last: an interrupted run leaves the previous outputs whole. Made before the work,
+  // so that an output folder that cannot be written is found at once.
+  staged_ = std::make_unique<StagedOutputs>(run_.output_path);
+}
+
+void CarvePipeline::Carve() {
+  CHECK(loaded_);
+  const VoxelGrid grid(project_.bounds.box, request_.options.resolution);
+  const ViewReaderSummary& masks = project_.view_summary;
+  if (masks.masks_from_files + masks.masks_from_backdrop == 0) {
+    LOG(INFO) << "no masks (no mask files, no plain backdrop found): every photo pixel is used";
+  } else {
+    LOG(INFO) << (masks.masks_from_files > 0 ? "masks from " + request_.view_options.mask_path
+                                             : std::string("masks from the backdrop colour"))
+              << (request_.options.visual_hull ? ", with the visual hull pre-carve"
+                                               : ", without the visual hull pre-carve");
+  }
+  LOG(INFO) << "carving a " << grid.dimensions().x() << "x" << grid.dimensions().y() << "x"
+            << grid.dimensions().z() << " grid (voxel " << grid.voxel_size() << ") with "
+            << carved_.size() << " views"
+            << (held_out_.empty() ? "" : ", holding out " + std::to_string(held_out_.size()))
+            << ", " << ConsistencyMethodToString(request_.options.consistency) << " threshold "
+            << (request_.options.auto_threshold ? std::string("auto (from the sparse points)")
+                                                : std::to_string(request_.options.threshold));
+  LogSurfacePointUses(request_.options, surface_points_.size());
+  run_.result = std::make_unique<CarveResult>(
+      CarveWith(request_.options, scope_.progress, request_.progress_seconds));
+  if (scope_.progress_end) scope_.progress_end();
+  LogCarve(request_.options, run_.result->statistics);
+  RecordSeconds("carve_setup", run_.result->statistics.setup_seconds);
+  RecordSeconds("carve", run_.result->statistics.carve_seconds);
+  RecordSeconds("colour", run_.result->statistics.colour_seconds);
+}
+
+CarveResult CarvePipeline::CarveWith(CarveOptions options,
+                                     const ProgressCallback& progress,
+                                     double progress_interval_seconds) const {
+  CHECK(loaded_);
+  std::string reason;
+  if (!CheckCarveFits(carved_, project_.bounds.box, options, &reason)) {
+    throw InputError("raycarve " + scope_.command + ": " + CarveMethodToString(options.method) +
+                     ": " + reason);
+  }
+  options.surface_points = surface_points_;
+  return CarveVolume(carved_, project_.bounds.box, options, progress, progress_interval_seconds);
+}
+
+void CarvePipeline::MakeSurface() {
+  CHECK(run_.result);
+  if (request_.mesh_kind != "smooth") return;  // --mesh voxels: the voxels' faces, when written
+  const Clock::time_point start = Clock::now();
+  exporter::ModelMeshOptions options = request_.mesh;
+  for (const SurfacePoint& point : surface_points_) options.sparse_points.push_back(point.xyz);
+  model_ = exporter::MeshCarvedModel(*run_.result, carved_, options);
+  LOG(INFO) << model_.geometry.Summary();
+  if (model_.parts.removed > 0 || model_.parts.anchored > 0) LOG(INFO) << model_.parts.Summary();
+  if (!model_.mesh.empty()) {
+    LOG(INFO) << model_.refinement.Summary();
+    LOG(INFO) << exporter::FinalSmoothingSummary(model_, request_.mesh);
+    if (model_.silhouettes.passes > 0) LOG(INFO) << model_.silhouettes.Summary();
+    LOG(INFO) << model_.colouring.Summary();
+  }
+  run_.num_mesh_triangles = model_.mesh.triangles.size();
+  run_.num_mesh_vertices = model_.mesh.vertices.size();
+  run_.mesh_colouring = model_.colouring;
+  run_.mesh_refinement = model_.refinement;
+  run_.mesh_parts = model_.parts;
+  run_.mesh_silhouettes = model_.silhouettes;
+  run_.mesh_final_smoothing_mean_move = model_.final_smoothing_mean_move;
+  run_.mesh_small_components_removed = model_.small_components_removed;
+  run_.mesh_grid_wall_vertices = model_.grid_wall_vertices;
+  RecordSeconds("mesh", SecondsSince(start));
+}
+
+void CarvePipeline::SampleCloud() {
+  CHECK(run_.result);
+  const Clock::time_point start = Clock::now();
+  if (request_.mesh_kind != "smooth") {
+    points_ = exporter::SurfacePoints(*run_.result, request_.options.min_views);
+    run_.num_cloud_points = points_.size();
+    export_seconds_ += SecondsSince(start);
+    return;
+  }
+  if (staged_) {
+    // The mesh's checks and file on a second thread while the cloud is sampled and written: both
+    // only read the mesh. (The future waits for its thread however the pipeline is left; the
+    // mesh's own failure is thrown by get() in WriteOutputs.)
+    const fs::path out(staged_->path());
+    auto mesh_file = [this, out] {
+      run_.mesh_topology = exporter::AnalyseTopology(model_.mesh);
+      exporter::WriteMeshPly(model_.mesh, (out / "mesh.ply").string());
+    };
+    if (ResolveNumThreads(request_.options.num_threads) > 1) {
+      mesh_written_ = std::async(std::launch::async, mesh_file);
+    } else {
+      mesh_file();
+    }
+  }
+  // The mesh's surface that --cloud_min_views or more photos see, and which ones, in COLMAP's
+  // visibility format (image indices: positions among the model's images in id order).
+  const double spacing =
+      exporter::MedianPixelFootprint(carved_, run_.result->volume.grid().Box().center());
+  if (!model_.mesh.empty() && spacing > 0.0) {
+    points_ = exporter::SampleMeshPoints(model_, spacing, request_.cloud_min_views, /*seed=*/1,
+                                         &visibility_);
+  }
+  std::vector<image_t> ids;
+  for (const auto& [id, image] : project_.reconstruction.images) ids.push_back(id);
+  std::sort(ids.begin(), ids.end());
+  std::vector<uint32_t> index_of_view(carved_.size());
+  for (size_t v = 0; v < carved_.size(); ++v) {
+    index_of_view[v] = static_cast<uint32_t>(
+        std::lower_bound(ids.begin(), ids.end(), carved_[v].image_id) - ids.begin());
+  }
+  for (std::vector<uint32_t>& seen : visibility_) {
+    for (uint32_t& v : seen) v = index_of_view[v];
+  }
+  run_.num_cloud_points = points_.size();
+  export_seconds_ += SecondsSince(start);
+}
+
+void CarvePipeline::MeasureCloud() {
+  CHECK(run_.result);
+  // COLMAP's sparse points lie on the true surface: how far they are from the carved one.
+  const Eigen::AlignedBox3d grid_box = run_.result->volume.grid().Box();
+  std::vector<Eigen::Vector3f> sparse, cloud;
+  for (const auto& [id, point] : project_.reconstruction.points3D) {
+    if (grid_box.contains(point.xyz)) sparse.push_back(point.xyz.cast<float>());
+  }
+  for (const exporter::ColouredPoint& point : points_) cloud.push_back(point.xyz);
+  if (sparse.empty() || cloud.empty()) return;
+  exporter::CompareOptions compare;
+  compare.threshold = 2.0 * run_.result->volume.grid().voxel_size();
+  compare.num_threads = request_.options.num_threads;
+  run_.sparse = exporter::CompareClouds(cloud, sparse, compare);
+  run_.has_sparse = true;
+}
+
+void CarvePipeline::WriteDenseWorkspace(const fs::path& staging) {
+  // COLMAP's dense workspace names, for its meshers: the same files under a second name (hard
+  // links; copies where the file system has none), and the sparse model they index.
+  for (const char* name : {"cloud.ply", "cloud.ply.vis"}) {
+    const fs::path from = staging / name;
+    const fs::path to = staging / (std::string("fused") + (name + 5));
+    std::error_code error;
+    fs::create_hard_link(from, to, error);
+    if (error) {
+      error.clear();
+      fs::copy_file(from, to, fs::copy_options::overwrite_existing, error);
+      if (error) throw InputError(to.string() + ": cannot write: " + error.message());
+    }
+  }
+  if (run_.dense_sparse_skipped.empty()) {
+    WriteModel(project_.reconstruction, (staging / "sparse").string(), ModelFormat::kBinary);
+  }
+}
+
+void CarvePipeline::WriteMasks(const fs::path& staging) const {
+  // The masks used, so that a user can check them: undistorted, as the carving saw them.
+  const fs::path final_out(run_.output_path);
+  for (size_t v = 0; v < carved_.size(); ++v) {
+    if (carved_[v].mask.empty()) continue;
+    // Checked before carving; written to the same place under the staging folder.
+    const fs::path mask_path = staging / fs::relative(mask_targets_[v], final_out);
+    std::error_code error;
+    fs::create_directories(mask_path.parent_path(), error);
+    if (error) throw InputError(mask_path.parent_path().string() + ": cannot create: " + error.message());
+    WriteImageAtomically(mask_path.string(), carved_[v].mask);
+  }
+}
+
+void CarvePipeline::WriteOutputs() {
+  CHECK(staged_) << "PlanOutputs must run before WriteOutputs";
+  const Clock::time_point start = Clock::now();
+  const fs::path out(staged_->path());
+  exporter::WritePointCloudPly(points_, (out / "cloud.ply").string());
+  if (request_.mesh_kind == "voxels") {
+    const exporter::MeshSummary mesh = exporter::WriteVoxelMeshPly(*run_.result, (out / "mesh.ply").string());
+    run_.num_mesh_triangles = mesh.num_triangles;
+    run_.num_mesh_vertices = mesh.num_vertices;
+  } else {
+    exporter::WritePointVisibility(visibility_, (out / "cloud.ply.vis").string());
+    if (mesh_written_.valid()) mesh_written_.get();
+    WriteDenseWorkspace(out);
+  }
+  RecordSeconds("export", export_seconds_ + SecondsSince(start));
+  WriteMasks(out);
+  std::ostringstream csv;
+  csv << "seconds,carved,evaluated\n";
+  for (const CurveSample& sample : run_.result->statistics.curve) {
+    csv << sample.seconds << "," << sample.carved << "," << sample.evaluated << "\n";
+  }
+  WriteTextFileAtomically((out / "convergence.csv").string(), csv.str());
+  WriteTextFileAtomically((out / "report.json").string(), CarveReportJson(request_, run_));
+  staged_->MoveIntoPlace("report.json");
+}
+
+}  // namespace raycarve

@@ -1,0 +1,143 @@
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <future>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "calib/atomic_file.h"
+#include "carve/carver.h"
+#include "carve/mask_agreement.h"
+#include "export/carve_export.h"
+#include "export/point_cloud_compare.h"
+#include "pipeline/carve_request.h"
+#include "pipeline/project.h"
+
+namespace raycarve {
+
+using ProgressCallback = std::function<void(const CarveProgress&)>;
+
+// What a run of the pipeline is for. `raycarve carve` runs every stage and writes the outputs;
+// `holdout` leaves every k-th photo out of the carve and stops after the surface; `benchmark`
+// carves the same views once per visibility method (CarvePipeline::CarveWith).
+struct PipelineScope {
+  std::string command = "carve";  // names the command in messages: "raycarve <command>: ..."
+  int min_images = 2;             // registered images (and loaded photos) the command needs
+  // > 0: every k-th photo in name order is left out of everything the carve sees (its sparse
+  // observations too) and kept apart in held_out_views().
+  int hold_out_every = 0;
+  ProgressCallback progress;           // during the carve stage (optional)
+  std::function<void()> progress_end;  // after the carve stage (optional: ends a progress bar)
+};
+
+// What the stages produced, for the report and the summary. Filled stage by stage.
+struct CarveRun {
+  // Load views (and masks).
+  std::string model_path;
+  std::string image_path;
+  std::string output_path;
+  Bounds bounds;
+  int num_views = 0;  // the views carved
+  int num_missing_images = 0;
+  int masks_from_files = 0;
+  int masks_from_backdrop = 0;
+  std::vector<PhotoMaskInfo> mask_photos;  // per view: where its mask came from, what was found
+  std::vector<std::string> view_names;     // the views carved, in carve order
+  ColourCalibration colour;
+  // Masks agree.
+  MaskAgreementStatistics mask_agreement;
+  // Carve.
+  std::unique_ptr<CarveResult> result;
+  // Surface and colour.
+  size_t num_mesh_triangles = 0;
+  size_t num_mesh_vertices = 0;
+  exporter::MeshTopology mesh_topology;
+  exporter::MeshColouringSummary mesh_colouring;  // the smooth mesh's (vertices 0 otherwise)
+  exporter::MeshRefinementSummary mesh_refinement;
+  exporter::MeshPartsSummary mesh_parts;
+  exporter::SilhouetteFitSummary mesh_silhouettes;
+  double mesh_final_smoothing_mean_move = 0.0;  // world units
+  int64_t mesh_small_components_removed = 0;
+  int64_t mesh_grid_wall_vertices = 0;  // on the grid's wall: left out of the cloud
+  // Cloud.
+  size_t num_cloud_points = 0;
+  // The model's sparse points inside the grid against the cloud (accuracy: their 90% distance).
+  bool has_sparse = false;
+  exporter::CloudComparison sparse;
+  // Write. The output folder as a COLMAP dense workspace: fused.ply and fused.ply.vis (links to
+  // cloud.ply and cloud.ply.vis) and the sparse model in sparse/. Empty when sparse/ was written;
+  // otherwise why it was not (an input there, or a folder raycarve did not write).
+  std::string dense_sparse_skipped;
+  // Each stage's wall time, in order: load_project, agree_masks, carve_setup, carve, colour,
+  // mesh, export.
+  std::vector<std::pair<std::string, double>> stage_seconds;
+};
+
+// The carve pipeline: load views -> masks agree -> check the volume -> carve -> surface ->
+// cloud -> write. One controller for every command that carves, so that what holdout and
+// benchmark measure is what carve writes. Each stage reads the request (its options), records
+// its result in run() and its wall time in run().stage_seconds, and logs a line on what it did.
+// Stages throw InputError on bad input; each needs the ones it reads from to have run (CHECKed).
+class CarvePipeline {
+ public:
+  CarvePipeline(CarveRequest request, PipelineScope scope);
+  ~CarvePipeline();
+
+  // Every stage in order, writing the outputs (`raycarve carve`).
+  const CarveRun& Run();
+
+  // The stages.
+  void LoadViews();    // model, bounds, photos undistorted and masked, colour calibration
+  void AgreeMasks();   // the carved views' backdrop masks agree across them (AgreeMasks)
+  void CheckVolume();  // the grid fits in memory (CheckCarveFits) and the photos see the volume
+  void PlanOutputs();  // what the outputs must not overwrite; the staging folder, made at once
+  void Carve();        // incremental voxel colouring over the carved views
+  void MakeSurface();  // the mesh: smooth (refined, coloured from the photos) or left to Write
+  void SampleCloud();  // cloud.ply's points on the mesh and the views that see them
+  void MeasureCloud();  // how far the model's sparse points lie from the cloud
+  void WriteOutputs();  // every file into the staging folder, then moved into place
+
+  // A carve of the carved views with other options (their surface points filled in), without
+  // touching run(): benchmark's methods. Throws InputError when the carve does not fit.
+  CarveResult CarveWith(CarveOptions options,
+                        const ProgressCallback& progress,
+                        double progress_interval_seconds) const;
+
+  const CarveRequest& request() const { return request_; }
+  const LoadedProject& project() const { return project_; }
+  // The views the carve sees: every loaded view, or the training views when holding out. (The
+  // project's own `views` are moved here by LoadViews.)
+  const std::vector<CalibratedView>& carved_views() const { return carved_; }
+  // With hold_out_every: the held-out views, in name order.
+  const std::vector<CalibratedView>& held_out_views() const { return held_out_; }
+  // The reliable sparse points of the carved views (SurfacePointsOf).
+  const std::vector<SurfacePoint>& surface_points() const { return surface_points_; }
+  const exporter::ModelMesh& model() const { return model_; }
+  const CarveRun& run() const { return run_; }
+
+ private:
+  void RecordSeconds(const std::string& stage, double seconds);
+  void WriteMasks(const std::filesystem::path& staging) const;
+  void WriteDenseWorkspace(const std::filesystem::path& staging);
+
+  const CarveRequest request_;
+  const PipelineScope scope_;
+  LoadedProject project_;
+  std::vector<CalibratedView> carved_;
+  std::vector<CalibratedView> held_out_;
+  std::vector<SurfacePoint> surface_points_;
+  exporter::ModelMesh model_;
+  std::vector<exporter::ColouredPoint> points_;
+  std::vector<std::vector<uint32_t>> visibility_;  // per point, image indices (COLMAP's .vis)
+  std::vector<std::filesystem::path> mask_targets_;  // per carved view, under the output folder
+  std::unique_ptr<StagedOutputs> staged_;
+  std::future<void> mesh_written_;  // the smooth mesh's file, written beside the cloud
+  double export_seconds_ = 0.0;     // the cloud's sampling and the files
+  bool loaded_ = false;
+  CarveRun run_;
+};
+
+}  // namespace raycarve

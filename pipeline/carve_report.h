@@ -1,0 +1,22 @@
+#pragma once
+
+#include <string>
+
+#include "pipeline/carve_pipeline.h"
+#include "pipeline/json_writer.h"
+
+namespace raycarve {
+
+// report.json of a carve: the run's identity, every option as used, the masks per photo, the
+// colour calibration, bounds, the carve's statistics and levels, the sparse points' distance,
+// each stage's seconds, the outputs and the mesh. Fed from the pipeline's stage results.
+std::string CarveReportJson(const CarveRequest& request, const CarveRun& run);
+
+// The run's identity at the head of every report: raycarve_version, commit, command_line and
+// start_time, as keys of the open object.
+void WriteRunIdentity(JsonWriter& json);
+
+// The process's peak resident memory so far, in MiB (getrusage).
+double ProcessPeakMiB();
+
+}  // namespace raycarve

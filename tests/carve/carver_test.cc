@@ -1,4 +1,5 @@
 #include "carve/carver.h"
+#include "carve/incremental_carver.h"
 
 #include <algorithm>
 #include <map>

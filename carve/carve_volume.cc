@@ -1,0 +1,275 @@
+#include "carve/carver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+
+#include <glog/logging.h>
+
+#include "carve/free_space.h"
+#include "carve/item_buffer_visibility.h"
+#include "carve/layered_depth_visibility.h"
+#include "carve/patch_correlation.h"
+#include "carve/ray_image.h"
+
+
+#include "carve/carver_internal.h"
+#include "carve/incremental_carver.h"
+
+namespace raycarve {
+namespace {
+
+using carve_internal::Clock;
+using carve_internal::ElapsedNanoseconds;
+using carve_internal::GatherColours;
+using carve_internal::SecondsSince;
+
+// How many times a level's photos are reduced: the level's voxel scale, halved while any photo's
+// shorter side would fall below CarveOptions::kMinReducedSide.
+int ImageFactor(const std::vector<CalibratedView>& views, int level_resolution, int resolution) {
+  int factor = resolution / level_resolution;
+  int shortest = std::numeric_limits<int>::max();
+  for (const CalibratedView& view : views) shortest = std::min({shortest, view.width, view.height});
+  while (factor > 1 && shortest / factor < CarveOptions::kMinReducedSide) factor /= 2;
+  return factor;
+}
+
+// With --threshold auto (or an automatic pattern threshold): the level's thresholds from the
+// sparse points (EstimateThreshold), recorded in *level_statistics.
+void ChooseLevelThresholds(const std::vector<CalibratedView>& level_views,
+                           const VoxelGrid& level_grid,
+                           const CarveOptions& options,
+                           CarveOptions* level_options,
+                           LevelStatistics* level_statistics) {
+  const bool auto_pattern = options.consistency == ConsistencyMethod::kPatchCorrelation &&
+                            (options.auto_threshold || options.auto_pattern_threshold);
+  if (!options.auto_threshold && !auto_pattern) return;
+  level_statistics->estimate = EstimateThreshold(
+      level_views, level_grid, options.surface_points, options.consistency, options.min_views,
+      std::any_of(level_views.begin(), level_views.end(),
+                  [](const CalibratedView& view) { return !view.mask.empty(); }),
+      options.auto_threshold_quantile, level_options->threshold, options.pattern_threshold);
+  level_statistics->threshold_from_data =
+      level_statistics->estimate.points_judged >= kMinThresholdPoints;
+  if (options.auto_threshold) level_options->threshold = level_statistics->estimate.threshold;
+  if (auto_pattern) level_options->pattern_threshold = level_statistics->estimate.pattern_threshold;
+}
+
+// The final level: specks left in empty space go, then pieces without the sparse points their
+// size predicts; carving carries on behind each.
+void RemoveComponents(const CarveOptions& options, IncrementalCarver* carver, CarveStatistics* statistics) {
+  for (int round = 0; options.min_component_voxels > 1 && round < 4; ++round) {
+    const int64_t removed = carver->RemoveSmallComponents(options.min_component_voxels);
+    if (removed == 0) break;
+    statistics->component_carved += removed;
+    while (carver->Step()) {
+    }
+  }
+  if (options.unsupported_component_points > 0.0 && !options.surface_points.empty()) {
+    int64_t components = 0;
+    double expected = 0.0;
+    const int64_t removed = carver->RemoveUnsupportedComponents(
+        options.surface_points, options.unsupported_component_points, &components, &expected);
+    if (removed > 0) {
+      statistics->unsupported_components = components;
+      statistics->unsupported_component_carved = removed;
+      statistics->unsupported_largest_expected = expected;
+      while (carver->Step()) {
+      }
+    }
+  }
+}
+
+// With masks: each photo's object pixels get back the model carving took from their rays; the
+// restored voxels are final, so a new carver over the repaired volume only colours it.
+template <typename AddWorkerTimes>
+void RepairSilhouettesAndRecolour(const std::vector<CalibratedView>& views,
+                                  const CarveOptions& options,
+                                  AddWorkerTimes& add_worker_times,
+                                  std::unique_ptr<IncrementalCarver>* carver,
+                                  CarveStatistics* statistics) {
+  if (!options.repair_silhouettes || statistics->views_with_masks == 0) return;
+  Volume repaired = (*carver)->volume();
+  statistics->silhouette_repair = RepairSilhouettes(views, &repaired, options.num_threads);
+  if (statistics->silhouette_repair.restored_voxels == 0) return;
+  CarveOptions colouring = options;
+  colouring.lod_levels = 1;
+  colouring.visual_hull = false;
+  colouring.free_space_margin_voxels = 0.0;
+  colouring.protect_surface_points = false;
+  colouring.min_component_voxels = 0;
+  colouring.unsupported_component_points = 0.0;
+  statistics->peak_memory_bytes = std::max(statistics->peak_memory_bytes, (*carver)->MemoryBytes());
+  add_worker_times(**carver);
+  carver->reset();
+  *carver = std::make_unique<IncrementalCarver>(views, std::move(repaired), colouring);
+}
+
+}  // namespace
+
+// The levels of detail in one function: they share the carver (a level starts from the one
+// before), the curve's clock and the progress schedule; what stands alone is in the helpers above.
+CarveResult CarveVolume(const std::vector<CalibratedView>& views,
+                        const Eigen::AlignedBox3d& box,
+                        const CarveOptions& options,
+                        const std::function<void(const CarveProgress&)>& progress,
+                        double progress_interval_seconds) {
+  std::string reason;
+  CHECK(CheckCarveFits(views, box, options, &reason)) << reason;
+  std::vector<int> resolutions;
+  CHECK(LevelResolutions(options.resolution, options.lod_levels, &resolutions, &reason)) << reason;
+  const int num_levels = static_cast<int>(resolutions.size());
+  const VoxelGrid final_grid(box, options.resolution);
+
+  CarveStatistics statistics;
+  Clock::time_point start;  // when the first level's carving began
+  double next_report = progress_interval_seconds;
+  double next_sample = 0.0;
+  int64_t hull_carved = 0;  // the first level's visual hull, in final voxels
+  std::unique_ptr<IncrementalCarver> carver;
+  std::vector<CalibratedView> reduced_views;  // the photos of a coarse level, when reduced
+  auto add_worker_times = [&statistics](const IncrementalCarver& level_carver) {
+    const ViewWorkers::Times times = level_carver.worker_times();
+    statistics.parallel_seconds += times.wall_seconds;
+    statistics.parallel_runs += times.runs;
+    statistics.inline_runs += times.inline_runs;
+    if (statistics.thread_work_seconds.size() < times.busy_seconds.size()) {
+      statistics.thread_work_seconds.resize(times.busy_seconds.size(), 0.0);
+    }
+    for (size_t t = 0; t < times.busy_seconds.size(); ++t) {
+      statistics.thread_work_seconds[t] += times.busy_seconds[t];
+    }
+  };
+  for (int level = 0; level < num_levels; ++level) {
+    const Clock::time_point level_start = Clock::now();
+    CarveOptions level_options = options;
+    level_options.resolution = resolutions[level];
+    level_options.lod_levels = 1;
+    level_options.threshold =
+        options.threshold * std::pow(options.lod_threshold_scale, num_levels - 1 - level);
+    const int factor = options.lod_reduce_images ? ImageFactor(views, resolutions[level],
+                                                               options.resolution)
+                                                 : 1;
+    std::unique_ptr<Volume> start_volume;
+    if (level > 0) {
+      start_volume = std::make_unique<Volume>(
+          RefineVolume(carver->volume(), VoxelGrid(box, resolutions[level]), options.lod_band));
+      carver.reset();  // the coarse level's rays and queue go before the fine level's come
+    }
+    reduced_views.clear();
+    if (factor > 1) {
+      reduced_views.resize(views.size());
+      for (size_t v = 0; v < views.size(); ++v) reduced_views[v] = ReduceView(views[v], factor);
+    }
+    const std::vector<CalibratedView>& level_views = factor > 1 ? reduced_views : views;
+    LevelStatistics level_statistics;
+    ChooseLevelThresholds(level_views, VoxelGrid(box, resolutions[level]), options, &level_options,
+                          &level_statistics);
+    if (level == 0) {
+      carver = std::make_unique<IncrementalCarver>(level_views, box, level_options);
+    } else {
+      carver = std::make_unique<IncrementalCarver>(level_views, std::move(*start_volume),
+                                                   level_options);
+    }
+    // A voxel of this level holds `scale` final voxels (up to the grid's edge).
+    const int64_t scale = int64_t{1} << (3 * (num_levels - 1 - level));
+    level_statistics.resolution = resolutions[level];
+    level_statistics.image_factor = factor;
+    level_statistics.threshold = level_options.threshold;
+    level_statistics.pattern_threshold = level_options.pattern_threshold;
+    level_statistics.dimensions = carver->volume().grid().dimensions();
+    level_statistics.start_solid = carver->volume().num_solid();
+    level_statistics.setup_seconds = SecondsSince(level_start);
+    if (level == 0) {
+      statistics.visibility = carver->visibility().Name();
+      if (options.method == CarveMethod::kRay) {
+        statistics.visibility += " (" + VisLookupToString(options.vis_lookup) + ")";
+      }
+      statistics.initial_surface = carver->volume().num_surface();
+      statistics.views_with_masks = carver->visual_hull().views_with_masks;
+      statistics.visual_hull_carved = carver->visual_hull().carved;
+      statistics.visual_hull_seconds = carver->visual_hull().seconds;
+      statistics.free_space_level0_carved = carver->free_space().carved;
+      statistics.setup_seconds = SecondsSince(level_start);
+      // The curve leaves out what the visual hull carved; the sparse points' sight lines are in
+      // its first value.
+      hull_carved = std::min(final_grid.num_voxels(), carver->visual_hull().carved * scale);
+      if (options.decision == CarveDecision::kReprojection) {
+        statistics.reprojection_error_before = carver->MeanReprojectionError();
+      }
+      start = Clock::now();
+    }
+    auto sample = [&](double seconds) {
+      const int64_t removed = std::max<int64_t>(
+          0, final_grid.num_voxels() - std::min(final_grid.num_voxels(),
+                                                carver->volume().num_solid() * scale));
+      statistics.curve.push_back({seconds, std::max<int64_t>(0, removed - hull_carved),
+                                  statistics.evaluated + carver->evaluated()});
+    };
+    sample(SecondsSince(start));
+    for (int64_t next_check = 1024; carver->Step();) {
+      if (carver->evaluated() < next_check) continue;
+      next_check = carver->evaluated() + 1024;
+      const double seconds = SecondsSince(start);
+      if (seconds >= next_sample) {
+        sample(seconds);
+        next_sample = seconds + 0.05;
+      }
+      if (progress && seconds >= next_report) {
+        progress({level, num_levels, statistics.evaluated + carver->evaluated(), carver->carved(),
+                  static_cast<int64_t>(carver->queue_size()), seconds});
+        next_report = seconds + progress_interval_seconds;
+      }
+    }
+    if (level + 1 == num_levels) RemoveComponents(options, carver.get(), &statistics);
+    sample(SecondsSince(start));
+    level_statistics.carved =
+        carver->carved() + carver->visual_hull().carved + carver->free_space().carved;
+    level_statistics.free_space_carved = carver->free_space().carved;
+    statistics.free_space_carved += carver->free_space().carved;
+    statistics.free_space_sight_lines = carver->free_space().sight_lines;
+    statistics.free_space_seconds += carver->free_space().seconds;
+    level_statistics.evaluated = carver->evaluated();
+    level_statistics.protected_kept = carver->protected_kept();
+    level_statistics.final_solid = carver->volume().num_solid();
+    level_statistics.seconds = SecondsSince(level_start);
+    statistics.levels.push_back(level_statistics);
+    statistics.evaluated += carver->evaluated();
+    statistics.passes = std::max(statistics.passes, carver->passes());
+    statistics.threads = carver->threads();
+    statistics.peak_memory_bytes = std::max(statistics.peak_memory_bytes, carver->MemoryBytes());
+    if (level + 1 < num_levels) add_worker_times(*carver);
+  }
+  RepairSilhouettesAndRecolour(views, options, add_worker_times, &carver, &statistics);
+  statistics.carve_seconds = SecondsSince(start);
+  statistics.dimensions = carver->volume().grid().dimensions();
+  statistics.voxel_size = carver->volume().grid().voxel_size();
+  statistics.num_voxels = carver->volume().grid().num_voxels();
+  statistics.carved = statistics.num_voxels - carver->volume().num_solid();
+
+  const Clock::time_point colour_start = Clock::now();
+  CarveResult result{carver->volume().grid()};
+  result.surface = carver->ColourSurface();
+  statistics.reprojection_error_after = carver->surface_reprojection_error();
+  for (const ColouredVoxel& voxel : result.surface) {
+    if (voxel.num_pixels > 0) ++statistics.visible_surface;
+  }
+  statistics.colour_seconds = SecondsSince(colour_start);
+  add_worker_times(*carver);
+  statistics.final_surface = carver->volume().num_surface();
+  statistics.final_solid = carver->volume().num_solid();
+  result.volume = std::move(*carver->mutable_volume());
+  result.statistics = std::move(statistics);
+  if (progress) {
+    progress({num_levels - 1, num_levels, result.statistics.evaluated, result.statistics.carved,
+              0, result.statistics.carve_seconds});
+  }
+  return result;
+}
+
+}  // namespace raycarve

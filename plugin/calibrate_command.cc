@@ -30,6 +30,64 @@ double Median(std::vector<double> values) {
   return values[middle];
 }
 
+using OutputPair = std::pair<std::filesystem::path, std::filesystem::path>;  // photo, mask
+
+// Where each view's undistorted photo and validity mask go under `root`, every name checked
+// before the first file is written.
+std::vector<OutputPair> PlanUndistortedOutputs(const LoadedProject& project,
+                                               const ViewReaderOptions& view_options,
+                                               const std::filesystem::path& root) {
+  std::vector<OutputPair> targets;
+  std::error_code error;
+  // COLMAP's conventions: photos keep their names (and format), masks are <name>.png.
+  std::vector<std::pair<std::string, std::string>> inputs = {
+      {project.model_path, "input model"}, {project.image_path, "photo folder"}};
+  if (!view_options.mask_path.empty()) inputs.emplace_back(view_options.mask_path, "mask folder");
+  // Every name checked before the first file is written.
+  for (const CalibratedView& view : project.views) {
+    // In this order: the photo's name is the one a user gave.
+    std::filesystem::path photo = OutputFileInside((root / "undistorted").string(), view.name, inputs);
+    std::filesystem::path mask = OutputFileInside((root / "masks").string(), view.name + ".png", inputs);
+    targets.emplace_back(std::move(photo), std::move(mask));
+  }
+  // Folders in the output that no earlier run wrote (no report.json beside them) are the
+  // user's (photos, masks): never written into.
+  const bool ours = std::filesystem::exists(root / "report.json");
+  for (const char* folder : {"undistorted", "masks"}) {
+    if (!ours && std::filesystem::is_directory(root / folder) &&
+        !std::filesystem::is_empty(root / folder, error)) {
+      throw InputError((root / folder).string() +
+                       ": already holds files that raycarve did not write (no report.json "
+                       "beside it); calibrate would write there: give another --output_path");
+    }
+  }
+  return targets;
+}
+
+// The undistorted photos and masks, into the staging folder `stage` at their places under `root`.
+void WriteUndistorted(const std::vector<CalibratedView>& views,
+                      const std::vector<OutputPair>& targets,
+                      const std::filesystem::path& root,
+                      const std::filesystem::path& stage) {
+  std::error_code error;
+  const std::filesystem::path canonical_root = std::filesystem::weakly_canonical(root);
+  for (size_t v = 0; v < targets.size(); ++v) {
+    const CalibratedView& view = views[v];
+    const std::filesystem::path photo =
+        stage / std::filesystem::relative(targets[v].first, canonical_root);
+    const std::filesystem::path mask =
+        stage / std::filesystem::relative(targets[v].second, canonical_root);
+    for (const std::filesystem::path& folder : {photo.parent_path(), mask.parent_path()}) {
+      std::filesystem::create_directories(folder, error);
+      if (error) throw InputError(folder.string() + ": cannot create: " + error.message());
+    }
+    cv::Mat bgr;
+    cv::cvtColor(view.image, bgr, cv::COLOR_RGB2BGR);
+    WriteImageAtomically(photo.string(), bgr);
+    WriteImageAtomically(mask.string(), view.valid);
+  }
+}
+
 }  // namespace
 
 CalibrationReport CalibrateProject(const Reconstruction& reconstruction,
@@ -196,51 +254,13 @@ int RunCalibrate(int argc, char** argv) {
   std::filesystem::create_directories(output_path, error);
   if (error) throw InputError(output_path + ": cannot create the output folder: " + error.message());
   const std::filesystem::path root(output_path);
-  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> targets;
-  if (write_undistorted) {
-    // COLMAP's conventions: photos keep their names (and format), masks are <name>.png.
-    std::vector<std::pair<std::string, std::string>> inputs = {
-        {project.model_path, "input model"}, {project.image_path, "photo folder"}};
-    if (!view_options.mask_path.empty()) inputs.emplace_back(view_options.mask_path, "mask folder");
-    // Every name checked before the first file is written.
-    for (const CalibratedView& view : views) {
-      // In this order: the photo's name is the one a user gave.
-      std::filesystem::path photo = OutputFileInside((root / "undistorted").string(), view.name, inputs);
-      std::filesystem::path mask = OutputFileInside((root / "masks").string(), view.name + ".png", inputs);
-      targets.emplace_back(std::move(photo), std::move(mask));
-    }
-    // Folders in the output that no earlier run wrote (no report.json beside them) are the
-    // user's (photos, masks): never written into.
-    const bool ours = std::filesystem::exists(root / "report.json");
-    for (const char* folder : {"undistorted", "masks"}) {
-      if (!ours && std::filesystem::is_directory(root / folder) &&
-          !std::filesystem::is_empty(root / folder, error)) {
-        throw InputError((root / folder).string() +
-                         ": already holds files that raycarve did not write (no report.json "
-                         "beside it); calibrate would write there: give another --output_path");
-      }
-    }
-  }
+  const std::vector<OutputPair> targets =
+      write_undistorted ? PlanUndistortedOutputs(project, view_options, root) : std::vector<OutputPair>();
   // The outputs are written into a staging folder and moved into place together, report.json
   // last: an interrupted run leaves the previous set whole.
   StagedOutputs staged(output_path);
   const std::filesystem::path stage(staged.path());
-  const std::filesystem::path canonical_root = std::filesystem::weakly_canonical(root);
-  for (size_t v = 0; v < targets.size(); ++v) {
-    const CalibratedView& view = views[v];
-    const std::filesystem::path photo =
-        stage / std::filesystem::relative(targets[v].first, canonical_root);
-    const std::filesystem::path mask =
-        stage / std::filesystem::relative(targets[v].second, canonical_root);
-    for (const std::filesystem::path& folder : {photo.parent_path(), mask.parent_path()}) {
-      std::filesystem::create_directories(folder, error);
-      if (error) throw InputError(folder.string() + ": cannot create: " + error.message());
-    }
-    cv::Mat bgr;
-    cv::cvtColor(view.image, bgr, cv::COLOR_RGB2BGR);
-    WriteImageAtomically(photo.string(), bgr);
-    WriteImageAtomically(mask.string(), view.valid);
-  }
+  WriteUndistorted(project.views, targets, root, stage);
   const std::string report_path = (root / "report.json").string();
   WriteTextFileAtomically((stage / "report.json").string(),
                           report.Json(project.model_path, project.image_path, views));

@@ -45,6 +45,158 @@ void RunStep(const std::string& colmap, const std::string& step,
   throw InputError(message);
 }
 
+// What `raycarve sfm` takes.
+struct SfmOptions {
+  std::string image_path, workspace_path, camera_model = "SIMPLE_RADIAL", camera_params;
+  std::string colmap_path = "colmap";
+  bool single_camera = true;
+  int min_registered = 3, max_image_size = 3200, min_num_matches = 15;
+  int init_min_num_inliers = 100, abs_pose_min_num_inliers = 30, num_threads = -1;
+  double init_min_tri_angle = 16.0;
+  std::string colmap_options;
+};
+
+// Checks everything before running anything; returns the number of photos.
+int CheckSfmInput(const SfmOptions& o) {
+  const CameraModelId model_id = CameraModelIdFromName(o.camera_model, "--camera_model");
+  if (!o.camera_params.empty()) {
+    int count = 1;
+    for (const char c : o.camera_params) count += c == ',';
+    if (count != CameraModelNumParams(model_id)) {
+      throw InputError("--camera_params: " + o.camera_model + " takes " +
+                       std::to_string(CameraModelNumParams(model_id)) + " parameters, got " +
+                       std::to_string(count));
+    }
+  }
+  if (!fs::is_directory(o.image_path)) throw InputError(o.image_path + ": photo folder does not exist");
+  int num_photos = 0;
+  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(o.image_path)) {
+    num_photos += entry.is_regular_file() && IsPhoto(entry.path());
+  }
+  if (num_photos < 2) {
+    throw InputError(o.image_path + ": " + std::to_string(num_photos) +
+                     " photos found (png, jpg, tif, bmp, ppm); structure-from-motion needs at "
+                     "least 2");
+  }
+  const fs::path workspace(o.workspace_path);
+  const fs::path database = workspace / "database.db", sparse = workspace / "sparse";
+  if (fs::exists(database) || (fs::exists(sparse) && !fs::is_empty(sparse))) {
+    throw InputError(o.workspace_path +
+                     ": already holds database.db or sparse/; raycarve sfm never overwrites a "
+                     "project: remove them or choose another --workspace_path");
+  }
+  return num_photos;
+}
+
+// The project's folders: sparse/ made, images/ a link to the photos.
+void PrepareWorkspace(const SfmOptions& o, const fs::path& sparse) {
+  const fs::path workspace(o.workspace_path);
+  std::error_code error;
+  fs::create_directories(sparse, error);
+  if (error) throw InputError(sparse.string() + ": cannot create: " + error.message());
+  const fs::path images = workspace / "images";
+  const fs::path absolute_images = fs::absolute(o.image_path);
+  if (!fs::exists(images)) {
+    fs::create_directory_symlink(absolute_images, images, error);
+    if (error) throw InputError(images.string() + ": cannot link to the photos: " + error.message());
+  } else if (fs::equivalent(images, absolute_images, error) == false) {
+    LOG(WARNING) << images.string() << " exists and is not " << o.image_path
+                 << "; raycarve carve will read " << images.string()
+                 << " unless given --image_path " << o.image_path;
+  }
+}
+
+// COLMAP's three steps, on the CPU, each with the options of its sections last.
+void RunColmapSteps(const SfmOptions& o, const std::string& colmap, int num_photos,
+                    const fs::path& database, const fs::path& sparse) {
+  const ColmapPassThrough passed = SplitColmapOptions(o.colmap_options);
+  const std::string threads = std::to_string(o.num_threads);
+  LOG(INFO) << "sfm: " << num_photos << " photos in " << o.image_path << "; 1/3 feature extraction";
+  std::vector<std::string> extract = {
+      "--database_path", database.string(), "--image_path", o.image_path,
+      "--ImageReader.camera_model", o.camera_model,
+      "--ImageReader.single_camera", o.single_camera ? "1" : "0",
+      "--SiftExtraction.use_gpu", "0",
+      "--SiftExtraction.max_image_size", std::to_string(o.max_image_size),
+      "--SiftExtraction.num_threads", threads};
+  if (!o.camera_params.empty()) {
+    extract.insert(extract.end(), {"--ImageReader.camera_params", o.camera_params});
+  }
+  extract.insert(extract.end(), passed.extractor.begin(), passed.extractor.end());
+  RunStep(colmap, "feature_extractor", extract);
+  LOG(INFO) << "sfm: 2/3 exhaustive matching";
+  std::vector<std::string> match = {"--database_path", database.string(),
+                                    "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads",
+                                    threads};
+  match.insert(match.end(), passed.matcher.begin(), passed.matcher.end());
+  RunStep(colmap, "exhaustive_matcher", match);
+  LOG(INFO) << "sfm: 3/3 mapping";
+  std::vector<std::string> map = {
+      "--database_path", database.string(), "--image_path", o.image_path,
+      "--output_path", sparse.string(),
+      "--Mapper.num_threads", threads,
+      "--Mapper.min_num_matches", std::to_string(o.min_num_matches),
+      "--Mapper.init_min_num_inliers", std::to_string(o.init_min_num_inliers),
+      "--Mapper.abs_pose_min_num_inliers", std::to_string(o.abs_pose_min_num_inliers),
+      "--Mapper.init_min_tri_angle", std::to_string(o.init_min_tri_angle)};
+  if (!o.camera_params.empty()) {
+    // Known intrinsics stay as given: on narrow object rings the focal length drifts otherwise.
+    map.insert(map.end(), {"--Mapper.ba_refine_focal_length", "0",
+                           "--Mapper.ba_refine_principal_point", "0",
+                           "--Mapper.ba_refine_extra_params", "0"});
+  }
+  map.insert(map.end(), passed.mapper.begin(), passed.mapper.end());
+  RunStep(colmap, "mapper", map);
+
+}
+
+// The mapper's models, the largest's figures, and what to do next.
+void ReportModels(const SfmOptions& o, int num_photos, const fs::path& sparse) {
+  const std::vector<ModelCandidate> models = NumberedModels(sparse.string());
+  if (models.empty()) {
+    throw InputError("colmap mapper made no model in " + sparse.string() +
+                     ": no initial pair of photos was found; try --init_min_num_inliers 50 "
+                     "--init_min_tri_angle 4, or known --camera_params");
+  }
+  const ModelCandidate& best = *std::max_element(
+      models.begin(), models.end(), [](const ModelCandidate& a, const ModelCandidate& b) {
+        return a.num_images < b.num_images;
+      });
+  const Reconstruction reconstruction = ReadModel(best.path);
+  double error_sum = 0.0;
+  size_t observations = 0;
+  for (const auto& [id, point] : reconstruction.points3D) {
+    error_sum += point.error;
+    observations += point.track.size();
+  }
+  std::printf("\nsfm: %zu model(s) in %s", models.size(), sparse.string().c_str());
+  for (const ModelCandidate& model : models) {
+    std::printf("%s%s: %lld photos", &model == &models.front() ? " (" : ", ",
+                fs::path(model.path).filename().string().c_str(),
+                static_cast<long long>(model.num_images));
+  }
+  std::printf(")\n  largest         %s: %zu of %d photos registered, %zu points, mean track %.2f, "
+              "mean reprojection error %.3f px\n",
+              best.path.c_str(), reconstruction.images.size(), num_photos,
+              reconstruction.points3D.size(),
+              reconstruction.points3D.empty() ? 0.0
+                                              : static_cast<double>(observations) /
+                                                    reconstruction.points3D.size(),
+              reconstruction.points3D.empty() ? 0.0 : error_sum / reconstruction.points3D.size());
+  if (static_cast<int>(reconstruction.images.size()) < o.min_registered) {
+    throw InputError("colmap registered only " + std::to_string(reconstruction.images.size()) +
+                     " of " + std::to_string(num_photos) + " photos (--min_registered " +
+                     std::to_string(o.min_registered) + "); try known --camera_params, "
+                     "--abs_pose_min_num_inliers 15 or --init_min_tri_angle 4");
+  }
+  if (static_cast<int>(reconstruction.images.size()) < num_photos) {
+    std::printf("  unregistered    %d photos; on a narrow object ring, --abs_pose_min_num_inliers 15 "
+                "--init_min_tri_angle 8 (and known --camera_params) register more\n",
+                num_photos - static_cast<int>(reconstruction.images.size()));
+  }
+  std::printf("  next            raycarve carve --workspace_path %s\n", o.workspace_path.c_str());
+}
+
 }  // namespace
 
 ColmapPassThrough SplitColmapOptions(const std::string& text) {
@@ -80,170 +232,47 @@ ColmapPassThrough SplitColmapOptions(const std::string& text) {
 }
 
 int RunSfm(int argc, char** argv) {
-  std::string image_path, workspace_path, camera_model = "SIMPLE_RADIAL", camera_params;
-  std::string colmap_path = "colmap";
-  bool single_camera = true;
-  int min_registered = 3, max_image_size = 3200, min_num_matches = 15;
-  int init_min_num_inliers = 100, abs_pose_min_num_inliers = 30, num_threads = -1;
-  double init_min_tri_angle = 16.0;
+  SfmOptions o;
   OptionParser parser(
       "sfm",
       "Runs COLMAP's structure-from-motion on the CPU (feature_extractor, exhaustive_matcher, "
       "mapper) and leaves a standard COLMAP project in --workspace_path: database.db, sparse/N "
       "(the mapper's models), images (a link to --image_path). Known intrinsics can be given "
       "and are then held fixed. Then: raycarve carve --workspace_path P.");
-  parser.AddRequired("image_path", &image_path, "folder of photos");
-  parser.AddRequired("workspace_path", &workspace_path,
+  parser.AddRequired("image_path", &o.image_path, "folder of photos");
+  parser.AddRequired("workspace_path", &o.workspace_path,
                      "project folder to create (must not hold a database or models yet)");
-  parser.AddDefault("camera_model", &camera_model,
+  parser.AddDefault("camera_model", &o.camera_model,
                     "COLMAP camera model of the photos (e.g. SIMPLE_RADIAL, PINHOLE, OPENCV)");
-  parser.AddDefault("camera_params", &camera_params,
+  parser.AddDefault("camera_params", &o.camera_params,
                     "known intrinsics, comma-separated in the model's order (COLMAP's); held "
                     "fixed by the mapper. Empty: estimated");
-  parser.AddDefault("single_camera", &single_camera, "all photos share one camera");
-  parser.AddDefault("colmap_path", &colmap_path, "the colmap program");
-  parser.AddDefault("min_registered", &min_registered,
+  parser.AddDefault("single_camera", &o.single_camera, "all photos share one camera");
+  parser.AddDefault("colmap_path", &o.colmap_path, "the colmap program");
+  parser.AddDefault("min_registered", &o.min_registered,
                     "fail unless the largest model registers at least this many photos");
-  parser.AddDefault("max_image_size", &max_image_size, "SiftExtraction.max_image_size");
-  parser.AddDefault("min_num_matches", &min_num_matches, "Mapper.min_num_matches");
-  parser.AddDefault("init_min_num_inliers", &init_min_num_inliers, "Mapper.init_min_num_inliers");
-  parser.AddDefault("abs_pose_min_num_inliers", &abs_pose_min_num_inliers,
+  parser.AddDefault("max_image_size", &o.max_image_size, "SiftExtraction.max_image_size");
+  parser.AddDefault("min_num_matches", &o.min_num_matches, "Mapper.min_num_matches");
+  parser.AddDefault("init_min_num_inliers", &o.init_min_num_inliers, "Mapper.init_min_num_inliers");
+  parser.AddDefault("abs_pose_min_num_inliers", &o.abs_pose_min_num_inliers,
                     "Mapper.abs_pose_min_num_inliers (lower it for hard sets)");
-  parser.AddDefault("init_min_tri_angle", &init_min_tri_angle,
+  parser.AddDefault("init_min_tri_angle", &o.init_min_tri_angle,
                     "Mapper.init_min_tri_angle in degrees (lower it for narrow rings)");
-  parser.AddDefault("num_threads", &num_threads, "threads for COLMAP (-1: all)");
-  std::string colmap_options;
-  parser.AddDefault("colmap_options", &colmap_options,
+  parser.AddDefault("num_threads", &o.num_threads, "threads for COLMAP (-1: all)");
+  parser.AddDefault("colmap_options", &o.colmap_options,
                     "further COLMAP options, comma-separated Section.name=value (e.g. "
                     "SiftExtraction.max_num_features=4096,Mapper.ba_refine_focal_length=0), each "
                     "given to the step that takes its section; they come last, so they win");
   if (!parser.Parse(argc, argv)) return 0;
-  const ColmapPassThrough passed = SplitColmapOptions(colmap_options);
+  SplitColmapOptions(o.colmap_options);  // checked before anything runs
 
-  // Check everything before running anything.
-  const CameraModelId model_id = CameraModelIdFromName(camera_model, "--camera_model");
-  if (!camera_params.empty()) {
-    int count = 1;
-    for (const char c : camera_params) count += c == ',';
-    if (count != CameraModelNumParams(model_id)) {
-      throw InputError("--camera_params: " + camera_model + " takes " +
-                       std::to_string(CameraModelNumParams(model_id)) + " parameters, got " +
-                       std::to_string(count));
-    }
-  }
-  if (!fs::is_directory(image_path)) throw InputError(image_path + ": photo folder does not exist");
-  int num_photos = 0;
-  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(image_path)) {
-    num_photos += entry.is_regular_file() && IsPhoto(entry.path());
-  }
-  if (num_photos < 2) {
-    throw InputError(image_path + ": " + std::to_string(num_photos) +
-                     " photos found (png, jpg, tif, bmp, ppm); structure-from-motion needs at "
-                     "least 2");
-  }
-  const fs::path workspace(workspace_path);
+  const int num_photos = CheckSfmInput(o);
+  const fs::path workspace(o.workspace_path);
   const fs::path database = workspace / "database.db", sparse = workspace / "sparse";
-  if (fs::exists(database) || (fs::exists(sparse) && !fs::is_empty(sparse))) {
-    throw InputError(workspace_path +
-                     ": already holds database.db or sparse/; raycarve sfm never overwrites a "
-                     "project: remove them or choose another --workspace_path");
-  }
-  const std::string colmap = FindColmap(colmap_path);
-  std::error_code error;
-  fs::create_directories(sparse, error);
-  if (error) throw InputError(sparse.string() + ": cannot create: " + error.message());
-  const fs::path images = workspace / "images";
-  const fs::path absolute_images = fs::absolute(image_path);
-  if (!fs::exists(images)) {
-    fs::create_directory_symlink(absolute_images, images, error);
-    if (error) throw InputError(images.string() + ": cannot link to the photos: " + error.message());
-  } else if (fs::equivalent(images, absolute_images, error) == false) {
-    LOG(WARNING) << images.string() << " exists and is not " << image_path
-                 << "; raycarve carve will read " << images.string()
-                 << " unless given --image_path " << image_path;
-  }
-  const std::string threads = std::to_string(num_threads);
-
-  LOG(INFO) << "sfm: " << num_photos << " photos in " << image_path << "; 1/3 feature extraction";
-  std::vector<std::string> extract = {
-      "--database_path", database.string(), "--image_path", image_path,
-      "--ImageReader.camera_model", camera_model,
-      "--ImageReader.single_camera", single_camera ? "1" : "0",
-      "--SiftExtraction.use_gpu", "0",
-      "--SiftExtraction.max_image_size", std::to_string(max_image_size),
-      "--SiftExtraction.num_threads", threads};
-  if (!camera_params.empty()) {
-    extract.insert(extract.end(), {"--ImageReader.camera_params", camera_params});
-  }
-  extract.insert(extract.end(), passed.extractor.begin(), passed.extractor.end());
-  RunStep(colmap, "feature_extractor", extract);
-  LOG(INFO) << "sfm: 2/3 exhaustive matching";
-  std::vector<std::string> match = {"--database_path", database.string(),
-                                    "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads",
-                                    threads};
-  match.insert(match.end(), passed.matcher.begin(), passed.matcher.end());
-  RunStep(colmap, "exhaustive_matcher", match);
-  LOG(INFO) << "sfm: 3/3 mapping";
-  std::vector<std::string> map = {
-      "--database_path", database.string(), "--image_path", image_path,
-      "--output_path", sparse.string(),
-      "--Mapper.num_threads", threads,
-      "--Mapper.min_num_matches", std::to_string(min_num_matches),
-      "--Mapper.init_min_num_inliers", std::to_string(init_min_num_inliers),
-      "--Mapper.abs_pose_min_num_inliers", std::to_string(abs_pose_min_num_inliers),
-      "--Mapper.init_min_tri_angle", std::to_string(init_min_tri_angle)};
-  if (!camera_params.empty()) {
-    // Known intrinsics stay as given: on narrow object rings the focal length drifts otherwise.
-    map.insert(map.end(), {"--Mapper.ba_refine_focal_length", "0",
-                           "--Mapper.ba_refine_principal_point", "0",
-                           "--Mapper.ba_refine_extra_params", "0"});
-  }
-  map.insert(map.end(), passed.mapper.begin(), passed.mapper.end());
-  RunStep(colmap, "mapper", map);
-
-  const std::vector<ModelCandidate> models = NumberedModels(sparse.string());
-  if (models.empty()) {
-    throw InputError("colmap mapper made no model in " + sparse.string() +
-                     ": no initial pair of photos was found; try --init_min_num_inliers 50 "
-                     "--init_min_tri_angle 4, or known --camera_params");
-  }
-  const ModelCandidate& best = *std::max_element(
-      models.begin(), models.end(), [](const ModelCandidate& a, const ModelCandidate& b) {
-        return a.num_images < b.num_images;
-      });
-  const Reconstruction reconstruction = ReadModel(best.path);
-  double error_sum = 0.0;
-  size_t observations = 0;
-  for (const auto& [id, point] : reconstruction.points3D) {
-    error_sum += point.error;
-    observations += point.track.size();
-  }
-  std::printf("\nsfm: %zu model(s) in %s", models.size(), sparse.string().c_str());
-  for (const ModelCandidate& model : models) {
-    std::printf("%s%s: %lld photos", &model == &models.front() ? " (" : ", ",
-                fs::path(model.path).filename().string().c_str(),
-                static_cast<long long>(model.num_images));
-  }
-  std::printf(")\n  largest         %s: %zu of %d photos registered, %zu points, mean track %.2f, "
-              "mean reprojection error %.3f px\n",
-              best.path.c_str(), reconstruction.images.size(), num_photos,
-              reconstruction.points3D.size(),
-              reconstruction.points3D.empty() ? 0.0
-                                              : static_cast<double>(observations) /
-                                                    reconstruction.points3D.size(),
-              reconstruction.points3D.empty() ? 0.0 : error_sum / reconstruction.points3D.size());
-  if (static_cast<int>(reconstruction.images.size()) < min_registered) {
-    throw InputError("colmap registered only " + std::to_string(reconstruction.images.size()) +
-                     " of " + std::to_string(num_photos) + " photos (--min_registered " +
-                     std::to_string(min_registered) + "); try known --camera_params, "
-                     "--abs_pose_min_num_inliers 15 or --init_min_tri_angle 4");
-  }
-  if (static_cast<int>(reconstruction.images.size()) < num_photos) {
-    std::printf("  unregistered    %d photos; on a narrow object ring, --abs_pose_min_num_inliers 15 "
-                "--init_min_tri_angle 8 (and known --camera_params) register more\n",
-                num_photos - static_cast<int>(reconstruction.images.size()));
-  }
-  std::printf("  next            raycarve carve --workspace_path %s\n", workspace_path.c_str());
+  const std::string colmap = FindColmap(o.colmap_path);
+  PrepareWorkspace(o, sparse);
+  RunColmapSteps(o, colmap, num_photos, database, sparse);
+  ReportModels(o, num_photos, sparse);
   return 0;
 }
 

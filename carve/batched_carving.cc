@@ -25,11 +25,6 @@
 namespace raycarve {
 namespace {
 
-using carve_internal::Clock;
-using carve_internal::ElapsedNanoseconds;
-using carve_internal::GatherColours;
-using carve_internal::SecondsSince;
-
 // between two sortings of the views by their cost (SortViewsByCost).
 constexpr int kClaimChunk = 8;
 // Finding Vis: how many voxels ahead their rays and photo rows are fetched.

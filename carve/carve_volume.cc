@@ -24,11 +24,6 @@
 namespace raycarve {
 namespace {
 
-using carve_internal::Clock;
-using carve_internal::ElapsedNanoseconds;
-using carve_internal::GatherColours;
-using carve_internal::SecondsSince;
-
 // How many times a level's photos are reduced: the level's voxel scale, halved while any photo's
 // shorter side would fall below CarveOptions::kMinReducedSide.
 int ImageFactor(const std::vector<CalibratedView>& views, int level_resolution, int resolution) {

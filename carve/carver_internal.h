@@ -11,7 +11,6 @@
 #include "carve/voxel_colour_sums.h"
 
 namespace raycarve {
-namespace carve_internal {
 
 using Clock = std::chrono::steady_clock;
 
@@ -30,5 +29,4 @@ void GatherColours(const std::vector<CalibratedView>& views,
                    const PixelRef* end,
                    std::vector<ViewColourStats>* stats);
 
-}  // namespace carve_internal
 }  // namespace raycarve

@@ -22,7 +22,6 @@
 #include "carve/known_surface.h"
 
 namespace raycarve {
-namespace carve_internal {
 
 // Appends to `stats` the colour statistics of pixels [begin, end), grouped view by view (a new
 // entry wherever the view changes).
@@ -40,14 +39,8 @@ void GatherColours(const std::vector<CalibratedView>& views,
   }
 }
 
-}  // namespace carve_internal
 
 namespace {
-
-using carve_internal::Clock;
-using carve_internal::ElapsedNanoseconds;
-using carve_internal::GatherColours;
-using carve_internal::SecondsSince;
 
 // Whether `options` carve in batches (CarveOptions::batch_voxels), given ray casting that finds
 // Vis by footprints.

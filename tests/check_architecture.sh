@@ -19,7 +19,7 @@ hits=$(grep -rnE '#include *"(plugin|samples)/' pipeline 2>/dev/null)
 [ -n "$hits" ] && report "pipeline/ may use only export/, carve/ and calib/" "$hits"
 hits=$(grep -rnE '#include *"(pipeline|plugin)/' samples 2>/dev/null)
 [ -n "$hits" ] && report "samples/ may not use pipeline/ or plugin/" "$hits"
-for folder in calib carve; do
+for folder in calib carve samples; do
   internal=$(grep -lE "^// Internal to $folder/" $folder/*.h 2>/dev/null | sed 's|^|#include "|; s|$|"|')
   [ -z "$internal" ] && continue
   others=$(ls -d calib carve export pipeline plugin samples benchmarks tests/* 2>/dev/null | grep -vE "^($folder|tests/$folder)$")

@@ -14,6 +14,12 @@ std::string TemporaryPathFor(const std::string& path);
 // Renames `temporary` to `path`; throws InputError naming `path` on failure.
 void RenameIntoPlace(const std::string& temporary, const std::string& path);
 
+// Throws InputError when a write of `relative` (a path relative to the output folder `folder`)
+// would go through or onto a symbolic link inside `folder`: raycarve does not follow links in
+// its output folders that it did not make, since one can point at an input (the photos, the
+// masks). The message names the link and its target. `folder` itself may be a link.
+void CheckNoLinkInside(const std::string& folder, const std::string& relative);
+
 // A set of outputs that should be replaced together (a cloud, its mesh and the report that
 // describes them). The constructor makes `<folder>/.raycarve-partial-<pid>`, empty, after
 // removing staging folders that earlier, interrupted runs left in `folder`; the outputs are
@@ -21,9 +27,15 @@ void RenameIntoPlace(const std::string& temporary, const std::string& path);
 // (same relative path), `last` after all the others, and syncs the folder. An interrupted run
 // leaves the previous set whole; a run that fails before MoveIntoPlace leaves no staging folder
 // (the destructor removes it). Throws InputError naming the file on failure.
+//
+// One run at a time writes into a folder: the constructor takes an advisory lock on
+// `<folder>/.raycarve.lock` (flock, held until the destructor; the kernel drops it when a run is
+// killed, so a stale lock never blocks) before it touches anything there. When another run holds
+// it, the constructor throws InputError naming that run's process, or with `wait` waits for it.
+// Every file is checked with CheckNoLinkInside before any is moved.
 class StagedOutputs {
  public:
-  explicit StagedOutputs(const std::string& folder);
+  explicit StagedOutputs(const std::string& folder, bool wait = false);
   ~StagedOutputs();
   StagedOutputs(const StagedOutputs&) = delete;
   StagedOutputs& operator=(const StagedOutputs&) = delete;
@@ -34,6 +46,7 @@ class StagedOutputs {
  private:
   std::string folder_;
   std::string staging_;
+  int lock_fd_ = -1;
 };
 
 }  // namespace raycarve

@@ -71,6 +71,7 @@ CarvePipeline::CarvePipeline(CarveRequest request, PipelineScope scope)
 CarvePipeline::~CarvePipeline() = default;
 
 const CarveRun& CarvePipeline::Run() {
+  LockOutputs();
   LoadViews();
   AgreeMasks();
   CheckVolume();
@@ -85,6 +86,12 @@ const CarveRun& CarvePipeline::Run() {
 
 void CarvePipeline::RecordSeconds(const std::string& stage, double seconds) {
   run_.stage_seconds.emplace_back(stage, seconds);
+}
+
+void CarvePipeline::LockOutputs() {
+  std::string output_path;
+  ResolveProjectPaths(ProjectRequestOf(request_, scope_.command), &output_path);
+  staged_ = std::make_unique<StagedOutputs>(output_path, request_.wait_for_output);
 }
 
 void CarvePipeline::LoadViews() {
@@ -171,6 +178,7 @@ void CarvePipeline::PlanOutputs() {
   for (size_t v = 0; v < carved_.size(); ++v) {
     if (carved_[v].mask.empty()) continue;
     any_mask = true;
+    CheckNoLinkInside(run_.output_path, "masks/" + carved_[v].name + ".png");
     mask_targets_[v] = OutputFileInside((out / "masks").string(), carved_[v].name + ".png", inputs);
   }
   // A masks folder already in the output that no earlier carve wrote (no report.json beside it)
@@ -186,6 +194,10 @@ void CarvePipeline::PlanOutputs() {
   // The output folder doubles as a COLMAP dense workspace, whose meshers read the sparse model
   // from sparse/: written there unless an input is or holds that folder, or it holds files that
   // no earlier carve wrote.
+  for (const char* name : {"cloud.ply", "cloud.ply.vis", "mesh.ply", "fused.ply", "fused.ply.vis",
+                           "sparse", "report.json", "convergence.csv"}) {
+    CheckNoLinkInside(run_.output_path, name);
+  }
   const fs::path sparse_folder = fs::weakly_canonical(out / "sparse");
   for (const auto& [path, what] : inputs) {
     const fs::path input = fs::weakly_canonical(path);
@@ -204,7 +216,7 @@ void CarvePipeline::PlanOutputs() {
   // Every output is written to a staging folder and moved into place together at the end,
   // report.json last: an interrupted run leaves the previous outputs whole. Made before the work,
   // so that an output folder that cannot be written is found at once.
-  staged_ = std::make_unique<StagedOutputs>(run_.output_path);
+  if (!staged_) staged_ = std::make_unique<StagedOutputs>(run_.output_path, request_.wait_for_output);
 }
 
 void CarvePipeline::Carve() {

@@ -89,7 +89,9 @@ class CarvePipeline {
   // Every stage in order, writing the outputs (`raycarve carve`).
   const CarveRun& Run();
 
-  // The stages.
+  // The stages. LockOutputs (carve's first) resolves the output folder and takes it for this run
+  // (StagedOutputs' lock), so that a second run into it is refused before any work.
+  void LockOutputs();
   void LoadViews();    // model, bounds, photos undistorted and masked, colour calibration
   void AgreeMasks();   // the carved views' backdrop masks agree across them (AgreeMasks)
   void CheckVolume();  // the grid fits in memory (CheckCarveFits) and the photos see the volume

@@ -48,6 +48,8 @@ struct CarveRequest {
   std::string image_path;
   std::string output_path;  // default <workspace>/raycarve
   int model_index = -1;     // sparse/<index> among several models; -1: the largest
+  // When another run is writing into the output folder: wait for it (else refuse at once).
+  bool wait_for_output = false;
 
   // Load views and masks.
   ViewReaderOptions view_options;

@@ -223,6 +223,12 @@ HoldoutEvaluation EvaluateHeldOutViews(const CarveRequest& request, const Holdou
   scope.hold_out_every = options.every;
   CarvePipeline pipeline(request, scope);
   pipeline.LoadViews();
+  // The images are named after the held-out photos: <output>/holdout must be a folder of its own.
+  const std::string output_path = pipeline.project().output_path;
+  const std::filesystem::path final_out = std::filesystem::path(output_path) / "holdout";
+  CheckNoLinkInside(output_path, "holdout");
+  CheckOutputFileOutside(final_out.string(), pipeline.project().image_path, "photo folder");
+  CheckOutputFileOutside(final_out.string(), pipeline.project().model_path, "input model");
   std::vector<CalibratedView> held_out = pipeline.held_out_views();
   if (!options.score_mask_path.empty()) ReplaceScoringMasks(pipeline, options.score_mask_path, &held_out);
   // Block PSNR's block: about a voxel of the grid the carve uses (or would use).
@@ -250,8 +256,7 @@ HoldoutEvaluation EvaluateHeldOutViews(const CarveRequest& request, const Holdou
     evaluation.carved = true;
   }
   // Written as a set, as carve's outputs: staged, then moved into place with holdout.json last.
-  const std::filesystem::path final_out = std::filesystem::path(pipeline.project().output_path) / "holdout";
-  StagedOutputs staged(final_out.string());
+  StagedOutputs staged(final_out.string(), request.wait_for_output);
   const std::filesystem::path out(staged.path());
   for (const CalibratedView& view : held_out) {
     evaluation.views.push_back(ScoreView(scored, evaluation.render, grid, view, out));

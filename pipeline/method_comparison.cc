@@ -7,6 +7,7 @@
 
 #include <glog/logging.h>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "export/carve_export.h"
 #include "export/line_plot.h"
@@ -207,6 +208,7 @@ MethodComparison CompareCarveMethods(const CarveRequest& request,
   if (!options.reference_path.empty()) {
     reference_points = exporter::ReadComparablePoints(options.reference_path, 200000);
   }
+  CheckNoLinkInside(pipeline.project().output_path, "benchmark");
   const std::filesystem::path out = std::filesystem::path(pipeline.project().output_path) / "benchmark";
   std::error_code error;
   std::filesystem::create_directories(out, error);

@@ -99,19 +99,24 @@ void CheckPhotosFitInMemory(const Reconstruction& reconstruction, int max_image_
   throw InputError(text.str());
 }
 
+WorkspacePaths ResolveProjectPaths(const ProjectRequest& request, std::string* output_path) {
+  const WorkspacePaths paths = ResolveWorkspace(request.workspace_path, request.input_path,
+                                                request.image_path, request.model_index);
+  *output_path = request.output_path;
+  if (output_path->empty()) {
+    if (request.workspace_path.empty()) throw InputError("raycarve " + request.command + ": give --output_path");
+    *output_path = (std::filesystem::path(request.workspace_path) / "raycarve").string();
+  }
+  CheckOutputDoesNotOverwrite(*output_path, paths.model_path, "input model");
+  CheckOutputDoesNotOverwrite(*output_path, paths.image_path, "photo folder");
+  return paths;
+}
+
 LoadedProject LoadProject(const ProjectRequest& request) {
   LoadedProject project;
-  const WorkspacePaths paths =
-      ResolveWorkspace(request.workspace_path, request.input_path, request.image_path, request.model_index);
+  const WorkspacePaths paths = ResolveProjectPaths(request, &project.output_path);
   project.model_path = paths.model_path;
   project.image_path = paths.image_path;
-  project.output_path = request.output_path;
-  if (project.output_path.empty()) {
-    if (request.workspace_path.empty()) throw InputError("raycarve " + request.command + ": give --output_path");
-    project.output_path = (std::filesystem::path(request.workspace_path) / "raycarve").string();
-  }
-  CheckOutputDoesNotOverwrite(project.output_path, paths.model_path, "input model");
-  CheckOutputDoesNotOverwrite(project.output_path, paths.image_path, "photo folder");
 
   LOG(INFO) << "reading model " << paths.model_path << " (" << paths.layout << ")";
   project.reconstruction = ReadModel(paths.model_path);

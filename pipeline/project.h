@@ -12,6 +12,7 @@
 #include "calib/view_reader.h"
 #include "carve/surface_evidence.h"
 #include "pipeline/carve_request.h"
+#include "pipeline/workspace.h"
 
 namespace raycarve {
 
@@ -69,6 +70,10 @@ struct ProjectRequest {
 };
 // The ProjectRequest of a carve request, for `command`.
 ProjectRequest ProjectRequestOf(const CarveRequest& request, const std::string& command);
+
+// The project's model and photo folders (ResolveWorkspace) and in *output_path its output folder
+// (default <workspace>/raycarve); throws InputError when the output is the model or photo folder.
+WorkspacePaths ResolveProjectPaths(const ProjectRequest& request, std::string* output_path);
 
 // Resolves the workspace (see workspace.h) and the output folder (default <workspace>/raycarve,
 // refused when it is the model or photo folder), reads the model (it must have at least

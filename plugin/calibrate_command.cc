@@ -46,6 +46,8 @@ std::vector<OutputPair> PlanUndistortedOutputs(const LoadedProject& project,
   // Every name checked before the first file is written.
   for (const CalibratedView& view : project.views) {
     // In this order: the photo's name is the one a user gave.
+    CheckNoLinkInside(root.string(), "undistorted/" + view.name);
+    CheckNoLinkInside(root.string(), "masks/" + view.name + ".png");
     std::filesystem::path photo = OutputFileInside((root / "undistorted").string(), view.name, inputs);
     std::filesystem::path mask = OutputFileInside((root / "masks").string(), view.name + ".png", inputs);
     targets.emplace_back(std::move(photo), std::move(mask));

@@ -241,6 +241,9 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   text->decision = CarveDecisionToString(request->options.decision);
   AddWorkspaceFlags(parser, {&request->workspace_path, &request->input_path, &request->image_path,
                              &request->output_path, &request->model_index});
+  parser->AddDefault("wait", &request->wait_for_output,
+                     "when another raycarve run is writing into the output folder, wait for it "
+                     "to end instead of stopping");
   AddPhotoFlags(parser, request, text);
   AddBoundsFlags(parser, &request->bounds);
   AddCarvingFlags(parser, request, text);

@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/atomic_file.h"
 #include "calib/image_reader.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
@@ -45,10 +46,13 @@ int RunRender(int argc, char** argv) {
   while (std::getline(list, name, ',')) {
     if (!name.empty()) wanted.insert(name);
   }
+  // The images go into the output folder: never the model's, the photos' or the cloud's place.
+  CheckOutputFileOutside(output_path, model_path, "input model");
+  CheckOutputFileOutside(output_path, input, "input cloud");
+  if (!image_path.empty()) CheckOutputFileOutside(output_path, image_path, "photo folder");
   std::error_code error;
   std::filesystem::create_directories(output_path, error);
   if (error) throw InputError(output_path + ": cannot create: " + error.message());
-  CheckOutputDoesNotOverwrite(output_path, model_path, "input model");
   int rendered = 0;
   for (const auto& [id, image] : model.images) {
     if (!wanted.empty() && !wanted.count(image.name)) continue;
@@ -65,8 +69,11 @@ int RunRender(int argc, char** argv) {
     }
     const CalibratedView view = MakeCalibratedView(camera, image, rgb, source);
     const exporter::Rendering rendering = exporter::RenderPoints(points, view, point_size);
-    const std::string stem =
-        (std::filesystem::path(output_path) / std::filesystem::path(image.name).filename()).string();
+    const std::string file = std::filesystem::path(image.name).filename().string();
+    for (const char* suffix : {".render.png", ".silhouette.png", ".side.png"}) {
+      CheckNoLinkInside(output_path, file + suffix);
+    }
+    const std::string stem = (std::filesystem::path(output_path) / file).string();
     cv::Mat bgr;
     cv::cvtColor(rendering.image, bgr, cv::COLOR_RGB2BGR);
     WriteImageAtomically(stem + ".render.png", bgr);

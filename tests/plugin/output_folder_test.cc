@@ -1,0 +1,172 @@
+// The output folder cannot be turned against the inputs: links inside it are refused, not
+// followed; one run at a time writes into it; no command writes into the photos. Every input is
+// checked byte for byte afterwards.
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "tests/test_support.h"
+
+namespace raycarve {
+namespace {
+
+namespace fs = std::filesystem;
+
+class OutputFolder : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = new std::string(testing::MakeTemporaryDirectory("output_folder"));
+    std::string output;
+    // A studio project (plain backdrop: automatic masks) with the generator's exact masks.
+    ASSERT_EQ(Run("synth --output_path " + Project() +
+                      " --views 4 --width 96 --height 72 --points 300 --backdrop uniform",
+                  &output),
+              0)
+        << output;
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*root_);
+    delete root_;
+  }
+
+  static std::string Project() { return *root_ + "/project"; }
+
+  static int Run(const std::string& arguments, std::string* output) {
+    return testing::RunShell("'" + testing::RaycarveBinary() + "' " + arguments, output);
+  }
+
+  // Every file under `folder` with its bytes.
+  static std::map<std::string, std::string> Snapshot(const std::string& folder) {
+    std::map<std::string, std::string> files;
+    for (const auto& entry : fs::recursive_directory_iterator(folder)) {
+      if (entry.is_regular_file()) files[entry.path().string()] = testing::ReadFileBytes(entry.path());
+    }
+    return files;
+  }
+
+  // Exit status 1, one line naming every part, no crash.
+  static void ExpectRefused(const std::string& arguments, std::initializer_list<std::string> parts) {
+    std::string output;
+    EXPECT_EQ(Run(arguments, &output), 1) << arguments << "\n" << output;
+    for (const std::string& part : parts) {
+      EXPECT_NE(output.find(part), std::string::npos) << "'" << part << "' not in:\n" << output;
+    }
+    for (const char* crash : {"Check failed", "Aborted", "terminate", "unexpected error"}) {
+      EXPECT_EQ(output.find(crash), std::string::npos) << output;
+    }
+  }
+
+  static std::string* root_;
+};
+
+std::string* OutputFolder::root_ = nullptr;
+
+TEST_F(OutputFolder, ALinkToTheUsersMasksInsideTheOutputIsRefusedNotFollowed) {
+  // The user's masks elsewhere; an earlier carve's output folder whose masks/ became a link to
+  // them: carve would have written its own masks over the user's (report.json says the folder
+  // is carve's).
+  const std::string masks = *root_ + "/users_masks";
+  fs::copy(Project() + "/masks", masks, fs::copy_options::recursive);
+  const std::string out = *root_ + "/linked_masks_out";
+  std::string output;
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + out + " --resolution 16",
+                &output),
+            0)
+      << output;
+  fs::remove_all(out + "/masks");
+  fs::create_directory_symlink(masks, out + "/masks");
+  const auto before = Snapshot(masks);
+  ExpectRefused("carve --workspace_path " + Project() + " --output_path " + out + " --resolution 16",
+                {out + "/masks", "symbolic link", masks});
+  EXPECT_EQ(Snapshot(masks), before);
+  // The same with --mask_path naming them.
+  ExpectRefused("carve --workspace_path " + Project() + " --output_path " + out +
+                    " --resolution 16 --mask_path " + masks,
+                {"symbolic link"});
+  EXPECT_EQ(Snapshot(masks), before);
+  // A link where the mesh goes, to a user's file beside the output.
+  const std::string users_file = *root_ + "/notes.ply";
+  testing::WriteFile(users_file, "the user's own file\n");
+  fs::remove(out + "/masks");
+  fs::remove(out + "/mesh.ply");
+  fs::create_symlink(users_file, out + "/mesh.ply");
+  ExpectRefused("carve --workspace_path " + Project() + " --output_path " + out + " --resolution 16",
+                {out + "/mesh.ply", "symbolic link"});
+  EXPECT_EQ(testing::ReadFileBytes(users_file), "the user's own file\n");
+}
+
+TEST_F(OutputFolder, CalibrateHoldoutAndRenderNeverWriteIntoThePhotos) {
+  const std::string photos = Project() + "/images";
+  const auto before = Snapshot(photos);
+  // calibrate's undistorted/ a link to the photo folder.
+  const std::string out = *root_ + "/calibrated";
+  fs::create_directories(out);
+  fs::create_directory_symlink(fs::absolute(photos), out + "/undistorted");
+  ExpectRefused("calibrate --workspace_path " + Project() + " --output_path " + out,
+                {out + "/undistorted", "symbolic link"});
+  // holdout's folder a link to the photo folder (its images are named after the photos).
+  const std::string held = *root_ + "/held";
+  fs::create_directories(held);
+  fs::create_directory_symlink(fs::absolute(photos), held + "/holdout");
+  ExpectRefused("holdout --workspace_path " + Project() + " --output_path " + held +
+                    " --resolution 16 --every 2",
+                {held + "/holdout", "symbolic link"});
+  // render into the photo folder.
+  std::string output;
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + *root_ +
+                    "/for_render --resolution 16",
+                &output),
+            0)
+      << output;
+  ExpectRefused("render --cloud_path " + *root_ + "/for_render/cloud.ply --input_path " +
+                    Project() + "/sparse/0 --image_path " + photos + " --output_path " + photos,
+                {"is the photo folder"});
+  EXPECT_EQ(Snapshot(photos), before);
+}
+
+TEST_F(OutputFolder, OneRunAtATimeWritesIntoAFolderAndAKilledRunsLockDoesNotBlock) {
+  const std::string out = *root_ + "/locked";
+  fs::create_directories(out);
+  const std::string carve =
+      "carve --workspace_path " + Project() + " --output_path " + out + " --resolution 16";
+  // Another run holds the folder (this test, in its place): refused at once, naming it.
+  const std::string lock = out + "/.raycarve.lock";
+  const int fd = open(lock.c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(flock(fd, LOCK_EX), 0);
+  const std::string pid = std::to_string(getpid());
+  ASSERT_EQ(pwrite(fd, pid.data(), pid.size(), 0), static_cast<ssize_t>(pid.size()));
+  ExpectRefused(carve, {out, "another raycarve run (process " + pid + ")", "--wait"});
+  EXPECT_FALSE(fs::exists(out + "/report.json"));
+  // Released (as when that run is killed: the kernel drops its lock), the file left behind with
+  // the old process id does not block.
+  close(fd);
+  std::string output;
+  ASSERT_EQ(Run(carve, &output), 0) << output;
+  EXPECT_TRUE(fs::exists(out + "/report.json"));
+  // Two carves started together with --wait: the second waits, both finish, the set is whole.
+  const std::string both = "'" + testing::RaycarveBinary() + "' " + carve + " --wait > " + out +
+                           "/../first.log 2>&1 & '" + testing::RaycarveBinary() + "' " + carve +
+                           " --wait > " + out + "/../second.log 2>&1; second=$?; wait $!; "
+                           "first=$?; echo $first $second";
+  ASSERT_EQ(testing::RunShell(both, &output), 0) << output;
+  EXPECT_NE(output.find("0 0"), std::string::npos)
+      << output << testing::ReadFileBytes(out + "/../first.log")
+      << testing::ReadFileBytes(out + "/../second.log");
+  for (const char* file : {"cloud.ply", "mesh.ply", "report.json", "convergence.csv"}) {
+    EXPECT_TRUE(fs::is_regular_file(out + "/" + file)) << file;
+  }
+  for (const auto& entry : fs::directory_iterator(out)) {
+    EXPECT_EQ(entry.path().filename().string().rfind(".raycarve-partial-", 0), std::string::npos)
+        << "a staging folder was left: " << entry.path();
+  }
+}
+
+}  // namespace
+}  // namespace raycarve

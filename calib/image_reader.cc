@@ -1,12 +1,97 @@
 #include "calib/image_reader.h"
 
+#include <cerrno>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include <jpeglib.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib/input_error.h"
 
 namespace raycarve {
+namespace {
+
+// libjpeg's error manager with its warnings made errors: both jump back with the message.
+struct StrictJpegErrors {
+  jpeg_error_mgr manager;
+  std::jmp_buf jump;
+  char message[JMSG_LENGTH_MAX] = {0};
+};
+
+[[noreturn]] void JumpWithMessage(j_common_ptr info) {
+  StrictJpegErrors* errors = reinterpret_cast<StrictJpegErrors*>(info->err);
+  (*info->err->format_message)(info, errors->message);
+  std::longjmp(errors->jump, 1);
+}
+
+void OnJpegMessage(j_common_ptr info, int level) {
+  if (level < 0) JumpWithMessage(info);  // a warning: the data is damaged
+}
+
+struct FileCloser {
+  void operator()(std::FILE* file) const { std::fclose(file); }
+};
+
+bool StartsLikeJpeg(const std::string& path) {
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  unsigned char magic[3] = {0, 0, 0};
+  return file && std::fread(magic, 1, 3, file.get()) == 3 && magic[0] == 0xFF &&
+         magic[1] == 0xD8 && magic[2] == 0xFF;
+}
+
+}  // namespace
+
+std::string WhyNotAFile(const std::string& path) {
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(path, error);
+  if (status.type() == std::filesystem::file_type::not_found) return "not found";
+  if (error) return "cannot be reached: " + error.message();
+  if (status.type() == std::filesystem::file_type::directory) return "is a folder, not a file";
+  if (status.type() != std::filesystem::file_type::regular) {
+    return "is a FIFO, socket or device, not a file";
+  }
+  return "";
+}
+
+void CheckJpegStrictly(const std::string& path) {
+  if (!StartsLikeJpeg(path)) return;
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  if (!file) throw InputError(path + ": cannot open for reading: " + std::strerror(errno));
+  jpeg_decompress_struct info;
+  StrictJpegErrors errors;
+  info.err = jpeg_std_error(&errors.manager);
+  errors.manager.error_exit = JumpWithMessage;
+  errors.manager.emit_message = OnJpegMessage;
+  std::vector<JSAMPLE> row;
+  if (setjmp(errors.jump) != 0) {
+    jpeg_destroy_decompress(&info);
+    throw InputError(path + ": damaged JPEG (" + errors.message +
+                     "): raycarve does not carve with a photo or mask that cannot be read whole");
+  }
+  jpeg_create_decompress(&info);
+  jpeg_stdio_src(&info, file.get());
+  jpeg_read_header(&info, TRUE);
+  jpeg_start_decompress(&info);
+  row.resize(static_cast<size_t>(info.output_width) * info.output_components);
+  JSAMPROW rows[1] = {row.data()};
+  while (info.output_scanline < info.output_height) jpeg_read_scanlines(&info, rows, 1);
+  jpeg_finish_decompress(&info);
+  jpeg_destroy_decompress(&info);
+}
 
 cv::Mat ReadImage(const std::string& path, int flags) {
+  const std::string why = WhyNotAFile(path);
+  if (!why.empty()) throw InputError(path + ": " + why);
+  {
+    std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+    if (!file) throw InputError(path + ": cannot open for reading: " + std::strerror(errno));
+  }
+  CheckJpegStrictly(path);
   // COLMAP reads the pixels as stored and registers them so; OpenCV would turn a photo by its
   // EXIF orientation (a phone held upright: 3000x4000 against COLMAP's 4000x3000, or upside
   // down: the same size, silently turned). IMREAD_UNCHANGED ignores the orientation already.

@@ -115,14 +115,15 @@ LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, cons
   LoadedView loaded;
   const std::string path = (std::filesystem::path(image_path) / image.name).string();
   loaded.path = path;
-  if (!std::filesystem::is_regular_file(path)) {
-    if (options.skip_missing_images) {
+  const std::string why = WhyNotAFile(path);
+  if (!why.empty()) {
+    if (options.skip_missing_images && why == "not found") {
       LOG(WARNING) << path << ": photo of image " << image_id << " not found; skipped";
       loaded.missing = true;
       return loaded;
     }
     throw InputError(path + ": photo of image " + std::to_string(image_id) + " ('" + image.name +
-                     "') not found");
+                     "') " + why);
   }
   const cv::Mat bgr = ReadImage(path, cv::IMREAD_COLOR);
   if (bgr.empty()) {
@@ -159,10 +160,14 @@ LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, cons
     const std::filesystem::path folder(options.mask_path);
     const std::string colmap_style = (folder / (image.name + ".png")).string();
     const std::string same_name = (folder / image.name).string();
-    mask_file = std::filesystem::is_regular_file(colmap_style) ? colmap_style : same_name;
-    if (!std::filesystem::is_regular_file(mask_file)) {
+    mask_file = WhyNotAFile(colmap_style) != "not found" ? colmap_style : same_name;
+    const std::string why_mask = WhyNotAFile(mask_file);
+    if (why_mask == "not found") {
       throw InputError(colmap_style + ": mask of image " + std::to_string(image_id) +
                        " not found (nor " + same_name + ")");
+    }
+    if (!why_mask.empty()) {
+      throw InputError(mask_file + ": mask of image " + std::to_string(image_id) + " " + why_mask);
     }
     mask = ReadImage(mask_file, cv::IMREAD_GRAYSCALE);
     if (mask.empty()) throw InputError(mask_file + ": mask cannot be decoded as an image");

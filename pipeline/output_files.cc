@@ -1,6 +1,8 @@
 #include "pipeline/output_files.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -34,16 +36,36 @@ void WriteTextFileAtomically(const std::string& path, const std::string& text) {
   const std::string temporary = TemporaryPathFor(path);
   {
     std::ofstream stream(temporary);
-    if (!stream) throw InputError(temporary + ": cannot open for writing");
+    if (!stream) throw InputError(temporary + ": cannot open for writing: " + std::strerror(errno));
     stream << text;
-    if (!stream.flush()) throw InputError(temporary + ": write failed");
+    if (!stream.flush()) {
+      const std::string reason = std::strerror(errno);
+      stream.close();
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      throw InputError(temporary + ": write failed (" + reason + "); " + path + " is unchanged");
+    }
   }
   RenameIntoPlace(temporary, path);
 }
 
 void WriteImageAtomically(const std::string& path, const cv::Mat& image) {
   const std::string temporary = TemporaryPathFor(path);
-  if (!cv::imwrite(temporary, image)) throw InputError(temporary + ": cannot write the image");
+  bool written = false;
+  try {
+    written = cv::imwrite(temporary, image);
+  } catch (const cv::Exception& error) {
+    throw InputError(temporary + ": cannot write the image (" + error.err + ")");
+  }
+  if (!written) {
+    // imwrite says no more: whether the folder takes a file says why.
+    std::ofstream probe(temporary);
+    const std::string reason = probe ? std::string("the encoder failed") : std::strerror(errno);
+    probe.close();
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw InputError(temporary + ": cannot write the image: " + reason);
+  }
   RenameIntoPlace(temporary, path);
 }
 

@@ -63,12 +63,14 @@ ProjectRequest ProjectRequestOf(const CarveRequest& request, const std::string& 
   return project;
 }
 
+double PhysicalMemoryBytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page_size > 0 ? static_cast<double>(pages) * page_size : 0.0;
+}
+
 void CheckPhotosFitInMemory(const Reconstruction& reconstruction, int max_image_size,
                             double physical_bytes) {
-  if (physical_bytes <= 0.0) {
-    const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGESIZE);
-    physical_bytes = pages > 0 && page_size > 0 ? static_cast<double>(pages) * page_size : 0.0;
-  }
+  if (physical_bytes <= 0.0) physical_bytes = PhysicalMemoryBytes();
   if (physical_bytes <= 0.0) return;  // unknown: nothing to compare with
   double pixels = 0.0;
   Eigen::Vector2i largest(0, 0);

@@ -89,6 +89,9 @@ LoadedProject LoadProject(const ProjectRequest& request);
 // machine's memory the photos may take.
 constexpr double kBytesPerPhotoPixel = 14.0;
 constexpr double kUsableMemoryShare = 0.75;
+// This machine's memory in bytes (0 when unknown).
+double PhysicalMemoryBytes();
+
 // Refuses, before any photo is read, a project whose photos (reduced to `max_image_size`) would
 // need more than kUsableMemoryShare of `physical_bytes` (0: this machine's memory): the
 // message gives the estimate and a --max_image_size that fits.

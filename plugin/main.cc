@@ -1,6 +1,8 @@
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <iostream>
+#include <new>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -103,6 +105,22 @@ std::string WithoutPrefix(const std::string& message, const std::string& name) {
   return message.rfind(prefix, 0) == 0 ? message.substr(prefix.size()) : message;
 }
 
+// A filesystem failure as the user reads it: the path, what was being done, the reason.
+std::string FilesystemMessage(const std::filesystem::filesystem_error& error) {
+  std::string path = error.path1().string();
+  if (path.empty()) path = "(a path)";
+  std::string what = error.what();
+  // libstdc++: "filesystem error: <operation>: <reason> [<path>]"; keep the operation.
+  const std::string prefix = "filesystem error: ";
+  std::string operation;
+  if (what.rfind(prefix, 0) == 0) {
+    const size_t colon = what.find(':', prefix.size());
+    if (colon != std::string::npos) operation = what.substr(prefix.size(), colon - prefix.size());
+  }
+  return path + ": " + error.code().message() +
+         (operation.empty() ? std::string() : " (while trying to " + operation + " it)");
+}
+
 }  // namespace
 
 int main(int original_argc, char** original_argv) {
@@ -134,6 +152,16 @@ int main(int original_argc, char** original_argv) {
       return command.run(argc, argv);
     } catch (const raycarve::InputError& error) {
       std::cerr << "raycarve " << name << ": error: " << WithoutPrefix(error.what(), name)
+                << std::endl;
+      return 1;
+    } catch (const std::filesystem::filesystem_error& error) {
+      // A path the user gave or made (permissions, a name too long, a link loop, a full or
+      // read-only disk): one line naming it and the reason.
+      std::cerr << "raycarve " << name << ": error: " << FilesystemMessage(error) << std::endl;
+      return 1;
+    } catch (const std::bad_alloc&) {
+      std::cerr << "raycarve " << name << ": error: out of memory: a size that an option or an "
+                << "input file chose is too large for this machine (see --help for the limits)"
                 << std::endl;
       return 1;
     } catch (const std::exception& error) {

@@ -6,8 +6,10 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "calib/input_error.h"
 #include "tests/test_support.h"
 
 namespace raycarve {
@@ -64,6 +66,72 @@ TEST(ImageReader, ReadsThePixelsAsStoredWhateverTheExifOrientationAsColmapDoes) 
     }
   }
   std::filesystem::remove_all(folder);
+}
+
+// A textured test image, as a JPEG's bytes.
+std::vector<uint8_t> TexturedJpeg() {
+  cv::Mat image(96, 128, CV_8UC3);
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
+  std::vector<uint8_t> encoded;
+  EXPECT_TRUE(cv::imencode(".jpg", image, encoded, {cv::IMWRITE_JPEG_QUALITY, 90}));
+  return encoded;
+}
+
+void WriteBytes(const std::string& path, const std::vector<uint8_t>& bytes, size_t count) {
+  std::ofstream file(path, std::ios::binary);
+  file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(count));
+}
+
+// The InputError's message of ReadImage(path), or "" when it reads.
+std::string ReadError(const std::string& path) {
+  try {
+    ReadImage(path, cv::IMREAD_COLOR);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(ImageReader, AJpegCutShortOrCorruptIsAnErrorNamingItAsAPngIs) {
+  const std::string folder = testing::MakeTemporaryDirectory("image_reader_damaged");
+  const std::vector<uint8_t> jpeg = TexturedJpeg();
+  const std::string whole = folder + "/whole.jpg";
+  WriteBytes(whole, jpeg, jpeg.size());
+  EXPECT_EQ(ReadError(whole), "");
+  EXPECT_FALSE(ReadImage(whole, cv::IMREAD_COLOR).empty());
+  // Cut in half: libjpeg would fill the rest with grey and only warn.
+  const std::string half = folder + "/half.jpg";
+  WriteBytes(half, jpeg, jpeg.size() / 2);
+  const std::string cut = ReadError(half);
+  EXPECT_NE(cut.find(half), std::string::npos) << cut;
+  EXPECT_NE(cut.find("damaged JPEG"), std::string::npos) << cut;
+  // Bytes of the entropy-coded data overwritten by markers libjpeg does not expect there.
+  std::vector<uint8_t> corrupt = jpeg;
+  for (size_t k = corrupt.size() / 2; k < corrupt.size() / 2 + 64; k += 2) {
+    corrupt[k] = 0xFF;
+    corrupt[k + 1] = 0xD0 + (k / 2) % 8;  // restart markers out of place
+  }
+  const std::string damaged = folder + "/corrupt.jpg";
+  WriteBytes(damaged, corrupt, corrupt.size());
+  EXPECT_NE(ReadError(damaged).find("damaged JPEG"), std::string::npos) << ReadError(damaged);
+  // A PNG cut short was refused already: the two formats agree now.
+  std::vector<uint8_t> png;
+  ASSERT_TRUE(cv::imencode(".png", cv::imread(whole), png));
+  const std::string half_png = folder + "/half.png";
+  WriteBytes(half_png, png, png.size() / 2);
+  EXPECT_TRUE(ReadImage(half_png, cv::IMREAD_COLOR).empty() || !ReadError(half_png).empty());
+}
+
+TEST(ImageReader, SaysWhatAPathIsWhenItIsNoFile) {
+  const std::string folder = testing::MakeTemporaryDirectory("image_reader_kinds");
+  EXPECT_EQ(WhyNotAFile(folder + "/absent.png"), "not found");
+  EXPECT_EQ(WhyNotAFile(folder), "is a folder, not a file");
+  EXPECT_NE(ReadError(folder).find("is a folder"), std::string::npos);
+  const std::string fifo = folder + "/pipe.png";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
+  EXPECT_EQ(WhyNotAFile(fifo), "is a FIFO, socket or device, not a file");
+  EXPECT_NE(ReadError(fifo).find("FIFO"), std::string::npos);  // and never blocks reading it
+  EXPECT_NE(ReadError("/dev/null").find("device"), std::string::npos);
 }
 
 }  // namespace

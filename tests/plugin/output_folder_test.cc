@@ -168,5 +168,71 @@ TEST_F(OutputFolder, OneRunAtATimeWritesIntoAFolderAndAKilledRunsLockDoesNotBloc
   }
 }
 
+TEST_F(OutputFolder, FilesystemFailuresAreInputErrorsNamingThePath) {
+  // Permissions bind only an unprivileged user: as root, each command runs as nobody (setpriv).
+  std::string as_user;
+  if (geteuid() == 0) {
+    if (!fs::exists("/usr/bin/setpriv")) GTEST_SKIP() << "running as root without setpriv";
+    as_user = "/usr/bin/setpriv --reuid=65534 --regid=65534 --clear-groups ";
+  }
+  const std::string place = *root_ + "/unprivileged";
+  fs::create_directories(place);
+  const std::string binary = place + "/raycarve";
+  fs::copy_file(testing::RaycarveBinary(), binary);
+  const std::string project = place + "/project";
+  fs::copy(Project(), project, fs::copy_options::recursive);
+  for (const auto& entry : fs::recursive_directory_iterator(place)) {
+    fs::permissions(entry.path(), fs::perms::others_read | fs::perms::group_read, fs::perm_options::add);
+    if (entry.is_directory()) {
+      fs::permissions(entry.path(), fs::perms::others_exec | fs::perms::group_exec, fs::perm_options::add);
+    }
+  }
+  fs::permissions(*root_, fs::perms::all, fs::perm_options::add);
+  fs::permissions(place, fs::perms::all, fs::perm_options::add);
+  const auto run = [&](const std::string& arguments, std::initializer_list<std::string> parts) {
+    std::string output;
+    EXPECT_EQ(testing::RunShell(as_user + "'" + binary + "' " + arguments, &output), 1)
+        << arguments << "\n" << output;
+    for (const std::string& part : parts) {
+      EXPECT_NE(output.find(part), std::string::npos) << "'" << part << "' not in:\n" << output;
+    }
+    EXPECT_EQ(output.find("unexpected error"), std::string::npos) << output;
+  };
+  const std::string carve = "carve --workspace_path " + project + " --resolution 16 --output_path ";
+  // An unreadable photo folder, then one unreadable photo.
+  fs::permissions(project + "/images", fs::perms::none);
+  run(carve + place + "/out1", {project + "/images", "ermission denied"});
+  fs::permissions(project + "/images", fs::perms::owner_all | fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(project + "/images/view001.png", fs::perms::none);
+  run(carve + place + "/out2", {project + "/images/view001.png", "ermission denied"});
+  fs::permissions(project + "/images/view001.png", fs::perms::owner_read | fs::perms::others_read);
+  // An output folder that cannot be made, for each command that writes.
+  const std::string read_only = place + "/read_only";
+  fs::create_directories(read_only);
+  fs::permissions(read_only, fs::perms::owner_all | fs::perms::others_read | fs::perms::others_exec);
+  run(carve + read_only + "/out", {read_only + "/out", "ermission denied"});
+  run("calibrate --workspace_path " + project + " --output_path " + read_only + "/out",
+      {read_only + "/out", "ermission denied"});
+  run("compare --reference_path " + project + "/truth.ply --input_path " + project +
+          "/truth.ply --output_path " + read_only + "/compare.json",
+      {read_only, "ermission denied"});
+  // A link loop as the workspace; a name longer than the filesystem allows as the output.
+  fs::create_symlink(place + "/loop_b", place + "/loop_a");
+  fs::create_symlink(place + "/loop_a", place + "/loop_b");
+  run("carve --workspace_path " + place + "/loop_a", {place + "/loop_a", "symbolic links"});
+  run(carve + place + "/" + std::string(300, 'x'), {"File name too long"});
+}
+
+TEST_F(OutputFolder, CompareRefusesSampleCountsBeyondTheMachinesMemory) {
+  std::string output;
+  EXPECT_EQ(Run("compare --reference_path " + Project() + "/truth.ply --input_path " + Project() +
+                    "/truth.ply --mesh_samples 2000000000",
+                &output),
+            1)
+      << output;
+  EXPECT_NE(output.find("--mesh_samples 2000000000"), std::string::npos) << output;
+  EXPECT_NE(output.find("give at most"), std::string::npos) << output;
+}
+
 }  // namespace
 }  // namespace raycarve

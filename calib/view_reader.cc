@@ -194,6 +194,16 @@ LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, cons
                                  VolumeOutline(camera, image, options.volume), &info.mask);
       mask_file = path + " (backdrop mask)";
       info.source = "backdrop";
+    }
+    if (!mask.empty() && cv::countNonZero(mask) == 0) {
+      // A photo of the object is never all backdrop: a mask that says so found no object in
+      // its colours (a grey photo, a backdrop that matches it), and would carve the model away
+      // in every photo through the visual hull. The photo is carved without a mask.
+      LOG(WARNING) << path << ": the backdrop mask holds no object; the photo is used without a mask";
+      mask.release();
+      mask_file.clear();
+      info.source = "none";
+    } else if (info.source == "backdrop") {
       VLOG(1) << path << ": backdrop " << info.backdrop.Summary() << ", object "
               << std::lround(100.0 * info.mask.object_share) << "% of the photo, "
               << info.mask.seeds << " sparse points as seeds";

@@ -24,13 +24,16 @@ int RunBenchmark(int argc, char** argv);
 int RunSfm(int argc, char** argv);
 int RunRender(int argc, char** argv);
 
-// model_info: a text and a JSON description of a model and the bounds it would carve.
+// model_info: a text and a JSON description of a model and the bounds it would carve; with
+// `bounds_error`, why its points bound no volume instead.
 std::string DescribeModelText(const Reconstruction& reconstruction,
                               const std::string& model_path,
-                              const Bounds& bounds);
+                              const Bounds& bounds,
+                              const std::string& bounds_error = "");
 std::string DescribeModelJson(const Reconstruction& reconstruction,
                               const std::string& model_path,
-                              const Bounds& bounds);
+                              const Bounds& bounds,
+                              const std::string& bounds_error = "");
 
 // sfm --colmap_options: "Section.name=value,..." split into the arguments of the COLMAP step
 // that takes each section. Throws InputError on a malformed item or an unknown section.

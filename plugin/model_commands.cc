@@ -46,7 +46,8 @@ PointStatistics ComputePointStatistics(const Reconstruction& reconstruction) {
 
 std::string DescribeModelText(const Reconstruction& reconstruction,
                               const std::string& model_path,
-                              const Bounds& bounds) {
+                              const Bounds& bounds,
+                              const std::string& bounds_error) {
   const PointStatistics points = ComputePointStatistics(reconstruction);
   std::ostringstream text;
   text << "model: " << model_path << "\n"
@@ -79,13 +80,14 @@ std::string DescribeModelText(const Reconstruction& reconstruction,
   text << "points3D: " << reconstruction.points3D.size() << ", mean track length "
        << points.mean_track_length << ", mean reprojection error " << points.mean_error
        << " px\n"
-       << bounds.Summary() << "\n";
+       << (bounds_error.empty() ? bounds.Summary() : "bounds: none (" + bounds_error + ")") << "\n";
   return text.str();
 }
 
 std::string DescribeModelJson(const Reconstruction& reconstruction,
                               const std::string& model_path,
-                              const Bounds& bounds) {
+                              const Bounds& bounds,
+                              const std::string& bounds_error) {
   const PointStatistics points = ComputePointStatistics(reconstruction);
   JsonWriter json;
   json.BeginObject().Key("model_path").Value(model_path);
@@ -120,6 +122,11 @@ std::string DescribeModelJson(const Reconstruction& reconstruction,
       .Key("mean_track_length").Value(points.mean_track_length)
       .Key("mean_reprojection_error").Value(points.mean_error)
       .EndObject();
+  if (!bounds_error.empty()) {
+    json.Key("bounds").BeginObject().Key("error").Value(bounds_error).EndObject();
+    json.EndObject();
+    return json.str();
+  }
   json.Key("bounds").BeginObject()
       .Key("min").Value(JsonArray(bounds.box.min()))
       .Key("max").Value(JsonArray(bounds.box.max()))
@@ -150,9 +157,17 @@ int RunModelInfo(int argc, char** argv) {
   if (!parser.Parse(argc, argv)) return 0;
 
   const Reconstruction reconstruction = ReadModel(input_path);
-  const Bounds bounds = ResolveBounds(reconstruction, bounds_flags, input_path);
-  const std::string json = DescribeModelJson(reconstruction, input_path, bounds);
-  std::cout << (format == "json" ? json : DescribeModelText(reconstruction, input_path, bounds));
+  // A model whose points cannot bound a volume (one image, too few points) is still described.
+  Bounds bounds;
+  std::string bounds_error;
+  try {
+    bounds = ResolveBounds(reconstruction, bounds_flags, input_path);
+  } catch (const InputError& error) {
+    bounds_error = error.what();
+  }
+  const std::string json = DescribeModelJson(reconstruction, input_path, bounds, bounds_error);
+  std::cout << (format == "json" ? json
+                                 : DescribeModelText(reconstruction, input_path, bounds, bounds_error));
   if (!output_path.empty()) {
     CheckOutputFileOutside(output_path, input_path, "input model");
     WriteTextFileAtomically(output_path, json);

@@ -117,6 +117,8 @@ void OptionParser::ReadProjectFile(const std::string& path) {
   std::string line, section;
   std::vector<std::string> ignored;
   for (int number = 1; std::getline(file, line); ++number) {
+    // A UTF-8 byte-order mark (editors on Windows write one) is not part of the first key.
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     const auto trim = [](std::string text) {
       const size_t begin = text.find_first_not_of(" \t\r");
       const size_t end = text.find_last_not_of(" \t\r");
@@ -197,6 +199,9 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
       has_value = true;
     }
     if (name == "project_path") {
+      if (!has_value && (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)) {
+        throw InputError("option --project_path needs a value (an INI file)");
+      }
       if (!has_value) ++i;  // read above
       continue;
     }

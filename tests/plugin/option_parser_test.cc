@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "calib/input_error.h"
+#include "tests/test_support.h"
 
 namespace raycarve {
 namespace {
@@ -71,6 +72,64 @@ TEST(OptionParser, RefusesUnknownMissingAndMalformedOptionsByName) {
   expect_error({"--input_path", "x", "--views"}, "--views needs a value");
   expect_error({"--input_path", "x", "--format", "xml"}, "not one of: text, json");
   expect_error({"--input_path", "x", "stray"}, "unexpected argument 'stray'");
+}
+
+TEST(OptionParser, ReadsIniFilesWithAByteOrderMarkAndCrlfAsColmapDoes) {
+  const std::string folder = testing::MakeTemporaryDirectory("option_parser_ini");
+  const std::string ini = folder + "/options.ini";
+  testing::WriteFile(ini, "\xEF\xBB\xBFviews=12\r\n[cmd]\r\nmargin = 0.5\r\n");
+  int views = 8;
+  double margin = 0.1;
+  OptionParser parser("cmd", "description");
+  parser.AddDefault("views", &views, "views");
+  parser.AddDefault("margin", &margin, "margin");
+  Argv args({"raycarve", "cmd", "--project_path", ini});
+  ASSERT_TRUE(parser.Parse(args.argc(), args.argv()));
+  EXPECT_EQ(views, 12);
+  EXPECT_EQ(margin, 0.5);
+}
+
+TEST(OptionParser, AProjectPathWithoutItsValueIsAnErrorWhereverItStands) {
+  for (const std::vector<std::string>& arguments :
+       {std::vector<std::string>{"raycarve", "cmd", "--project_path"},
+        std::vector<std::string>{"raycarve", "cmd", "--views", "3", "--project_path"}}) {
+    int views = 8;
+    OptionParser parser("cmd", "description");
+    parser.AddDefault("views", &views, "views");
+    Argv args(arguments);
+    try {
+      parser.Parse(args.argc(), args.argv());
+      ADD_FAILURE() << "accepted --project_path without a value";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find("--project_path needs a value"), std::string::npos)
+          << error.what();
+    }
+  }
+}
+
+TEST(OptionParser, GroupsTheHelpAndShowsTheBasicOptionsFirst) {
+  int views = 8, level = 1;
+  std::string mesh = "smooth";
+  OptionParser parser("cmd", "description");
+  parser.BeginGroup("Carve");
+  parser.AddDefault("views", &views, "views");
+  parser.AddDefault("level", &level, "level");
+  parser.BeginGroup("Mesh");
+  parser.AddDefault("mesh", &mesh, "the mesh", {"smooth", "voxels"});
+  parser.SetBasicOptions({"mesh"});
+  parser.AddExample("raycarve cmd --mesh voxels", "voxel faces");
+  const std::string basic = parser.Help(false);
+  EXPECT_NE(basic.find("--mesh"), std::string::npos) << basic;
+  EXPECT_EQ(basic.find("--level"), std::string::npos) << basic;
+  EXPECT_NE(basic.find("--help all"), std::string::npos) << basic;
+  EXPECT_NE(basic.find("raycarve cmd --mesh voxels"), std::string::npos) << basic;
+  const std::string all = parser.Help(true);
+  EXPECT_LT(all.find("Carve options:"), all.find("--level")) << all;
+  EXPECT_LT(all.find("--level"), all.find("Mesh options:")) << all;
+  const std::string markdown = parser.Markdown();
+  EXPECT_NE(markdown.find("| `--mesh` * | `smooth` | the mesh (allowed: smooth, voxels) |"),
+            std::string::npos)
+      << markdown;
 }
 
 }  // namespace

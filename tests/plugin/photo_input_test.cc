@@ -1,0 +1,115 @@
+// Photos as users bring them: grey ones, damaged ones. Each case runs the `raycarve` program.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "tests/test_support.h"
+
+namespace raycarve {
+namespace {
+
+namespace fs = std::filesystem;
+
+int RunRaycarve(const std::string& arguments, std::string* output) {
+  return testing::RunShell("'" + testing::RaycarveBinary() + "' " + arguments, output);
+}
+
+// A generated studio project (plain backdrop) in `folder`.
+void MakeProject(const std::string& folder) {
+  std::string output;
+  ASSERT_EQ(RunRaycarve("synth --output_path " + folder +
+                    " --views 6 --width 128 --height 96 --points 400 --backdrop uniform",
+                &output),
+            0)
+      << output;
+}
+
+// Rewrites photo `name` of `project` as one-channel grey, 8 or 16 bits.
+void MakeGrey(const std::string& project, const std::string& name, int depth) {
+  const std::string path = project + "/images/" + name;
+  cv::Mat grey;
+  cv::cvtColor(cv::imread(path, cv::IMREAD_COLOR), grey, cv::COLOR_BGR2GRAY);
+  if (depth == CV_16U) grey.convertTo(grey, CV_16U, 257.0);
+  ASSERT_TRUE(cv::imwrite(path, grey));
+}
+
+// The number after "key": in report.json.
+double ReportNumber(const std::string& report, const std::string& key) {
+  const size_t at = report.find("\"" + key + "\":");
+  if (at == std::string::npos) return -1.0;
+  return std::stod(report.substr(at + key.size() + 3));
+}
+
+TEST(PhotoInput, GreyPhotosAreCarvedAndNeverMaskedWhole) {
+  const std::string root = testing::MakeTemporaryDirectory("photo_input_grey");
+  for (int depth : {CV_8U, CV_16U}) {
+    const std::string project = root + "/grey" + std::to_string(depth);
+    MakeProject(project);
+    for (const auto& entry : fs::directory_iterator(project + "/images")) {
+      MakeGrey(project, entry.path().filename().string(), depth);
+    }
+    std::string output;
+    ASSERT_EQ(RunRaycarve("carve --workspace_path " + project + " --resolution 32", &output), 0) << output;
+    EXPECT_EQ(output.find("kept nothing"), std::string::npos) << output;
+    const std::string report = testing::ReadFileBytes(project + "/raycarve/report.json");
+    EXPECT_GT(ReportNumber(report, "cloud_points"), 1000) << report;
+  }
+  // One grey photo among colour ones.
+  const std::string mixed = root + "/mixed";
+  MakeProject(mixed);
+  MakeGrey(mixed, "view002.png", CV_8U);
+  std::string output;
+  ASSERT_EQ(RunRaycarve("carve --workspace_path " + mixed + " --resolution 32", &output), 0) << output;
+  EXPECT_EQ(output.find("kept nothing"), std::string::npos) << output;
+  const std::string report = testing::ReadFileBytes(mixed + "/raycarve/report.json");
+  EXPECT_GT(ReportNumber(report, "cloud_points"), 1000) << report;
+  // No photo's mask is all background.
+  for (const auto& entry : fs::directory_iterator(mixed + "/raycarve/masks")) {
+    const cv::Mat mask = cv::imread(entry.path().string(), cv::IMREAD_GRAYSCALE);
+    EXPECT_GT(cv::countNonZero(mask), 0) << entry.path();
+  }
+}
+
+TEST(PhotoInput, APhotoOfTheBackdropAloneIsCarvedWithoutAMask) {
+  // view002's photo shows only the backdrop (the object left out of it): a mask of it would be
+  // all background, and the visual hull would carve away everything it sees. The sparse points
+  // that land on it say its colour is the object's, so it gets no mask (and a mask that would
+  // still come out empty is dropped: view_reader.cc).
+  const std::string root = testing::MakeTemporaryDirectory("photo_input_all_backdrop");
+  const std::string project = root + "/project";
+  MakeProject(project);
+  const std::string path = project + "/images/view002.png";
+  cv::Mat photo = cv::imread(path);
+  photo.setTo(photo.at<cv::Vec3b>(0, 0));
+  ASSERT_TRUE(cv::imwrite(path, photo));
+  std::string output;
+  ASSERT_EQ(RunRaycarve("carve --workspace_path " + project + " --resolution 32", &output), 0)
+      << output;
+  EXPECT_NE(output.find(path + ": no plain backdrop"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(project + "/raycarve/masks/view002.png.png"));
+  EXPECT_TRUE(fs::exists(project + "/raycarve/masks/view001.png.png"));
+  EXPECT_EQ(output.find("kept nothing"), std::string::npos) << output;
+}
+
+TEST(PhotoInput, ADamagedJpegPhotoIsNamedAndNothingIsCarved) {
+  const std::string root = testing::MakeTemporaryDirectory("photo_input_jpeg");
+  const std::string project = root + "/project";
+  MakeProject(project);
+  // view003's photo as a JPEG (under its own name: decoders go by the content), cut in half.
+  const std::string path = project + "/images/view003.png";
+  std::vector<uint8_t> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", cv::imread(path), jpeg));
+  testing::WriteFile(path, std::string(jpeg.begin(), jpeg.begin() + jpeg.size() / 2));
+  std::string output;
+  EXPECT_EQ(RunRaycarve("carve --workspace_path " + project + " --resolution 32", &output), 1) << output;
+  EXPECT_NE(output.find(path), std::string::npos) << output;
+  EXPECT_NE(output.find("damaged JPEG"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(project + "/raycarve/report.json"));
+}
+
+}  // namespace
+}  // namespace raycarve

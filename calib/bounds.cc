@@ -78,8 +78,9 @@ bool BoundsOptions::IsValid(std::string* reason) const {
     *reason = "trim_fraction must be in [0, 0.5)";
     return false;
   }
-  if (!(margin >= 0.0 && std::isfinite(margin))) {
-    *reason = "margin must be finite and >= 0";
+  if (!(margin >= 0.0 && margin <= kMaxMargin)) {
+    *reason = "margin must be in [0, " + std::to_string(static_cast<int>(kMaxMargin)) +
+              "] (a fraction of the volume's largest extent added on every side: 0.1 is 10%)";
     return false;
   }
   if (std::isnan(max_reprojection_error)) {

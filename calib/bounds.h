@@ -12,6 +12,9 @@ namespace raycarve {
 // outliers (mismatches, points on the background far behind the object), so the box is robust:
 // points are filtered by track length and reprojection error, each axis is trimmed at quantiles,
 // and a margin is added.
+// The largest --margin: a box a hundred times wider than the object carves nothing but space.
+constexpr double kMaxMargin = 100.0;
+
 struct BoundsOptions {
   // Points seen in fewer images than this are ignored.
   int min_track_length = 2;

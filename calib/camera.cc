@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
-#include <cmath>
 #include <sstream>
 
 #include "calib/input_error.h"
@@ -95,6 +93,18 @@ void ValidateCamera(const Camera& camera, const std::string& context) {
   }
   if (!(camera.FocalLengthX() > 0.0) || !(camera.FocalLengthY() > 0.0)) {
     throw InputError(prefix.str() + ": focal length must be positive");
+  }
+  // A focal length below a hundredth of the photo's longer side is a field of view of more than
+  // about 178 degrees across it: wider than any lens, fisheyes included (an equidistant fisheye
+  // seeing 180 degrees has f = side / pi). Such a value is a broken or mistyped calibration.
+  const double longer = static_cast<double>(std::max(camera.width, camera.height));
+  const double focal = std::min(camera.FocalLengthX(), camera.FocalLengthY());
+  if (focal < kMinFocalShare * longer) {
+    std::ostringstream text;
+    text << prefix.str() << ": focal length " << focal << " px is less than "
+         << kMinFocalShare * 100 << "% of the photo's longer side (" << longer
+         << " px): a field of view wider than any lens; check the camera's parameters";
+    throw InputError(text.str());
   }
 }
 

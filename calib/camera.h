@@ -45,8 +45,10 @@ Camera RescaledCamera(const Camera& camera, uint64_t new_width, uint64_t new_hei
 Eigen::Vector2i LimitedImageSize(uint64_t width, uint64_t height, int max_size);
 
 // Throws InputError, prefixed with `context` (file and camera), when the camera cannot be used:
-// wrong number of parameters, a non-finite parameter, a non-positive focal length or image size.
+// wrong number of parameters, a non-finite parameter, a non-positive focal length or image size,
+// or a focal length below kMinFocalShare of the longer side (a field of view over ~178 degrees).
 void ValidateCamera(const Camera& camera, const std::string& context);
+constexpr double kMinFocalShare = 0.01;
 // The most pixels a camera may have (ValidateCamera): OpenCV's default CV_IO_MAX_IMAGE_PIXELS.
 constexpr uint64_t kMaxCameraPixels = uint64_t{1} << 30;
 

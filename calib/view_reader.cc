@@ -211,6 +211,20 @@ LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, cons
   }
   if (!mask.empty()) info.object_share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
   loaded.view = MakeCalibratedView(camera, image, rgb, path, mask, mask_file);
+  // Distortion that folds the image (a coefficient of the wrong sign or size) leaves almost no
+  // pixel of the undistorted photo with a source: nothing to carve with.
+  const double valid_share =
+      static_cast<double>(cv::countNonZero(loaded.view.valid)) / loaded.view.valid.total();
+  if (valid_share < kMinValidShare) {
+    std::ostringstream text;
+    text << path << ": camera " << camera.camera_id << " (" << CameraModelName(camera.model)
+         << ", params";
+    for (double param : camera.params) text << " " << param;
+    text << ") leaves " << 100.0 * valid_share
+         << "% of the undistorted photo with a source pixel: its distortion folds the image; "
+            "check the camera's parameters";
+    throw InputError(text.str());
+  }
   VLOG(1) << path << ": view built";
   return loaded;
 }

@@ -9,6 +9,10 @@
 
 namespace raycarve {
 
+// The least share of an undistorted photo that must have a source pixel (ReadCalibratedViews
+// refuses a camera whose distortion leaves less: it folds the image).
+constexpr double kMinValidShare = 0.01;
+
 struct ViewReaderOptions {
   // Skip registered images whose photo is missing (counted and logged) instead of failing.
   bool skip_missing_images = false;

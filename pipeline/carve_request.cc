@@ -41,6 +41,13 @@ void FinishCarveRequest(CarveRequest* request) {
                      std::to_string(request->mesh_max_faces));
   }
   request->mesh.max_triangles = static_cast<int64_t>(request->mesh_max_faces);
+  const int max_image_size = request->view_options.max_image_size;
+  if (max_image_size > 0 && max_image_size < CarveOptions::kMinReducedSide) {
+    throw InputError("--max_image_size " + std::to_string(max_image_size) + ": photos reduced below " +
+                     std::to_string(CarveOptions::kMinReducedSide) +
+                     " pixels cannot show the object's colours; give at least " +
+                     std::to_string(CarveOptions::kMinReducedSide) + ", or 0 for full size");
+  }
   if (request->cloud_min_views < 1) {
     throw InputError("--cloud_min_views: must be >= 1, got " + std::to_string(request->cloud_min_views));
   }

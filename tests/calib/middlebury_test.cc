@@ -67,8 +67,13 @@ TEST(Middlebury, BadFilesNameTheLineAndField) {
   // A reflection is orthonormal but not a rotation.
   ExpectError("1\na.png 1500 0 300 0 1510 250 0 0 1 -1 0 0 0 1 0 0 0 1 0.1 0.2 0.6\n", {"not a rotation"});
   ExpectError("1\na.png 1500 0 300 0 1510 250 0 0 1 1 0 0 0 1 0 0 0 1 0.1 nan 0.6\n", {"'t2'"});
-  ExpectError("2\na.png 1 0 3 0 1 2 0 0 1 1 0 0 0 1 0 0 0 1 0 0 1\na.png 1 0 3 0 1 2 0 0 1 1 0 0 0 1 0 0 0 1 0 0 1\n",
+  ExpectError("2\na.png 1500 0 3 0 1500 2 0 0 1 1 0 0 0 1 0 0 0 1 0 0 1\na.png 1500 0 3 0 1500 2 0 0 1 1 0 0 0 1 0 0 0 1 0 0 1\n",
               {"duplicate", "a.png"});
+  // A focal length of a pixel in a photo 640 wide: a field of view wider than any lens.
+  ExpectError("1\na.png 1 0 300 0 1 250 0 0 1 1 0 0 0 1 0 0 0 1 0.1 0.2 0.6\n",
+              {"line 2", "focal length 1 px", "less than 1%"});
+  ExpectError("1\na.png 4e-320 0 300 0 4e-320 250 0 0 1 1 0 0 0 1 0 0 0 1 0.1 0.2 0.6\n",
+              {"line 2", "focal length"});
 }
 
 TEST(Middlebury, RotationsPrintedToSevenDigitsAreTakenAndOrthonormalised) {

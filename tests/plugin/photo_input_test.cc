@@ -1,5 +1,7 @@
 // Photos as users bring them: grey ones, damaged ones. Each case runs the `raycarve` program.
 #include <filesystem>
+#include <iterator>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -109,6 +111,47 @@ TEST(PhotoInput, ADamagedJpegPhotoIsNamedAndNothingIsCarved) {
   EXPECT_NE(output.find(path), std::string::npos) << output;
   EXPECT_NE(output.find("damaged JPEG"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(project + "/raycarve/report.json"));
+}
+
+TEST(PhotoInput, ImplausibleValuesAreRefusedSayingWhichAndWhy) {
+  const std::string root = testing::MakeTemporaryDirectory("photo_input_plausible");
+  const std::string project = root + "/project";
+  std::string output;
+  ASSERT_EQ(RunRaycarve("synth --output_path " + project + " --views 4 --width 96 --height 72 " +
+                            "--points 300 --camera_model OPENCV_FISHEYE",
+                        &output),
+            0)
+      << output;
+  const auto refused = [&](const std::string& arguments, std::initializer_list<std::string> parts) {
+    EXPECT_EQ(RunRaycarve(arguments, &output), 1) << arguments << "\n" << output;
+    for (const std::string& part : parts) {
+      EXPECT_NE(output.find(part), std::string::npos) << "'" << part << "' not in:\n" << output;
+    }
+  };
+  refused("carve --workspace_path " + project + " --max_image_size 1", {"--max_image_size 1", "at least 48"});
+  refused("carve --workspace_path " + project + " --margin 1e308", {"margin must be in [0, 100]"});
+  // A fisheye coefficient that folds the image: no undistorted pixel has a source.
+  const std::string model = root + "/folded";
+  ASSERT_EQ(RunRaycarve("model_converter --input_path " + project + "/sparse/0 --output_path " +
+                            model + " --output_type TXT",
+                        &output),
+            0)
+      << output;
+  std::string cameras = testing::ReadFileBytes(model + "/cameras.txt");
+  const size_t line = cameras.find("OPENCV_FISHEYE");
+  ASSERT_NE(line, std::string::npos);
+  // The 8 numbers after the size are fx fy cx cy k1 k2 k3 k4: k1 becomes -1e12.
+  std::istringstream fields(cameras.substr(line, cameras.find('\n', line) - line));
+  std::vector<std::string> words{std::istream_iterator<std::string>(fields), {}};
+  ASSERT_EQ(words.size(), 11u);
+  words[7] = "-1e12";
+  std::string edited;
+  for (const std::string& word : words) edited += (edited.empty() ? "" : " ") + word;
+  cameras.replace(line, cameras.find('\n', line) - line, edited);
+  testing::WriteFile(model + "/cameras.txt", cameras);
+  refused("calibrate --input_path " + model + " --image_path " + project + "/images --output_path " +
+              root + "/folded_out",
+          {"view001.png", "folds the image"});
 }
 
 }  // namespace

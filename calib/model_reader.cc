@@ -10,6 +10,7 @@
 
 #include <glog/logging.h>
 
+#include "calib/image_reader.h"
 #include "calib/input_error.h"
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
@@ -199,6 +200,8 @@ void ReadFile(const std::filesystem::path& path,
                   text_reader,
               Reconstruction* reconstruction) {
   const bool binary = path.extension() == ".bin";
+  const std::string why = WhyNotAFile(path.string());
+  if (!why.empty()) throw InputError(path.string() + ": " + why);
   std::ifstream stream(path, binary ? std::ios::binary : std::ios::in);
   if (!stream) {
     throw InputError(path.string() + ": cannot open for reading: " + std::strerror(errno));

@@ -4,11 +4,11 @@
 # for SECONDS (default 600) from a scratch copy of its committed corpus, printing libFuzzer's
 # figures (executions, coverage, corpus size). A crash fails and keeps its input in /tmp; add it
 # to tests/fuzz/corpus/<target>/ with a unit test once fixed.
-# Usage: scripts/run_fuzz.sh [SECONDS] [TARGETS]   (default: 600, "model_reader middlebury ply option_parser")
+# Usage: scripts/run_fuzz.sh [SECONDS] [TARGETS]   (default: 600, "model_reader middlebury ply option_parser image")
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-600}
-targets=${2:-"model_reader middlebury ply option_parser"}
+targets=${2:-"model_reader middlebury ply option_parser image"}
 scripts/setup.sh raycarve >&2
 if ! command -v clang++-16 > /dev/null || [ ! -d /usr/lib/llvm-16/lib/clang/16/lib/linux ] ||
    ! ls /usr/lib/llvm-16/lib/clang/16/lib/linux/libclang_rt.fuzzer-x86_64.a > /dev/null 2>&1; then

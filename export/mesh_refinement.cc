@@ -82,6 +82,159 @@ std::string MeshRefinementSummary::Summary() const {
   return text;
 }
 
+namespace {
+
+// The patch's colour spread over the views that see a vertex, with the vertex moved by t along
+// its normal: the mean squared distance of each view's samples to their mean, over the samples
+// every view has. False when a view's patch centre leaves its photo (or the object's mask), or
+// no sample is shared by two views.
+bool OffsetCost(const std::vector<CalibratedView>& views,
+                const std::vector<VertexSighting>& seen,
+                const std::vector<Projected>& projected,
+                double t,
+                std::vector<Eigen::Vector3f>* patch_buffer,
+                double* cost_out,
+                int* terms_out) {
+  std::vector<Eigen::Vector3f>& patch = *patch_buffer;
+  const int num_seen = static_cast<int>(seen.size());
+  // Sample the patch in every view that sees the vertex; a view whose patch leaves its
+  // photo's data (or the object's mask) says the offset is wrong.
+  int views_used = 0;
+  bool outside = false;
+  Eigen::Matrix<float, 3, kPatchSamples> mean = Eigen::Matrix<float, 3, kPatchSamples>::Zero();
+  for (int v = 0; v < num_seen; ++v) {
+    const CalibratedView& view = views[seen[v].view];
+    const Projected& at = projected[v];
+    const Eigen::Vector3d moved = at.centre + t * at.normal;
+    for (int k = 0; k < kPatchSamples && !outside; ++k) {
+      Eigen::Vector3f colour;
+      if (!SamplePhoto(view, (moved + at.around[k]).hnormalized(), &colour)) {
+        outside = k == 0;  // only the centre must stay on the object
+        colour = Eigen::Vector3f::Constant(-1.0f);
+      }
+      patch[views_used * kPatchSamples + k] = colour;
+    }
+    if (outside) break;
+    ++views_used;
+  }
+  if (outside) return false;
+  // Mean over the patch samples that every view has, then the spread about it.
+  double cost = 0.0;
+  int terms = 0;
+  for (int k = 0; k < kPatchSamples; ++k) {
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    int count = 0;
+    bool complete = true;
+    for (int v = 0; v < views_used; ++v) {
+      const Eigen::Vector3f& c = patch[v * kPatchSamples + k];
+      if (c.x() < 0.0f) {
+        complete = false;
+        break;
+      }
+      sum += c;
+      ++count;
+    }
+    if (!complete || count < 2) continue;
+    mean.col(k) = sum / count;
+    for (int v = 0; v < views_used; ++v) {
+      cost += (patch[v * kPatchSamples + k] - mean.col(k)).squaredNorm();
+      ++terms;
+    }
+  }
+  if (terms == 0) return false;
+  cost /= terms;
+  *cost_out = cost;
+  *terms_out = terms;
+  return true;
+}
+
+// What one refinement pass decides for a vertex.
+struct VertexMove {
+  bool judged = false;  // seen by enough photos to be judged
+  bool moved = false;
+  float offset = 0.0f;  // along the normal, world units
+  float pinned = 0.0f;  // how firmly the photos place it (PinnedShare)
+};
+
+// Tries the vertex at `centre` (unit `normal`) at every offset of the search range in the photos
+// of `seen` (the best-facing options.max_views of them) and keeps the offset whose patch the
+// photos agree on best, when it beats staying by options.min_gain. `patch` and `projected` are
+// buffers of the calling thread.
+VertexMove JudgeVertex(const std::vector<CalibratedView>& views,
+                       const MeshRefinementOptions& options,
+                       std::vector<VertexSighting> seen,
+                       bool on_rim,
+                       const Eigen::Vector3d& centre,
+                       const Eigen::Vector3d& normal,
+                       std::vector<Eigen::Vector3f>* patch_buffer,
+                       std::vector<Projected>* projected_buffer) {
+  std::vector<Eigen::Vector3f>& patch = *patch_buffer;
+  std::vector<Projected>& projected = *projected_buffer;
+  const int steps = 2 * options.steps_per_side + 1;
+  const double step = options.search_range / options.steps_per_side;
+  VertexMove result;
+  if (static_cast<int>(seen.size()) < options.min_views) return result;
+  // The best-facing photos judge: grazing views add blur and misregistration, and time.
+  if (static_cast<int>(seen.size()) > options.max_views) {
+    std::partial_sort(seen.begin(), seen.begin() + options.max_views, seen.end(),
+                      [](const VertexSighting& a, const VertexSighting& b) {
+                        return a.facing > b.facing;
+                      });
+    seen.resize(options.max_views);
+  }
+  result.judged = true;
+  Eigen::Vector3d u, w;
+  TangentBasis(normal, &u, &w);
+  const Eigen::Vector3d around[kPatchSamples] = {
+      Eigen::Vector3d::Zero(), options.patch_radius * u, -options.patch_radius * u,
+      options.patch_radius * w, -options.patch_radius * w};
+  // Projection is linear in homogeneous coordinates: per view, the centre's image and those
+  // of a step along the normal and of the patch's offsets, so that each sample costs a
+  // division rather than a matrix product.
+  const int num_seen = static_cast<int>(seen.size());
+  for (int v = 0; v < num_seen; ++v) {
+    const Eigen::Matrix<double, 3, 4>& P = views[seen[v].view].P;
+    const Eigen::Matrix3d M = P.leftCols<3>();
+    Projected& at = projected[v];
+    at.centre = M * centre + P.col(3);
+    at.normal = M * normal;
+    for (int k = 0; k < kPatchSamples; ++k) at.around[k] = M * around[k];
+  }
+  double best_cost = std::numeric_limits<double>::infinity(), stay_cost = best_cost;
+  double cost_sum = 0.0;
+  int costs = 0, best_terms = 0;
+  int best = options.steps_per_side;
+  // A silhouette's rim holds the surface where the mask says: no moving inwards there.
+  const int first_step = on_rim ? options.steps_per_side : 0;
+  for (int s = first_step; s < steps; ++s) {
+    const double t = (s - options.steps_per_side) * step;
+    double cost = 0.0;
+    int terms = 0;
+    if (!OffsetCost(views, seen, projected, t, &patch, &cost, &terms)) continue;
+    if (s == options.steps_per_side) stay_cost = cost;
+    cost_sum += cost;
+    ++costs;
+    if (cost < best_cost) {
+      best_terms = terms;
+      best_cost = cost;
+      best = s;
+    }
+  }
+  result.pinned = PinnedShare(cost_sum, costs, best_cost, best_terms);
+  if (best != options.steps_per_side && std::isfinite(stay_cost) &&
+      best_cost < options.min_gain * stay_cost) {
+    result.offset = static_cast<float>((best - options.steps_per_side) * step);
+    result.moved = true;
+  } else if (!std::isfinite(stay_cost) && std::isfinite(best_cost)) {
+    // Staying puts the vertex off the object in a photo that sees it: take the best.
+    result.offset = static_cast<float>((best - options.steps_per_side) * step);
+    result.moved = true;
+  }
+  return result;
+}
+
+}  // namespace
+
 MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& views,
                                            const MeshRefinementOptions& options,
                                            TriangleMesh* mesh) {
@@ -93,8 +246,6 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
   summary.vertices = static_cast<int64_t>(n);
   if (mesh->normals.size() != n) ComputeVertexNormals(mesh);
   const std::vector<std::vector<int>> neighbours = VertexNeighbours(*mesh);
-  const int steps = 2 * options.steps_per_side + 1;
-  const double step = options.search_range / options.steps_per_side;
   double offset_sum = 0.0, abs_offset_sum = 0.0;
   const std::vector<cv::Mat> mask_distances = MaskDistances(views, options.num_threads);
   for (int pass = 0; pass < options.passes; ++pass) {
@@ -108,112 +259,15 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
     const int threads = options.num_threads > 0 ? options.num_threads : ResolveNumThreads(-1);
     ParallelRanges(n, threads, /*min_per_thread=*/1024, [&](size_t begin, size_t end) {
     std::vector<Eigen::Vector3f> patch(static_cast<size_t>(kPatchSamples) * views.size());
-    std::vector<VertexSighting> seen;
     std::vector<Projected> projected(views.size());
     for (size_t i = begin; i < end; ++i) {
-      seen = sightings[i];
-      if (static_cast<int>(seen.size()) < options.min_views) continue;
-      // The best-facing photos judge: grazing views add blur and misregistration, and time.
-      if (static_cast<int>(seen.size()) > options.max_views) {
-        std::partial_sort(seen.begin(), seen.begin() + options.max_views, seen.end(),
-                          [](const VertexSighting& a, const VertexSighting& b) {
-                            return a.facing > b.facing;
-                          });
-        seen.resize(options.max_views);
-      }
-      judged[i] = 1;
-      const Eigen::Vector3d centre = mesh->vertices[i].cast<double>();
-      const Eigen::Vector3d normal = mesh->normals[i].cast<double>();
-      Eigen::Vector3d u, w;
-      TangentBasis(normal, &u, &w);
-      const Eigen::Vector3d around[kPatchSamples] = {
-          Eigen::Vector3d::Zero(), options.patch_radius * u, -options.patch_radius * u,
-          options.patch_radius * w, -options.patch_radius * w};
-      // Projection is linear in homogeneous coordinates: per view, the centre's image and those
-      // of a step along the normal and of the patch's offsets, so that each sample costs a
-      // division rather than a matrix product.
-      const int num_seen = static_cast<int>(seen.size());
-      for (int v = 0; v < num_seen; ++v) {
-        const Eigen::Matrix<double, 3, 4>& P = views[seen[v].view].P;
-        const Eigen::Matrix3d M = P.leftCols<3>();
-        Projected& at = projected[v];
-        at.centre = M * centre + P.col(3);
-        at.normal = M * normal;
-        for (int k = 0; k < kPatchSamples; ++k) at.around[k] = M * around[k];
-      }
-      double best_cost = std::numeric_limits<double>::infinity(), stay_cost = best_cost;
-      double cost_sum = 0.0;
-      int costs = 0, best_terms = 0;
-      int best = options.steps_per_side;
-      // A silhouette's rim holds the surface where the mask says: no moving inwards there.
-      const int first_step = on_rim[i] ? options.steps_per_side : 0;
-      for (int s = first_step; s < steps; ++s) {
-        const double t = (s - options.steps_per_side) * step;
-        // Sample the patch in every view that sees the vertex; a view whose patch leaves its
-        // photo's data (or the object's mask) says the offset is wrong.
-        int views_used = 0;
-        bool outside = false;
-        Eigen::Matrix<float, 3, kPatchSamples> mean = Eigen::Matrix<float, 3, kPatchSamples>::Zero();
-        for (int v = 0; v < num_seen; ++v) {
-          const CalibratedView& view = views[seen[v].view];
-          const Projected& at = projected[v];
-          const Eigen::Vector3d moved = at.centre + t * at.normal;
-          for (int k = 0; k < kPatchSamples && !outside; ++k) {
-            Eigen::Vector3f colour;
-            if (!SamplePhoto(view, (moved + at.around[k]).hnormalized(), &colour)) {
-              outside = k == 0;  // only the centre must stay on the object
-              colour = Eigen::Vector3f::Constant(-1.0f);
-            }
-            patch[views_used * kPatchSamples + k] = colour;
-          }
-          if (outside) break;
-          ++views_used;
-        }
-        if (outside) continue;
-        // Mean over the patch samples that every view has, then the spread about it.
-        double cost = 0.0;
-        int terms = 0;
-        for (int k = 0; k < kPatchSamples; ++k) {
-          Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-          int count = 0;
-          bool complete = true;
-          for (int v = 0; v < views_used; ++v) {
-            const Eigen::Vector3f& c = patch[v * kPatchSamples + k];
-            if (c.x() < 0.0f) {
-              complete = false;
-              break;
-            }
-            sum += c;
-            ++count;
-          }
-          if (!complete || count < 2) continue;
-          mean.col(k) = sum / count;
-          for (int v = 0; v < views_used; ++v) {
-            cost += (patch[v * kPatchSamples + k] - mean.col(k)).squaredNorm();
-            ++terms;
-          }
-        }
-        if (terms == 0) continue;
-        cost /= terms;
-        if (s == options.steps_per_side) stay_cost = cost;
-        cost_sum += cost;
-        ++costs;
-        if (cost < best_cost) {
-          best_terms = terms;
-          best_cost = cost;
-          best = s;
-        }
-      }
-      summary.pinned[i] = PinnedShare(cost_sum, costs, best_cost, best_terms);
-      if (best != options.steps_per_side && std::isfinite(stay_cost) &&
-          best_cost < options.min_gain * stay_cost) {
-        offsets[i] = static_cast<float>((best - options.steps_per_side) * step);
-        moved[i] = 1;
-      } else if (!std::isfinite(stay_cost) && std::isfinite(best_cost)) {
-        // Staying puts the vertex off the object in a photo that sees it: take the best.
-        offsets[i] = static_cast<float>((best - options.steps_per_side) * step);
-        moved[i] = 1;
-      }
+      const VertexMove move = JudgeVertex(views, options, sightings[i], on_rim[i] != 0,
+                                          mesh->vertices[i].cast<double>(),
+                                          mesh->normals[i].cast<double>(), &patch, &projected);
+      judged[i] = move.judged;
+      moved[i] = move.moved;
+      offsets[i] = move.offset;
+      if (move.judged) summary.pinned[i] = move.pinned;
     }
     });
     summary.judged = std::count(judged.begin(), judged.end(), 1);

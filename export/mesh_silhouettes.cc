@@ -210,6 +210,63 @@ std::string SilhouetteFitSummary::Summary() const {
   return text;
 }
 
+namespace {
+
+// One view's say on one outline vertex: the move along its normal (<= 0) and how far beyond
+// the mask's edge it lies (pixels, 0 on the object).
+struct Vote {
+  uint32_t vertex;
+  float move;
+  float outside;
+};
+
+// One masked view's votes: each vertex on the mesh's outline in the view (visible, next to a
+// pixel the mesh does not cover), moved along its normal to the mask's edge (at most max_move,
+// inwards only); `distance` is the view's signed distance to its mask's edge.
+std::vector<Vote> OutlineVotes(const CalibratedView& view,
+                               const cv::Mat& distance,
+                               const SilhouetteFitOptions& options,
+                               const TriangleMesh& mesh) {
+  std::vector<Vote> votes;
+  const size_t n = mesh.vertices.size();
+  const cv::Mat depths = RenderMeshDepth(mesh, view, /*front_faces_only=*/true);
+  const Eigen::Matrix3d M = view.P.leftCols<3>();
+  const cv::Mat exterior = ExteriorPixels(depths);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d h = view.P * mesh.vertices[i].cast<double>().homogeneous();
+    if (!(h.z() > 0.0)) continue;
+    const double x = h.x() / h.z(), y = h.y() / h.z();
+    const int col = static_cast<int>(std::floor(x)), row = static_cast<int>(std::floor(y));
+    if (col < 1 || row < 1 || col >= view.width - 1 || row >= view.height - 1) continue;
+    const float own = depths.at<float>(row, col);
+    if (std::isfinite(own) && h.z() > own + options.depth_tolerance) continue;  // hidden
+    bool outline = false;
+    for (int dr = -1; dr <= 1 && !outline; ++dr) {
+      for (int dc = -1; dc <= 1 && !outline; ++dc) {
+        outline = exterior.at<uint8_t>(row + dr, col + dc) != 0;
+      }
+    }
+    if (!outline) continue;
+    // The projection's velocity (pixels per world unit along the normal) and the rate at
+    // which it changes the signed distance; the normal must carry the projection across
+    // the edge outwards, not along it.
+    const Eigen::Vector3d dh = M * mesh.normals[i].cast<double>();
+    const double z2 = h.z() * h.z();
+    const Eigen::Vector2d velocity((dh.x() * h.z() - h.x() * dh.z()) / z2,
+                                   (dh.y() * h.z() - h.y() * dh.z()) / z2);
+    const float d = SampleField(distance, x, y);
+    const double gx = 0.5 * (SampleField(distance, x + 1.0, y) - SampleField(distance, x - 1.0, y));
+    const double gy = 0.5 * (SampleField(distance, x, y + 1.0) - SampleField(distance, x, y - 1.0));
+    const double rate = gx * velocity.x() + gy * velocity.y();
+    if (!(rate > 0.5 * velocity.norm() * std::hypot(gx, gy))) continue;
+    const double move = std::clamp(-d / rate, -options.max_move, 0.0);
+    votes.push_back({static_cast<uint32_t>(i), static_cast<float>(move), std::max(d, 0.0f)});
+  }
+  return votes;
+}
+
+}  // namespace
+
 SilhouetteFitSummary FitMeshToSilhouettes(const std::vector<CalibratedView>& views,
                                           const SilhouetteFitOptions& options, TriangleMesh* mesh) {
   std::string reason;
@@ -227,54 +284,13 @@ SilhouetteFitSummary FitMeshToSilhouettes(const std::vector<CalibratedView>& vie
   ParallelRanges(masked.size(), threads, /*min_per_thread=*/1, [&](size_t first, size_t last) {
     for (size_t m = first; m < last; ++m) distances[m] = SignedMaskDistance(views[masked[m]].mask);
   });
-  // One view's say on one outline vertex: the move along its normal (<= 0) and how far beyond
-  // the mask's edge it lies (pixels, 0 on the object).
-  struct Vote {
-    uint32_t vertex;
-    float move;
-    float outside;
-  };
   double move_sum = 0.0;
   int64_t moves_made = 0;
   for (int pass = 0; pass < options.passes; ++pass) {
     std::vector<std::vector<Vote>> votes(masked.size());
     ParallelRanges(masked.size(), threads, /*min_per_thread=*/1, [&](size_t first, size_t last) {
       for (size_t m = first; m < last; ++m) {
-        const CalibratedView& view = views[masked[m]];
-        const cv::Mat depths = RenderMeshDepth(*mesh, view, /*front_faces_only=*/true);
-        const cv::Mat& distance = distances[m];
-        const Eigen::Matrix3d M = view.P.leftCols<3>();
-        const cv::Mat exterior = ExteriorPixels(depths);
-        for (size_t i = 0; i < n; ++i) {
-          const Eigen::Vector3d h = view.P * mesh->vertices[i].cast<double>().homogeneous();
-          if (!(h.z() > 0.0)) continue;
-          const double x = h.x() / h.z(), y = h.y() / h.z();
-          const int col = static_cast<int>(std::floor(x)), row = static_cast<int>(std::floor(y));
-          if (col < 1 || row < 1 || col >= view.width - 1 || row >= view.height - 1) continue;
-          const float own = depths.at<float>(row, col);
-          if (std::isfinite(own) && h.z() > own + options.depth_tolerance) continue;  // hidden
-          bool outline = false;
-          for (int dr = -1; dr <= 1 && !outline; ++dr) {
-            for (int dc = -1; dc <= 1 && !outline; ++dc) {
-              outline = exterior.at<uint8_t>(row + dr, col + dc) != 0;
-            }
-          }
-          if (!outline) continue;
-          // The projection's velocity (pixels per world unit along the normal) and the rate at
-          // which it changes the signed distance; the normal must carry the projection across
-          // the edge outwards, not along it.
-          const Eigen::Vector3d dh = M * mesh->normals[i].cast<double>();
-          const double z2 = h.z() * h.z();
-          const Eigen::Vector2d velocity((dh.x() * h.z() - h.x() * dh.z()) / z2,
-                                         (dh.y() * h.z() - h.y() * dh.z()) / z2);
-          const float d = SampleField(distance, x, y);
-          const double gx = 0.5 * (SampleField(distance, x + 1.0, y) - SampleField(distance, x - 1.0, y));
-          const double gy = 0.5 * (SampleField(distance, x, y + 1.0) - SampleField(distance, x, y - 1.0));
-          const double rate = gx * velocity.x() + gy * velocity.y();
-          if (!(rate > 0.5 * velocity.norm() * std::hypot(gx, gy))) continue;
-          const double move = std::clamp(-d / rate, -options.max_move, 0.0);
-          votes[m].push_back({static_cast<uint32_t>(i), static_cast<float>(move), std::max(d, 0.0f)});
-        }
+        votes[m] = OutlineVotes(views[masked[m]], distances[m], options, *mesh);
       }
     });
     std::vector<std::vector<float>> moves(n);

@@ -1,3 +1,4 @@
+// raycarve model_info: a model's cameras, images, points and the volume it would carve.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,9 +10,7 @@
 #include <glog/logging.h>
 
 #include "calib/input_error.h"
-#include "calib/middlebury.h"
 #include "calib/model_reader.h"
-#include "calib/model_writer.h"
 #include "pipeline/project.h"
 #include "plugin/carve_flags.h"
 #include "plugin/commands.h"
@@ -172,48 +171,6 @@ int RunModelInfo(int argc, char** argv) {
     CheckOutputFileOutside(output_path, input_path, "input model");
     WriteTextFileAtomically(output_path, json);
   }
-  return 0;
-}
-
-int RunModelConverter(int argc, char** argv) {
-  std::string input_path, output_path, output_type = "BIN";
-  OptionParser parser("model_converter",
-                      "Reads a COLMAP model (binary or text) and writes it in the other form, "
-                      "as `colmap model_converter` does.");
-  parser.AddRequired("input_path", &input_path, "COLMAP model folder to read");
-  parser.AddRequired("output_path", &output_path, "folder to write (created; must differ from input)");
-  parser.AddDefault("output_type", &output_type, "format to write", {"BIN", "TXT"});
-  if (!parser.Parse(argc, argv)) return 0;
-  CheckOutputDoesNotOverwrite(output_path, input_path, "input model");
-  const Reconstruction reconstruction = ReadModel(input_path);
-  WriteModel(reconstruction, output_path, ModelFormatFromString(output_type));
-  LOG(INFO) << "wrote " << reconstruction.cameras.size() << " cameras, "
-            << reconstruction.images.size() << " images, " << reconstruction.points3D.size()
-            << " points to " << output_path << " (" << output_type << ")";
-  return 0;
-}
-
-int RunImportMiddlebury(int argc, char** argv) {
-  std::string input_path, image_path, output_path, output_type = "TXT";
-  MiddleburyImportOptions options;
-  OptionParser parser("import_middlebury",
-                      "Converts a Middlebury multi-view calibration file (*_par.txt) into a "
-                      "COLMAP model (PINHOLE cameras, no 3D points).");
-  parser.AddRequired("input_path", &input_path, "the *_par.txt calibration file");
-  parser.AddRequired("image_path", &image_path, "folder of the photos (their sizes are read)");
-  parser.AddRequired("output_path", &output_path, "model folder to write (created)");
-  parser.AddDefault("output_type", &output_type, "format to write", {"BIN", "TXT"});
-  parser.AddDefault("principal_point_offset", &options.principal_point_offset,
-                    "added to (k13, k23): 0.5 reads K with pixel centres at integers, 0 copies it");
-  if (!parser.Parse(argc, argv)) return 0;
-  std::string reason;
-  if (!options.IsValid(&reason)) throw InputError("--principal_point_offset: " + reason);
-  CheckOutputDoesNotOverwrite(output_path, image_path, "photo folder");
-  const Reconstruction reconstruction = ImportMiddlebury(input_path, image_path, options);
-  WriteModel(reconstruction, output_path, ModelFormatFromString(output_type));
-  LOG(INFO) << "imported " << reconstruction.images.size() << " images ("
-            << reconstruction.cameras.size() << " cameras) from " << input_path << " into "
-            << output_path;
   return 0;
 }
 

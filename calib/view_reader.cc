@@ -110,6 +110,84 @@ struct LoadedView {
   std::exception_ptr error;
 };
 
+// The mask file of `image` in options.mask_path (COLMAP's "<name>.png", else the photo's own name),
+// read and, when the photo was reduced, reduced with it; *mask_file its path.
+cv::Mat ReadMaskFile(const Image& image, image_t image_id, const ViewReaderOptions& options,
+                     const Camera& full_camera, const Eigen::Vector2i& size, bool reduced,
+                     std::string* mask_file) {
+  const std::filesystem::path folder(options.mask_path);
+  const std::string colmap_style = (folder / (image.name + ".png")).string();
+  const std::string same_name = (folder / image.name).string();
+  *mask_file = WhyNotAFile(colmap_style) != "not found" ? colmap_style : same_name;
+  const std::string why_mask = WhyNotAFile(*mask_file);
+  if (why_mask == "not found") {
+    throw InputError(colmap_style + ": mask of image " + std::to_string(image_id) +
+                     " not found (nor " + same_name + ")");
+  }
+  if (!why_mask.empty()) {
+    throw InputError(*mask_file + ": mask of image " + std::to_string(image_id) + " " + why_mask);
+  }
+  cv::Mat mask = ReadImage(*mask_file, cv::IMREAD_GRAYSCALE);
+  if (mask.empty()) throw InputError(*mask_file + ": mask cannot be decoded as an image");
+  if (reduced && mask.cols == static_cast<int>(full_camera.width) &&
+      mask.rows == static_cast<int>(full_camera.height)) {
+    cv::resize(mask, mask, cv::Size(size.x(), size.y()), 0, 0, cv::INTER_NEAREST);
+  }
+  return mask;
+}
+
+// The automatic mask from the photo's backdrop (options.background.mode kAuto): none where the
+// border is no plain backdrop, nor where the mask would hold no object. Fills `info`.
+cv::Mat BackdropMask(const Reconstruction& reconstruction, const Image& image, const Camera& camera,
+                     const cv::Mat& rgb, const Eigen::Vector2d& pixel_scale,
+                     const ViewReaderOptions& options, const std::string& path,
+                     PhotoMaskInfo* info) {
+  cv::Mat mask;
+  const std::vector<Eigen::Vector2d> seeds =
+      SeedPixels(reconstruction, image, options.volume, pixel_scale);
+  info->backdrop = EstimateBackdropModel(
+      rgb, options.background.tolerance,
+      ProjectedPointPixels(reconstruction, camera, image, options.volume));
+  if (!info->backdrop.found) {
+    LOG(WARNING) << path << ": " << info->backdrop.Summary() << "; no backdrop mask";
+  } else {
+    mask = ObjectMaskFromModel(rgb, info->backdrop, options.background.tolerance,
+                               options.background.refine, seeds,
+                               VolumeOutline(camera, image, options.volume), &info->mask);
+    info->source = "backdrop";
+  }
+  if (!mask.empty() && cv::countNonZero(mask) == 0) {
+    // A photo of the object is never all backdrop: a mask that says so found no object in
+    // its colours (a grey photo, a backdrop that matches it), and would carve the model away
+    // in every photo through the visual hull. The photo is carved without a mask.
+    LOG(WARNING) << path << ": the backdrop mask holds no object; the photo is used without a mask";
+    mask.release();
+    info->source = "none";
+  } else if (info->source == "backdrop") {
+    VLOG(1) << path << ": backdrop " << info->backdrop.Summary() << ", object "
+            << std::lround(100.0 * info->mask.object_share) << "% of the photo, "
+            << info->mask.seeds << " sparse points as seeds";
+  }
+  return mask;
+}
+
+// Refuses a view whose camera's distortion folds the image: almost no pixel of the undistorted
+// photo has a source, nothing to carve with.
+void CheckViewHoldsPixels(const CalibratedView& view, const Camera& camera, const std::string& path) {
+  const double valid_share =
+      static_cast<double>(cv::countNonZero(view.valid)) / view.valid.total();
+  if (valid_share < kMinValidShare) {
+    std::ostringstream text;
+    text << path << ": camera " << camera.camera_id << " (" << CameraModelName(camera.model)
+         << ", params";
+    for (double param : camera.params) text << " " << param;
+    text << ") leaves " << 100.0 * valid_share
+         << "% of the undistorted photo with a source pixel: its distortion folds the image; "
+            "check the camera's parameters";
+    throw InputError(text.str());
+  }
+}
+
 LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, const Image& image,
                     const std::string& image_path, const ViewReaderOptions& options) {
   LoadedView loaded;
@@ -157,74 +235,19 @@ LoadedView LoadView(const Reconstruction& reconstruction, image_t image_id, cons
     loaded.downscaled = true;
   }
   if (!options.mask_path.empty()) {
-    const std::filesystem::path folder(options.mask_path);
-    const std::string colmap_style = (folder / (image.name + ".png")).string();
-    const std::string same_name = (folder / image.name).string();
-    mask_file = WhyNotAFile(colmap_style) != "not found" ? colmap_style : same_name;
-    const std::string why_mask = WhyNotAFile(mask_file);
-    if (why_mask == "not found") {
-      throw InputError(colmap_style + ": mask of image " + std::to_string(image_id) +
-                       " not found (nor " + same_name + ")");
-    }
-    if (!why_mask.empty()) {
-      throw InputError(mask_file + ": mask of image " + std::to_string(image_id) + " " + why_mask);
-    }
-    mask = ReadImage(mask_file, cv::IMREAD_GRAYSCALE);
-    if (mask.empty()) throw InputError(mask_file + ": mask cannot be decoded as an image");
-    if (reduced && mask.cols == static_cast<int>(full_camera.width) &&
-        mask.rows == static_cast<int>(full_camera.height)) {
-      cv::resize(mask, mask, cv::Size(size.x(), size.y()), 0, 0, cv::INTER_NEAREST);
-    }
+    mask = ReadMaskFile(image, image_id, options, full_camera, size, reduced, &mask_file);
     info.source = "file";
   } else if (options.background.mode == BackgroundOptions::Mode::kColour) {
     mask = ObjectMaskFromBackdrop(rgb, options.background.colour, options.background.tolerance);
     mask_file = path + " (backdrop mask)";
     info.source = "colour";
   } else if (options.background.mode == BackgroundOptions::Mode::kAuto) {
-    const std::vector<Eigen::Vector2d> seeds =
-        SeedPixels(reconstruction, image, options.volume, pixel_scale);
-    info.backdrop = EstimateBackdropModel(
-        rgb, options.background.tolerance,
-        ProjectedPointPixels(reconstruction, camera, image, options.volume));
-    if (!info.backdrop.found) {
-      LOG(WARNING) << path << ": " << info.backdrop.Summary() << "; no backdrop mask";
-    } else {
-      mask = ObjectMaskFromModel(rgb, info.backdrop, options.background.tolerance,
-                                 options.background.refine, seeds,
-                                 VolumeOutline(camera, image, options.volume), &info.mask);
-      mask_file = path + " (backdrop mask)";
-      info.source = "backdrop";
-    }
-    if (!mask.empty() && cv::countNonZero(mask) == 0) {
-      // A photo of the object is never all backdrop: a mask that says so found no object in
-      // its colours (a grey photo, a backdrop that matches it), and would carve the model away
-      // in every photo through the visual hull. The photo is carved without a mask.
-      LOG(WARNING) << path << ": the backdrop mask holds no object; the photo is used without a mask";
-      mask.release();
-      mask_file.clear();
-      info.source = "none";
-    } else if (info.source == "backdrop") {
-      VLOG(1) << path << ": backdrop " << info.backdrop.Summary() << ", object "
-              << std::lround(100.0 * info.mask.object_share) << "% of the photo, "
-              << info.mask.seeds << " sparse points as seeds";
-    }
+    mask = BackdropMask(reconstruction, image, camera, rgb, pixel_scale, options, path, &info);
+    if (!mask.empty()) mask_file = path + " (backdrop mask)";
   }
   if (!mask.empty()) info.object_share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
   loaded.view = MakeCalibratedView(camera, image, rgb, path, mask, mask_file);
-  // Distortion that folds the image (a coefficient of the wrong sign or size) leaves almost no
-  // pixel of the undistorted photo with a source: nothing to carve with.
-  const double valid_share =
-      static_cast<double>(cv::countNonZero(loaded.view.valid)) / loaded.view.valid.total();
-  if (valid_share < kMinValidShare) {
-    std::ostringstream text;
-    text << path << ": camera " << camera.camera_id << " (" << CameraModelName(camera.model)
-         << ", params";
-    for (double param : camera.params) text << " " << param;
-    text << ") leaves " << 100.0 * valid_share
-         << "% of the undistorted photo with a source pixel: its distortion folds the image; "
-            "check the camera's parameters";
-    throw InputError(text.str());
-  }
+  CheckViewHoldsPixels(loaded.view, camera, path);
   VLOG(1) << path << ": view built";
   return loaded;
 }

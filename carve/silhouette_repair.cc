@@ -98,6 +98,64 @@ std::string SilhouetteRepairSummary::Summary() const {
   return out.str();
 }
 
+namespace {
+
+// The median depth of the model's surface around pixel (row, col) in `depth` (0: no surface), in
+// a window that doubles from `first_radius` until it holds kMinNeighbours pixels; -1 when none
+// within kMaxWindowPixels. `around` is a buffer.
+float DepthAround(const cv::Mat& depth,
+                  int row,
+                  int col,
+                  int first_radius,
+                  std::vector<float>* around_buffer) {
+  std::vector<float>& around = *around_buffer;
+  float target = -1.0f;
+  for (int radius = first_radius; target < 0.0f; radius *= 2) {
+    around.clear();
+    for (int r = std::max(0, row - radius); r <= std::min(depth.rows - 1, row + radius); ++r) {
+      const float* line = depth.ptr<float>(r);
+      for (int c = std::max(0, col - radius); c <= std::min(depth.cols - 1, col + radius); ++c) {
+        if (line[c] > 0.0f) around.push_back(line[c]);
+      }
+    }
+    if (static_cast<int>(around.size()) >= kMinNeighbours) target = Median(&around);
+    if (radius >= kMaxWindowPixels) break;
+  }
+  return target;
+}
+
+// Along pixel p's ray through the grid's box, the voxel of the visual hull nearest the depth
+// `target` (the nearest hull voxel when target < 0); -1 when the ray meets no hull voxel.
+int64_t HullVoxelNear(const CalibratedView& view, const RayImage& rays, int p, const VoxelGrid& grid,
+                      const Volume& hull, float target) {
+  const Eigen::AlignedBox3d box = grid.Box();
+  const Eigen::Vector3d direction = rays.Direction(p);
+  double t_near = 0.0, t_far = 0.0;
+  if (!ClipRayToBox(view.centre, direction, box, &t_near, &t_far)) t_far = -1.0;
+  const double step = 0.25 * grid.voxel_size() / direction.norm();
+  int64_t best = -1;
+  double best_gap = std::numeric_limits<double>::infinity();
+  for (double t = t_near + 0.5 * step; t < t_far; t += step) {
+    const Eigen::Vector3d point = view.centre + t * direction;
+    const Eigen::Vector3i cell = grid.VoxelOf(point);
+    if (!grid.Contains(cell)) continue;
+    const int64_t index = grid.Index(cell);
+    if (!hull.IsSolid(index)) continue;
+    if (target < 0.0f) {
+      best = index;  // no surface around: the hull's nearest voxel
+      break;
+    }
+    const double gap = std::abs(view.Depth(point) - target);
+    if (gap < best_gap) {
+      best_gap = gap;
+      best = index;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
 SilhouetteRepairSummary RepairSilhouettes(const std::vector<CalibratedView>& views,
                                           Volume* volume,
                                           int num_threads) {
@@ -145,42 +203,10 @@ SilhouetteRepairSummary RepairSilhouettes(const std::vector<CalibratedView>& vie
     for (int p : lost) {
       const int row = p / view.width, col = p % view.width;
       // The depth the surface around the hole has.
-      float target = -1.0f;
-      for (int radius = first_radius; target < 0.0f; radius *= 2) {
-        around.clear();
-        for (int r = std::max(0, row - radius); r <= std::min(view.height - 1, row + radius); ++r) {
-          const float* line = depth.ptr<float>(r);
-          for (int c = std::max(0, col - radius); c <= std::min(view.width - 1, col + radius); ++c) {
-            if (line[c] > 0.0f) around.push_back(line[c]);
-          }
-        }
-        if (static_cast<int>(around.size()) >= kMinNeighbours) target = Median(&around);
-        if (radius >= kMaxWindowPixels) break;
-      }
-      // Along the ray through the grid's box, the hull voxel nearest that depth (the nearest
-      // hull voxel when there is none).
-      const Eigen::Vector3d direction = rays->Direction(p);
-      double t_near = 0.0, t_far = 0.0;
-      if (!ClipRayToBox(view.centre, direction, box, &t_near, &t_far)) t_far = -1.0;
-      const double step = 0.25 * grid.voxel_size() / direction.norm();
-      int64_t best = -1;
-      double best_gap = std::numeric_limits<double>::infinity();
-      for (double t = t_near + 0.5 * step; t < t_far; t += step) {
-        const Eigen::Vector3d point = view.centre + t * direction;
-        const Eigen::Vector3i cell = grid.VoxelOf(point);
-        if (!grid.Contains(cell)) continue;
-        const int64_t index = grid.Index(cell);
-        if (!hull.IsSolid(index)) continue;
-        if (target < 0.0f) {
-          best = index;  // no surface around: the hull's nearest voxel
-          break;
-        }
-        const double gap = std::abs(view.Depth(point) - target);
-        if (gap < best_gap) {
-          best_gap = gap;
-          best = index;
-        }
-      }
+      const float target = DepthAround(depth, row, col, first_radius, &around);
+      // Along the ray, the hull voxel nearest that depth (the nearest hull voxel when there is
+      // none).
+      const int64_t best = HullVoxelNear(view, *rays, p, grid, hull, target);
       if (best < 0) {
         ++summary.outside_hull_pixels;  // the masks disagree here: nothing was carved from it
         continue;

@@ -133,19 +133,17 @@ std::string SurfaceMeshSummary::Summary() const {
   return text;
 }
 
-TriangleMesh MeshSolidVoxels(const Volume& volume,
-                             const SurfaceMeshOptions& options,
-                             SurfaceMeshSummary* summary) {
-  const auto start = std::chrono::steady_clock::now();
-  SurfaceMeshSummary local;
-  SurfaceMeshSummary& result = summary != nullptr ? *summary : local;
-  result = SurfaceMeshSummary();
+namespace {
+
+// The volume's solid voxels as a VTK image of 0/1, with one voxel of empty space all round so
+// that the surface closes at the grid's border; *solid counts them.
+vtkSmartPointer<vtkImageData> OccupancyImage(const Volume& volume, int64_t* solid_count) {
   const VoxelGrid& grid = volume.grid();
   const Eigen::Vector3i dims = grid.dimensions();
   // One voxel of empty space all round, so that the surface closes at the grid's border.
   const Eigen::Vector3i padded = dims + Eigen::Vector3i::Constant(2);
   const double size = grid.voxel_size();
-  vtkNew<vtkImageData> image;
+  vtkSmartPointer<vtkImageData> image = vtkSmartPointer<vtkImageData>::New();
   image->SetDimensions(padded.x(), padded.y(), padded.z());
   image->SetSpacing(size, size, size);
   const Eigen::Vector3d first = grid.Centre(Eigen::Vector3i(-1, -1, -1));
@@ -153,7 +151,8 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
   image->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
   auto* occupancy = static_cast<unsigned char*>(image->GetScalarPointer());
   std::fill(occupancy, occupancy + static_cast<int64_t>(padded.x()) * padded.y() * padded.z(), 0);
-  int64_t solid = 0;
+  int64_t& solid = *solid_count;
+  solid = 0;
   for (int z = 0; z < dims.z(); ++z) {
     for (int y = 0; y < dims.y(); ++y) {
       for (int x = 0; x < dims.x(); ++x) {
@@ -164,6 +163,73 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
       }
     }
   }
+  return image;
+}
+
+// Splits the surface's edges longer than options.max_edge_length, only as far as
+// options.max_triangles allows: each split at least halves an edge, and triangles grow with
+// (mean edge / max edge)^2.
+vtkSmartPointer<vtkPolyData> SplitLongEdges(vtkSmartPointer<vtkPolyData> surface,
+                                            const SurfaceMeshOptions& options) {
+  // Each split at least halves an edge; estimate the triangles it would make from the mean
+  // edge length, and split only as far as the budget allows.
+  double edge_sum = 0.0;
+  int64_t edge_count = 0;
+  vtkCellArray* polys = surface->GetPolys();
+  vtkIdType count = 0;
+  const vtkIdType* ids = nullptr;
+  for (polys->InitTraversal(); polys->GetNextCell(count, ids);) {
+    for (vtkIdType k = 0; k < count; ++k) {
+      double a[3], b[3];
+      surface->GetPoint(ids[k], a);
+      surface->GetPoint(ids[(k + 1) % count], b);
+      edge_sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                            (a[2] - b[2]) * (a[2] - b[2]));
+      ++edge_count;
+    }
+  }
+  double edge = options.max_edge_length;
+  if (options.max_triangles > 0 && edge_count > 0) {
+    const double mean_edge = edge_sum / edge_count;
+    const double growth = static_cast<double>(options.max_triangles) /
+                          std::max<int64_t>(1, surface->GetNumberOfPolys());
+    // Triangles grow with (mean edge / max edge)^2.
+    edge = std::max(edge, mean_edge / std::sqrt(std::max(growth, 1.0)));
+  }
+  vtkNew<vtkAdaptiveSubdivisionFilter> splitter;
+  splitter->SetInputData(surface);
+  splitter->SetMaximumEdgeLength(edge);
+  splitter->Update();
+  surface = splitter->GetOutput();
+  return surface;
+}
+
+// Decimates the surface to options.max_triangles, keeping its topology and boundary.
+vtkSmartPointer<vtkPolyData> Decimate(vtkSmartPointer<vtkPolyData> surface,
+                                      const SurfaceMeshOptions& options) {
+  vtkNew<vtkDecimatePro> decimate;
+  decimate->SetInputData(surface);
+  decimate->SetTargetReduction(1.0 - static_cast<double>(options.max_triangles) /
+                                         surface->GetNumberOfPolys());
+  decimate->PreserveTopologyOn();
+  decimate->SplittingOff();
+  decimate->BoundaryVertexDeletionOff();
+  decimate->Update();
+  surface = decimate->GetOutput();
+  return surface;
+}
+
+}  // namespace
+
+TriangleMesh MeshSolidVoxels(const Volume& volume,
+                             const SurfaceMeshOptions& options,
+                             SurfaceMeshSummary* summary) {
+  const auto start = std::chrono::steady_clock::now();
+  SurfaceMeshSummary local;
+  SurfaceMeshSummary& result = summary != nullptr ? *summary : local;
+  result = SurfaceMeshSummary();
+  int64_t solid = 0;
+  const vtkSmartPointer<vtkImageData> image = OccupancyImage(volume, &solid);
   if (solid == 0) {
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return TriangleMesh();
@@ -183,49 +249,10 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
     surface = WindowedSinc(surface, options.smoothing_iterations, options.smoothing_pass_band);
   }
 
-  if (options.max_edge_length > 0.0) {
-    // Each split at least halves an edge; estimate the triangles it would make from the mean
-    // edge length, and split only as far as the budget allows.
-    double edge_sum = 0.0;
-    int64_t edge_count = 0;
-    vtkCellArray* polys = surface->GetPolys();
-    vtkIdType count = 0;
-    const vtkIdType* ids = nullptr;
-    for (polys->InitTraversal(); polys->GetNextCell(count, ids);) {
-      for (vtkIdType k = 0; k < count; ++k) {
-        double a[3], b[3];
-        surface->GetPoint(ids[k], a);
-        surface->GetPoint(ids[(k + 1) % count], b);
-        edge_sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                              (a[2] - b[2]) * (a[2] - b[2]));
-        ++edge_count;
-      }
-    }
-    double edge = options.max_edge_length;
-    if (options.max_triangles > 0 && edge_count > 0) {
-      const double mean_edge = edge_sum / edge_count;
-      const double growth = static_cast<double>(options.max_triangles) /
-                            std::max<int64_t>(1, surface->GetNumberOfPolys());
-      // Triangles grow with (mean edge / max edge)^2.
-      edge = std::max(edge, mean_edge / std::sqrt(std::max(growth, 1.0)));
-    }
-    vtkNew<vtkAdaptiveSubdivisionFilter> splitter;
-    splitter->SetInputData(surface);
-    splitter->SetMaximumEdgeLength(edge);
-    splitter->Update();
-    surface = splitter->GetOutput();
-  }
+  if (options.max_edge_length > 0.0) surface = SplitLongEdges(surface, options);
 
   if (options.max_triangles > 0 && surface->GetNumberOfPolys() > options.max_triangles) {
-    vtkNew<vtkDecimatePro> decimate;
-    decimate->SetInputData(surface);
-    decimate->SetTargetReduction(1.0 - static_cast<double>(options.max_triangles) /
-                                           surface->GetNumberOfPolys());
-    decimate->PreserveTopologyOn();
-    decimate->SplittingOff();
-    decimate->BoundaryVertexDeletionOff();
-    decimate->Update();
-    surface = decimate->GetOutput();
+    surface = Decimate(surface, options);
   }
 
   // Flying edges winds every triangle with the occupancy's gradient, facing away from the solid

@@ -34,23 +34,22 @@ bool FullyInside(const Eigen::Matrix<double, 3, 4>& P,
 
 }  // namespace
 
-VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
-                                     Volume* volume,
-                                     int num_threads,
-                                     int min_background_views) {
-  const auto start = std::chrono::steady_clock::now();
-  VisualHullStatistics statistics;
-  struct MaskedView {
-    const CalibratedView* view;
-    cv::Mat object_integral;
-    cv::Mat valid_integral;
-  };
+namespace {
+
+struct MaskedView {
+  const CalibratedView* view;
+  cv::Mat object_integral;
+  cv::Mat valid_integral;
+};
+
+// Per masked view, the integral images of its silhouette (grown by one pixel: a binary mask
+// drops pixels less than half covered, which would cut slivers of the object, thin parts and
+// corners, out of the hull) and of its valid pixels.
+std::vector<MaskedView> MaskedViewsOf(const std::vector<CalibratedView>& views) {
   std::vector<MaskedView> masked;
   for (const CalibratedView& view : views) {
     if (view.mask.empty()) continue;
     MaskedView m{&view, cv::Mat(), cv::Mat()};
-    // Silhouettes grown by one pixel: a binary mask drops pixels less than half covered, which
-    // would cut slivers of the object (thin parts, corners) out of the hull.
     cv::Mat object;
     cv::dilate(view.mask != 0, object, cv::Mat::ones(3, 3, CV_8U));
     object &= (view.valid != 0);
@@ -58,6 +57,77 @@ VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
     cv::integral(view.valid / 255, m.valid_integral, CV_32S);
     masked.push_back(std::move(m));
   }
+  return masked;
+}
+
+constexpr int kBlock = 4;
+
+// Judges the solid voxels of the 4x4x4 block `block` (of `blocks` along each axis): marks in
+// `outside` those that `min_background_views` views show entirely on background. `asked` and
+// `solid` are buffers of the calling thread.
+void JudgeBlock(const std::vector<MaskedView>& masked,
+                const Volume& volume,
+                const Eigen::Vector3i& blocks,
+                int64_t block,
+                int min_background_views,
+                std::vector<const MaskedView*>* asked_buffer,
+                std::vector<int64_t>* solid_buffer,
+                std::vector<uint8_t>* outside_out) {
+  const VoxelGrid& grid = volume.grid();
+  const Eigen::Vector3i& n = grid.dimensions();
+  std::vector<const MaskedView*>& asked = *asked_buffer;
+  std::vector<int64_t>& solid = *solid_buffer;
+  std::vector<uint8_t>& outside = *outside_out;
+  const Eigen::Vector3i first =
+      kBlock * Eigen::Vector3i(static_cast<int>(block % blocks.x()),
+                               static_cast<int>(block / blocks.x() % blocks.y()),
+                               static_cast<int>(block / blocks.x() / blocks.y()));
+  const Eigen::Vector3i last = (first.array() + kBlock).min(n.array()) - 1;
+  solid.clear();
+  for (int z = first.z(); z <= last.z(); ++z) {
+    for (int y = first.y(); y <= last.y(); ++y) {
+      for (int x = first.x(); x <= last.x(); ++x) {
+        const int64_t index = grid.Index(Eigen::Vector3i(x, y, z));
+        if (volume.IsSolid(index)) solid.push_back(index);
+      }
+    }
+  }
+  if (solid.empty()) return;
+  asked.clear();
+  for (const MaskedView& m : masked) {
+    Footprint wide = ComputeFootprint(m.view->P, 1 << 20, 1 << 20, grid, first, kBlock);
+    const bool all_object =
+        !wide.empty() && --wide.col_min >= 0 && --wide.row_min >= 0 &&
+        ++wide.col_max < m.view->width && ++wide.row_max < m.view->height &&
+        RectSum(m.object_integral, wide) == wide.area();
+    if (!all_object) asked.push_back(&m);
+  }
+  for (int64_t index : solid) {
+    const Eigen::Vector3i voxel = grid.Voxel(index);
+    int background = 0;
+    for (const MaskedView* m : asked) {
+      Footprint footprint;
+      if (!FullyInside(m->view->P, m->view->width, m->view->height, grid, voxel, &footprint)) {
+        continue;
+      }
+      if (RectSum(m->valid_integral, footprint) == 0) continue;  // no photo data there
+      if (RectSum(m->object_integral, footprint) == 0 && ++background >= min_background_views) {
+        outside[index] = 1;
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
+                                     Volume* volume,
+                                     int num_threads,
+                                     int min_background_views) {
+  const auto start = std::chrono::steady_clock::now();
+  VisualHullStatistics statistics;
+  const std::vector<MaskedView> masked = MaskedViewsOf(views);
   statistics.views_with_masks = static_cast<int>(masked.size());
   if (masked.empty()) return statistics;
   const VoxelGrid& grid = volume->grid();
@@ -66,7 +136,6 @@ VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
   // all round, is object everywhere cannot carve any of its voxels (each voxel's footprint lies
   // inside the block's and holds an object pixel), so its voxels skip that view. Inside the
   // hull, where every view must be asked, that is most views.
-  constexpr int kBlock = 4;
   const Eigen::Vector3i& n = grid.dimensions();
   const Eigen::Vector3i blocks = (n.array() + (kBlock - 1)) / kBlock;
   const int64_t num_blocks = static_cast<int64_t>(blocks.x()) * blocks.y() * blocks.z();
@@ -76,45 +145,7 @@ VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
     std::vector<const MaskedView*> asked;
     std::vector<int64_t> solid;
     for (int64_t block = thread; block < num_blocks; block += threads) {
-      const Eigen::Vector3i first =
-          kBlock * Eigen::Vector3i(static_cast<int>(block % blocks.x()),
-                                   static_cast<int>(block / blocks.x() % blocks.y()),
-                                   static_cast<int>(block / blocks.x() / blocks.y()));
-      const Eigen::Vector3i last = (first.array() + kBlock).min(n.array()) - 1;
-      solid.clear();
-      for (int z = first.z(); z <= last.z(); ++z) {
-        for (int y = first.y(); y <= last.y(); ++y) {
-          for (int x = first.x(); x <= last.x(); ++x) {
-            const int64_t index = grid.Index(Eigen::Vector3i(x, y, z));
-            if (volume->IsSolid(index)) solid.push_back(index);
-          }
-        }
-      }
-      if (solid.empty()) continue;
-      asked.clear();
-      for (const MaskedView& m : masked) {
-        Footprint wide = ComputeFootprint(m.view->P, 1 << 20, 1 << 20, grid, first, kBlock);
-        const bool all_object =
-            !wide.empty() && --wide.col_min >= 0 && --wide.row_min >= 0 &&
-            ++wide.col_max < m.view->width && ++wide.row_max < m.view->height &&
-            RectSum(m.object_integral, wide) == wide.area();
-        if (!all_object) asked.push_back(&m);
-      }
-      for (int64_t index : solid) {
-        const Eigen::Vector3i voxel = grid.Voxel(index);
-        int background = 0;
-        for (const MaskedView* m : asked) {
-          Footprint footprint;
-          if (!FullyInside(m->view->P, m->view->width, m->view->height, grid, voxel, &footprint)) {
-            continue;
-          }
-          if (RectSum(m->valid_integral, footprint) == 0) continue;  // no photo data there
-          if (RectSum(m->object_integral, footprint) == 0 && ++background >= min_background_views) {
-            outside[index] = 1;
-            break;
-          }
-        }
-      }
+      JudgeBlock(masked, *volume, blocks, block, min_background_views, &asked, &solid, &outside);
     }
   };
   std::vector<std::thread> workers;

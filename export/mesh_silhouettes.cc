@@ -86,6 +86,93 @@ std::string MeshPartsSummary::Summary() const {
   return text;
 }
 
+namespace {
+
+// The mesh's triangles grouped by part, as DrawMeshParts needs them; *triangle_part the part of
+// each.
+TriangleMesh GroupedByPart(const TriangleMesh& mesh, const std::vector<int>& part,
+                           std::vector<int>* triangle_part_out) {
+  std::vector<int>& triangle_part = *triangle_part_out;
+  TriangleMesh grouped;
+  grouped.vertices = mesh.vertices;
+  std::vector<size_t> order(mesh.triangles.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return part[mesh.triangles[a][0]] < part[mesh.triangles[b][0]];
+  });
+  triangle_part.assign(order.size(), 0);
+  grouped.triangles.reserve(order.size());
+  for (size_t k = 0; k < order.size(); ++k) {
+    grouped.triangles.push_back(mesh.triangles[order[k]]);
+    triangle_part[k] = part[mesh.triangles[order[k]][0]];
+  }
+  return grouped;
+}
+
+// Per masked view (`masked`, indices into `views`), the parts it needs: half or more of what a
+// part covers in the view is object that no other part covers.
+std::vector<std::vector<uint8_t>> PartsNeeded(const std::vector<CalibratedView>& views,
+                                              const std::vector<size_t>& masked,
+                                              const TriangleMesh& grouped,
+                                              const std::vector<int>& triangle_part,
+                                              int parts,
+                                              int num_threads) {
+  std::vector<std::vector<uint8_t>> needs(masked.size(), std::vector<uint8_t>(parts, 0));
+  ParallelRanges(masked.size(), ResolveNumThreads(num_threads), /*min_per_thread=*/1,
+                 [&](size_t first, size_t last) {
+    cv::Mat count, last_part;
+    std::vector<int64_t> covered, alone(parts);
+    for (size_t m = first; m < last; ++m) {
+      const CalibratedView& view = views[masked[m]];
+      DrawMeshParts(grouped, triangle_part, parts, view, &count, &last_part, &covered);
+      std::fill(alone.begin(), alone.end(), 0);
+      for (int row = 0; row < view.height; ++row) {
+        const uint8_t* c = count.ptr<uint8_t>(row);
+        const int* p = last_part.ptr<int>(row);
+        const uint8_t* object = view.mask.ptr<uint8_t>(row);
+        for (int col = 0; col < view.width; ++col) {
+          if (c[col] == 1 && object[col] != 0) ++alone[p[col]];
+        }
+      }
+      for (int p = 0; p < parts; ++p) needs[m][p] = covered[p] > 0 && 2 * alone[p] >= covered[p];
+    }
+  });
+  return needs;
+}
+
+// The parts other than `largest` that hold a sparse point (`anchors`, within `anchor_radius`).
+std::vector<uint8_t> AnchoredParts(const TriangleMesh& mesh, const std::vector<int>& part,
+                                   int parts, int largest,
+                                   const std::vector<Eigen::Vector3d>& anchors,
+                                   double anchor_radius) {
+  const int n = static_cast<int>(mesh.vertices.size());
+  std::vector<uint8_t> anchored(parts, 0);
+  if (!anchors.empty() && anchor_radius > 0.0) {
+    pcl::PointCloud<pcl::PointXYZ>::Ptr others(new pcl::PointCloud<pcl::PointXYZ>);
+    std::vector<int> vertex_of;
+    for (int i = 0; i < n; ++i) {
+      if (part[i] == largest) continue;
+      others->push_back(pcl::PointXYZ(mesh.vertices[i].x(), mesh.vertices[i].y(), mesh.vertices[i].z()));
+      vertex_of.push_back(i);
+    }
+    if (!others->empty()) {
+      pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+      tree.setInputCloud(others);
+      std::vector<int> found;
+      std::vector<float> squared;
+      for (const Eigen::Vector3d& point : anchors) {
+        const pcl::PointXYZ query(static_cast<float>(point.x()), static_cast<float>(point.y()),
+                                  static_cast<float>(point.z()));
+        tree.radiusSearch(query, anchor_radius, found, squared);
+        for (int k : found) anchored[part[vertex_of[k]]] = 1;
+      }
+    }
+  }
+  return anchored;
+}
+
+}  // namespace
+
 MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
                                      int min_needing_views,
                                      const std::vector<Eigen::Vector3d>& anchors,
@@ -109,63 +196,14 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
   const int largest = static_cast<int>(
       std::max_element(part_vertices.begin(), part_vertices.end()) - part_vertices.begin());
   // The triangles grouped by part, as DrawMeshParts needs them.
-  TriangleMesh grouped;
-  grouped.vertices = mesh->vertices;
-  std::vector<size_t> order(mesh->triangles.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return part[mesh->triangles[a][0]] < part[mesh->triangles[b][0]];
-  });
-  std::vector<int> triangle_part(order.size());
-  grouped.triangles.reserve(order.size());
-  for (size_t k = 0; k < order.size(); ++k) {
-    grouped.triangles.push_back(mesh->triangles[order[k]]);
-    triangle_part[k] = part[mesh->triangles[order[k]][0]];
-  }
+  std::vector<int> triangle_part;
+  const TriangleMesh grouped = GroupedByPart(*mesh, part, &triangle_part);
   // Per masked view, the parts it needs.
-  std::vector<std::vector<uint8_t>> needs(masked.size(), std::vector<uint8_t>(parts, 0));
-  ParallelRanges(masked.size(), ResolveNumThreads(num_threads), /*min_per_thread=*/1,
-                 [&](size_t first, size_t last) {
-    cv::Mat count, last_part;
-    std::vector<int64_t> covered, alone(parts);
-    for (size_t m = first; m < last; ++m) {
-      const CalibratedView& view = views[masked[m]];
-      DrawMeshParts(grouped, triangle_part, parts, view, &count, &last_part, &covered);
-      std::fill(alone.begin(), alone.end(), 0);
-      for (int row = 0; row < view.height; ++row) {
-        const uint8_t* c = count.ptr<uint8_t>(row);
-        const int* p = last_part.ptr<int>(row);
-        const uint8_t* object = view.mask.ptr<uint8_t>(row);
-        for (int col = 0; col < view.width; ++col) {
-          if (c[col] == 1 && object[col] != 0) ++alone[p[col]];
-        }
-      }
-      for (int p = 0; p < parts; ++p) needs[m][p] = covered[p] > 0 && 2 * alone[p] >= covered[p];
-    }
-  });
+  const std::vector<std::vector<uint8_t>> needs =
+      PartsNeeded(views, masked, grouped, triangle_part, parts, num_threads);
   // Parts holding a sparse point: the anchors' neighbours among the other parts' vertices.
-  std::vector<uint8_t> anchored(parts, 0);
-  if (!anchors.empty() && anchor_radius > 0.0) {
-    pcl::PointCloud<pcl::PointXYZ>::Ptr others(new pcl::PointCloud<pcl::PointXYZ>);
-    std::vector<int> vertex_of;
-    for (int i = 0; i < n; ++i) {
-      if (part[i] == largest) continue;
-      others->push_back(pcl::PointXYZ(mesh->vertices[i].x(), mesh->vertices[i].y(), mesh->vertices[i].z()));
-      vertex_of.push_back(i);
-    }
-    if (!others->empty()) {
-      pcl::KdTreeFLANN<pcl::PointXYZ> tree;
-      tree.setInputCloud(others);
-      std::vector<int> found;
-      std::vector<float> squared;
-      for (const Eigen::Vector3d& point : anchors) {
-        const pcl::PointXYZ query(static_cast<float>(point.x()), static_cast<float>(point.y()),
-                                  static_cast<float>(point.z()));
-        tree.radiusSearch(query, anchor_radius, found, squared);
-        for (int k : found) anchored[part[vertex_of[k]]] = 1;
-      }
-    }
-  }
+  const std::vector<uint8_t> anchored =
+      AnchoredParts(*mesh, part, parts, largest, anchors, anchor_radius);
   std::vector<uint8_t> keep(parts, 0);
   for (int p = 0; p < parts; ++p) {
     int needing = 0;

@@ -184,6 +184,58 @@ std::string MeshColouringSummary::Summary() const {
   return text;
 }
 
+namespace {
+
+// Colours the vertices no photo coloured (`known` 0) from their coloured neighbours, ring by ring
+// inwards; returns how many it coloured.
+int64_t FillFromNeighbours(const TriangleMesh& mesh,
+                           std::vector<Eigen::Vector3f>* colours_io,
+                           std::vector<char>* known_io) {
+  std::vector<Eigen::Vector3f>& colours = *colours_io;
+  std::vector<char>& known = *known_io;
+  const size_t n = mesh.vertices.size();
+  int64_t filled_count = 0;
+  std::vector<std::vector<int>> neighbours(n);
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      neighbours[t[k]].push_back(t[(k + 1) % 3]);
+      neighbours[t[k]].push_back(t[(k + 2) % 3]);
+    }
+  }
+  std::vector<int> frontier;
+  for (size_t i = 0; i < n; ++i) {
+    if (!known[i]) frontier.push_back(static_cast<int>(i));
+  }
+  while (!frontier.empty()) {
+    std::vector<std::pair<int, Eigen::Vector3f>> filled;
+    std::vector<int> still;
+    for (int i : frontier) {
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      int count = 0;
+      for (int j : neighbours[i]) {
+        if (!known[j]) continue;
+        sum += colours[j];
+        ++count;
+      }
+      if (count > 0) {
+        filled.emplace_back(i, sum / count);
+      } else {
+        still.push_back(i);
+      }
+    }
+    if (filled.empty()) break;
+    for (const auto& [i, colour] : filled) {
+      colours[i] = colour;
+      known[i] = 1;
+    }
+    filled_count += static_cast<int64_t>(filled.size());
+    frontier.swap(still);
+  }
+  return filled_count;
+}
+
+}  // namespace
+
 MeshColouringSummary ColourMeshFromPhotos(const std::vector<CalibratedView>& views,
                                           const MeshColouringOptions& options,
                                           TriangleMesh* mesh,
@@ -227,42 +279,7 @@ MeshColouringSummary ColourMeshFromPhotos(const std::vector<CalibratedView>& vie
     views_sum += samples[i].size();
   }
   summary.mean_views = summary.from_photos > 0 ? views_sum / summary.from_photos : 0.0;
-  std::vector<std::vector<int>> neighbours(n);
-  for (const Eigen::Vector3i& t : mesh->triangles) {
-    for (int k = 0; k < 3; ++k) {
-      neighbours[t[k]].push_back(t[(k + 1) % 3]);
-      neighbours[t[k]].push_back(t[(k + 2) % 3]);
-    }
-  }
-  std::vector<int> frontier;
-  for (size_t i = 0; i < n; ++i) {
-    if (!known[i]) frontier.push_back(static_cast<int>(i));
-  }
-  while (!frontier.empty()) {
-    std::vector<std::pair<int, Eigen::Vector3f>> filled;
-    std::vector<int> still;
-    for (int i : frontier) {
-      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-      int count = 0;
-      for (int j : neighbours[i]) {
-        if (!known[j]) continue;
-        sum += colours[j];
-        ++count;
-      }
-      if (count > 0) {
-        filled.emplace_back(i, sum / count);
-      } else {
-        still.push_back(i);
-      }
-    }
-    if (filled.empty()) break;
-    for (const auto& [i, colour] : filled) {
-      colours[i] = colour;
-      known[i] = 1;
-    }
-    summary.from_neighbours += static_cast<int64_t>(filled.size());
-    frontier.swap(still);
-  }
+  summary.from_neighbours = FillFromNeighbours(*mesh, &colours, &known);
   mesh->colours.resize(n);
   for (size_t i = 0; i < n; ++i) {
     if (known[i]) {

@@ -92,18 +92,17 @@ void GatherVoxelPixels(const CalibratedView& view,
   }
 }
 
-ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
-                                    const VoxelGrid& grid,
-                                    const std::vector<SurfacePoint>& points,
-                                    ConsistencyMethod test_method,
-                                    int min_views,
-                                    bool masked,
-                                    double quantile,
-                                    double fallback,
-                                    double pattern_fallback,
-                                    int min_points) {
-  ThresholdEstimate estimate;
-  estimate.quantile = quantile;
+namespace {
+
+// Each point's voxel's error, and that of the voxel kFrontOffsetVoxels in front of it (towards
+// the views that saw it), judged from the point's views, into `estimate`'s lists (sorted).
+void MeasurePointErrors(const std::vector<CalibratedView>& views,
+                        const VoxelGrid& grid,
+                        const std::vector<SurfacePoint>& points,
+                        ConsistencyMethod test_method,
+                        int min_views,
+                        ThresholdEstimate* estimate_out) {
+  ThresholdEstimate& estimate = *estimate_out;
   const ConsistencyTest test(test_method, 0.0, min_views);
   std::vector<ViewColourStats> stats;
   // The error of `voxel` judged from `point`'s views, or a negative value when not judged.
@@ -154,6 +153,24 @@ ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
   std::sort(estimate.front_errors.begin(), estimate.front_errors.end());
   std::sort(estimate.surface_pattern_errors.begin(), estimate.surface_pattern_errors.end());
   std::sort(estimate.front_pattern_errors.begin(), estimate.front_pattern_errors.end());
+}
+
+}  // namespace
+
+ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
+                                    const VoxelGrid& grid,
+                                    const std::vector<SurfacePoint>& points,
+                                    ConsistencyMethod test_method,
+                                    int min_views,
+                                    bool masked,
+                                    double quantile,
+                                    double fallback,
+                                    double pattern_fallback,
+                                    int min_points) {
+  ThresholdEstimate estimate;
+  estimate.quantile = quantile;
+  const bool patterns = test_method == ConsistencyMethod::kPatchCorrelation;
+  MeasurePointErrors(views, grid, points, test_method, min_views, &estimate);
   estimate.masked = masked;
   auto choose = [&](const std::vector<double>& surface, const std::vector<double>& front) {
     return masked || front.empty() ? ThresholdEstimate::Quantile(surface, quantile)

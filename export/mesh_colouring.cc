@@ -73,6 +73,50 @@ std::vector<cv::Mat> MaskDistances(const std::vector<CalibratedView>& views, int
   return distances;
 }
 
+namespace {
+
+// What one view sees of the mesh: the vertices in front of its depth buffer, facing it, on valid
+// object pixels, with how squarely (in vertex order), and in *rim those within rim_voxels voxel
+// widths of its mask's edge (`to_background`: each object pixel's distance to the background,
+// empty for none).
+std::vector<std::pair<uint32_t, float>> SightingsInView(const CalibratedView& view,
+                                                        const TriangleMesh& mesh,
+                                                        double depth_tolerance,
+                                                        const cv::Mat& to_background,
+                                                        double voxel_size,
+                                                        double rim_voxels,
+                                                        std::vector<uint32_t>* rim) {
+  std::vector<std::pair<uint32_t, float>> seen;
+  const size_t n = mesh.vertices.size();
+  // The mesh is closed (MeshSolidVoxels) and the cameras outside it: front faces suffice.
+  const cv::Mat depths = RenderMeshDepth(mesh, view, /*front_faces_only=*/true);
+  const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d world = mesh.vertices[i].cast<double>();
+    // P's last row is the camera's z (K's last row is (0, 0, 1)): one product gives both.
+    const Eigen::Vector3d image = view.P * world.homogeneous();
+    const double depth = image.z();
+    if (!(depth > 0.0)) continue;
+    const Eigen::Vector2d pixel = image.head<2>() / depth;
+    const int col = static_cast<int>(std::floor(pixel.x()));
+    const int row = static_cast<int>(std::floor(pixel.y()));
+    if (col < 0 || row < 0 || col >= view.width || row >= view.height) continue;
+    if (depth > depths.at<float>(row, col) + depth_tolerance) continue;
+    if (!to_background.empty() && view.mask.at<uint8_t>(row, col) != 0 &&
+        to_background.at<float>(row, col) <= rim_voxels * focal * voxel_size / depth) {
+      rim->push_back(static_cast<uint32_t>(i));
+    }
+    const double facing = mesh.normals[i].cast<double>().dot((view.centre - world).normalized());
+    if (!(facing > 0.0)) continue;
+    if (view.valid.at<uint8_t>(row, col) == 0) continue;
+    if (!view.mask.empty() && view.mask.at<uint8_t>(row, col) == 0) continue;
+    seen.emplace_back(static_cast<uint32_t>(i), static_cast<float>(facing));
+  }
+  return seen;
+}
+
+}  // namespace
+
 std::vector<std::vector<VertexSighting>> FindVertexSightings(
     const std::vector<CalibratedView>& views, const TriangleMesh& mesh, double depth_tolerance,
     std::vector<uint8_t>* on_rim, double voxel_size, double rim_voxels, int num_threads,
@@ -95,35 +139,13 @@ std::vector<std::vector<VertexSighting>> FindVertexSightings(
   ParallelRanges(views.size(), threads, /*min_per_thread=*/1, [&](size_t first, size_t last) {
     for (size_t v = first; v < last; ++v) {
       const CalibratedView& view = views[v];
-      // The mesh is closed (MeshSolidVoxels) and the cameras outside it: front faces suffice.
-      const cv::Mat depths = RenderMeshDepth(mesh, view, /*front_faces_only=*/true);
       // Distance (pixels) from each object pixel to the nearest background pixel.
       cv::Mat to_background;
       if (on_rim != nullptr && !view.mask.empty() && voxel_size > 0.0) {
         to_background = (*mask_distances)[v];
       }
-      const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
-      for (size_t i = 0; i < n; ++i) {
-        const Eigen::Vector3d world = mesh.vertices[i].cast<double>();
-        // P's last row is the camera's z (K's last row is (0, 0, 1)): one product gives both.
-        const Eigen::Vector3d image = view.P * world.homogeneous();
-        const double depth = image.z();
-        if (!(depth > 0.0)) continue;
-        const Eigen::Vector2d pixel = image.head<2>() / depth;
-        const int col = static_cast<int>(std::floor(pixel.x()));
-        const int row = static_cast<int>(std::floor(pixel.y()));
-        if (col < 0 || row < 0 || col >= view.width || row >= view.height) continue;
-        if (depth > depths.at<float>(row, col) + depth_tolerance) continue;
-        if (!to_background.empty() && view.mask.at<uint8_t>(row, col) != 0 &&
-            to_background.at<float>(row, col) <= rim_voxels * focal * voxel_size / depth) {
-          rims[v].push_back(static_cast<uint32_t>(i));
-        }
-        const double facing = mesh.normals[i].cast<double>().dot((view.centre - world).normalized());
-        if (!(facing > 0.0)) continue;
-        if (view.valid.at<uint8_t>(row, col) == 0) continue;
-        if (!view.mask.empty() && view.mask.at<uint8_t>(row, col) == 0) continue;
-        per_view[v].emplace_back(static_cast<uint32_t>(i), static_cast<float>(facing));
-      }
+      per_view[v] = SightingsInView(view, mesh, depth_tolerance, to_background, voxel_size,
+                                    rim_voxels, &rims[v]);
     }
   });
   // Per vertex in view order, the vertices split over the threads: each view's list is in vertex

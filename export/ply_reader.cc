@@ -12,126 +12,102 @@
 namespace raycarve {
 namespace exporter {
 
-PlyHeader ParsePlyHeader(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError(path + ": cannot open");
-  file.seekg(0, std::ios::end);
-  const uint64_t size = static_cast<uint64_t>(file.tellg());
-  file.seekg(0);
-  constexpr size_t kMaxHeaderBytes = 1 << 16;
-  std::string line;
-  size_t header_bytes = 0;
-  auto next_line = [&]() -> bool {
-    if (!std::getline(file, line)) return false;
-    header_bytes += line.size() + 1;
-    if (header_bytes > kMaxHeaderBytes) {
-      throw InputError(path + ": PLY header longer than " + std::to_string(kMaxHeaderBytes) +
-                       " bytes (no end_header?)");
-    }
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    return true;
-  };
-  if (!next_line() || line != "ply") throw InputError(path + ": not a PLY file (no 'ply' on line 1)");
-  struct Element {
-    PlyElement element;
-    uint64_t min_bytes = 0;  // binary: one record's fixed part
-    uint64_t values = 0;     // properties per record
-    bool x = false, y = false, z = false;
-  };
-  std::vector<Element> elements;
-  std::string format;
-  uint64_t grid_cols = 0, grid_rows = 0;
-  bool ended = false;
-  auto type_bytes = [&](const std::string& type) -> uint64_t {
-    if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-    if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
-        type == "float32") {
-      return 4;
-    }
-    if (type == "double" || type == "float64") return 8;
-    throw InputError(path + ": PLY property type '" + type + "' is not one PLY has");
-  };
-  while (next_line()) {
-    std::istringstream words(line);
-    std::string keyword;
-    words >> keyword;
-    if (keyword == "end_header") {
-      ended = true;
-      break;
-    }
-    if (keyword == "format") {
-      words >> format;
-      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") {
-        throw InputError(path + ": PLY format '" + format + "' is not one PLY has");
-      }
-    } else if (keyword == "element") {
-      Element element;
-      std::string count;
-      words >> element.element.name >> count;
-      if (count.empty() || count.find_first_not_of("0123456789") != std::string::npos ||
-          count.size() > 19) {
-        throw InputError(path + ": PLY element '" + element.element.name +
-                         "' has no valid count ('" + count + "')");
-      }
-      element.element.count = std::stoull(count);
-      // Found by fuzzing: a second vertex element gave vertices without the first's colours.
-      for (const Element& earlier : elements) {
-        if ((element.element.name == "vertex" || element.element.name == "face") &&
-            earlier.element.name == element.element.name) {
-          throw InputError(path + ": PLY element '" + element.element.name + "' appears twice");
-        }
-      }
-      elements.push_back(element);
-    } else if (keyword == "property") {
-      if (elements.empty()) throw InputError(path + ": PLY property before any element");
-      Element& element = elements.back();
-      std::string type, name;
-      words >> type;
-      PlyProperty property;
-      if (type == "list") {
-        std::string count_type, item_type;
-        words >> count_type >> item_type >> name;
-        if (element.element.name == "vertex") {
-          throw InputError(path + ": PLY element 'vertex' has a list property ('" + name +
-                           "'), which no reader here takes");
-        }
-        element.min_bytes += type_bytes(count_type);
-        type_bytes(item_type);
-        if (count_type == "float" || count_type == "float32" || count_type == "double" ||
-            count_type == "float64") {
-          throw InputError(path + ": PLY list property '" + name + "' has a count of type '" +
-                           count_type + "' (an integer type is needed)");
-        }
-        property.type = item_type;
-        property.count_type = count_type;
-      } else {
-        words >> name;
-        element.min_bytes += type_bytes(type);
-        property.type = type;
-      }
-      if (name.empty()) throw InputError(path + ": PLY property line '" + line + "' has no name");
-      property.name = name;
-      element.element.properties.push_back(property);
-      ++element.values;
-      element.x = element.x || name == "x";
-      element.y = element.y || name == "y";
-      element.z = element.z || name == "z";
-    } else if (keyword == "obj_info") {
-      std::string key;
-      uint64_t value = 0;
-      words >> key >> value;
-      if (key == "num_cols") grid_cols = value;
-      if (key == "num_rows") grid_rows = value;
-    } else if (keyword != "comment" && !keyword.empty()) {
-      // Found by fuzzing: PCL skips an unknown line and files the properties after it under the
-      // element before, where a list property trips an assertion.
-      throw InputError(path + ": PLY header line '" + line.substr(0, 80) +
-                       "' is not one PLY has (format, element, property, comment, obj_info)");
+namespace {
+
+// An element of a PLY header as parsed, with what its records need at least.
+struct Element {
+  PlyElement element;
+  uint64_t min_bytes = 0;  // binary: one record's fixed part
+  uint64_t values = 0;     // properties per record
+  bool x = false, y = false, z = false;
+};
+
+// The bytes of a PLY property type; throws InputError naming `path` for a type PLY does not have.
+uint64_t PlyTypeBytes(const std::string& path, const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
+      type == "float32") {
+    return 4;
+  }
+  if (type == "double" || type == "float64") return 8;
+  throw InputError(path + ": PLY property type '" + type + "' is not one PLY has");
+}
+
+// An "element NAME COUNT" line's rest (`words`), appended to `elements`.
+void ParseElementLine(const std::string& path,
+                      std::istringstream& words,
+                      std::vector<Element>* elements_io) {
+  std::vector<Element>& elements = *elements_io;
+  Element element;
+  std::string count;
+  words >> element.element.name >> count;
+  if (count.empty() || count.find_first_not_of("0123456789") != std::string::npos ||
+      count.size() > 19) {
+    throw InputError(path + ": PLY element '" + element.element.name +
+                     "' has no valid count ('" + count + "')");
+  }
+  element.element.count = std::stoull(count);
+  // Found by fuzzing: a second vertex element gave vertices without the first's colours.
+  for (const Element& earlier : elements) {
+    if ((element.element.name == "vertex" || element.element.name == "face") &&
+        earlier.element.name == element.element.name) {
+      throw InputError(path + ": PLY element '" + element.element.name + "' appears twice");
     }
   }
-  if (!ended) throw InputError(path + ": PLY header has no end_header");
-  if (format.empty()) throw InputError(path + ": PLY header has no format line");
+  elements.push_back(element);
+}
+
+// A "property ..." line's rest (`words`), added to the last element.
+void ParsePropertyLine(const std::string& path,
+                       const std::string& line,
+                       std::istringstream& words,
+                       std::vector<Element>* elements_io) {
+  std::vector<Element>& elements = *elements_io;
+  if (elements.empty()) throw InputError(path + ": PLY property before any element");
+  Element& element = elements.back();
+  std::string type, name;
+  words >> type;
+  PlyProperty property;
+  if (type == "list") {
+    std::string count_type, item_type;
+    words >> count_type >> item_type >> name;
+    if (element.element.name == "vertex") {
+      throw InputError(path + ": PLY element 'vertex' has a list property ('" + name +
+                       "'), which no reader here takes");
+    }
+    element.min_bytes += PlyTypeBytes(path, count_type);
+    PlyTypeBytes(path, item_type);
+    if (count_type == "float" || count_type == "float32" || count_type == "double" ||
+        count_type == "float64") {
+      throw InputError(path + ": PLY list property '" + name + "' has a count of type '" +
+                       count_type + "' (an integer type is needed)");
+    }
+    property.type = item_type;
+    property.count_type = count_type;
+  } else {
+    words >> name;
+    element.min_bytes += PlyTypeBytes(path, type);
+    property.type = type;
+  }
+  if (name.empty()) throw InputError(path + ": PLY property line '" + line + "' has no name");
+  property.name = name;
+  element.element.properties.push_back(property);
+  ++element.values;
+  element.x = element.x || name == "x";
+  element.y = element.y || name == "y";
+  element.z = element.z || name == "z";
+}
+
+// The parsed header checked against the file: each element's records fit in the bytes after the
+// header, there are vertices with x, y and z, and an obj_info grid fits in them.
+PlyHeader CheckedHeader(const std::string& path,
+                        const std::string& format,
+                        const std::vector<Element>& elements,
+                        uint64_t size,
+                        size_t header_bytes,
+                        uint64_t grid_cols,
+                        uint64_t grid_rows) {
   const uint64_t body = size - std::min<uint64_t>(size, header_bytes);
   uint64_t needed = 0, vertices = 0;
   bool has_vertex = false;
@@ -166,6 +142,67 @@ PlyHeader ParsePlyHeader(const std::string& path) {
   }
   header.vertices = vertices;
   return header;
+}
+
+}  // namespace
+
+PlyHeader ParsePlyHeader(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError(path + ": cannot open");
+  file.seekg(0, std::ios::end);
+  const uint64_t size = static_cast<uint64_t>(file.tellg());
+  file.seekg(0);
+  constexpr size_t kMaxHeaderBytes = 1 << 16;
+  std::string line;
+  size_t header_bytes = 0;
+  auto next_line = [&]() -> bool {
+    if (!std::getline(file, line)) return false;
+    header_bytes += line.size() + 1;
+    if (header_bytes > kMaxHeaderBytes) {
+      throw InputError(path + ": PLY header longer than " + std::to_string(kMaxHeaderBytes) +
+                       " bytes (no end_header?)");
+    }
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  };
+  if (!next_line() || line != "ply") throw InputError(path + ": not a PLY file (no 'ply' on line 1)");
+  std::vector<Element> elements;
+  std::string format;
+  uint64_t grid_cols = 0, grid_rows = 0;
+  bool ended = false;
+  while (next_line()) {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (keyword == "end_header") {
+      ended = true;
+      break;
+    }
+    if (keyword == "format") {
+      words >> format;
+      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") {
+        throw InputError(path + ": PLY format '" + format + "' is not one PLY has");
+      }
+    } else if (keyword == "element") {
+      ParseElementLine(path, words, &elements);
+    } else if (keyword == "property") {
+      ParsePropertyLine(path, line, words, &elements);
+    } else if (keyword == "obj_info") {
+      std::string key;
+      uint64_t value = 0;
+      words >> key >> value;
+      if (key == "num_cols") grid_cols = value;
+      if (key == "num_rows") grid_rows = value;
+    } else if (keyword != "comment" && !keyword.empty()) {
+      // Found by fuzzing: PCL skips an unknown line and files the properties after it under the
+      // element before, where a list property trips an assertion.
+      throw InputError(path + ": PLY header line '" + line.substr(0, 80) +
+                       "' is not one PLY has (format, element, property, comment, obj_info)");
+    }
+  }
+  if (!ended) throw InputError(path + ": PLY header has no end_header");
+  if (format.empty()) throw InputError(path + ": PLY header has no format line");
+  return CheckedHeader(path, format, elements, size, header_bytes, grid_cols, grid_rows);
 }
 
 uint64_t CheckPlyHeader(const std::string& path) { return ParsePlyHeader(path).vertices; }

@@ -229,6 +229,10 @@ HoldoutEvaluation EvaluateHeldOutViews(const CarveRequest& request, const Holdou
   CheckNoLinkInside(output_path, "holdout");
   CheckOutputFileOutside(final_out.string(), pipeline.project().image_path, "photo folder");
   CheckOutputFileOutside(final_out.string(), pipeline.project().model_path, "input model");
+  // Written as a set, as carve's outputs: staged, then moved into place with holdout.json last.
+  // Made before the carve, so that a folder that cannot be written is found at once.
+  StagedOutputs staged(final_out.string(), request.wait_for_output);
+  const std::filesystem::path out(staged.path());
   std::vector<CalibratedView> held_out = pipeline.held_out_views();
   if (!options.score_mask_path.empty()) ReplaceScoringMasks(pipeline, options.score_mask_path, &held_out);
   // Block PSNR's block: about a voxel of the grid the carve uses (or would use).
@@ -255,9 +259,6 @@ HoldoutEvaluation EvaluateHeldOutViews(const CarveRequest& request, const Holdou
     }
     evaluation.carved = true;
   }
-  // Written as a set, as carve's outputs: staged, then moved into place with holdout.json last.
-  StagedOutputs staged(final_out.string(), request.wait_for_output);
-  const std::filesystem::path out(staged.path());
   for (const CalibratedView& view : held_out) {
     evaluation.views.push_back(ScoreView(scored, evaluation.render, grid, view, out));
   }

@@ -33,6 +33,78 @@ bool MiddleburyImportOptions::IsValid(std::string* reason) const {
   return true;
 }
 
+namespace {
+
+// Throws InputError naming the file, the line and the field.
+struct LineError {
+  const std::string& source;
+  const int& line_number;
+  [[noreturn]] void operator()(const std::string& field, const std::string& what) const {
+    throw InputError(source + ": line " + std::to_string(line_number) + ": field '" + field +
+                     "': " + what);
+  }
+};
+
+// The kNumValues finite numbers after an image line's name.
+void ParseValues(std::istringstream& parse, const LineError& fail, double values[kNumValues]) {
+  for (int k = 0; k < kNumValues; ++k) {
+    std::string token;
+    if (!(parse >> token)) fail(kFieldNames[k], "missing");
+    std::istringstream number(token);
+    number.imbue(std::locale::classic());
+    if (!(number >> values[k]) || !number.eof() || !std::isfinite(values[k])) {
+      fail(kFieldNames[k], "'" + token + "' is not a finite number");
+    }
+  }
+}
+
+// R, orthonormal only to the files' printed digits, replaced by the nearest rotation; throws when
+// it is no rotation. *max_deviation grows to its largest |R R^T - I| entry.
+Eigen::Matrix3d CheckedRotation(Eigen::Matrix3d R, const LineError& fail, double* max_deviation) {
+  // The files print R to about 7 significant digits, so it is orthonormal only to about 1e-6
+  // (the shipped dinoR_par.txt and dinoSR_par.txt: 1.6e-6). Within kRotationTolerance it is
+  // taken and replaced by the nearest rotation (SVD); beyond, it is not a rotation.
+  const double deviation = (R * R.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!(deviation <= kRotationTolerance) || std::abs(R.determinant() - 1.0) > 3.0 * kRotationTolerance) {
+    fail("r11..r33", "R is not a rotation matrix (R R^T differs from I by " +
+                         std::to_string(deviation) + ", det " + std::to_string(R.determinant()) + ")");
+  }
+  *max_deviation = std::max(*max_deviation, deviation);
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  R = svd.matrixU() * svd.matrixV().transpose();
+  return R;
+}
+
+// The id of the PINHOLE camera of K at `size` in `reconstruction`, added when new.
+camera_t CameraIdOf(const Eigen::Matrix3d& K, const Eigen::Vector2i& size,
+                    const MiddleburyImportOptions& options, const std::string& context,
+                    Reconstruction* reconstruction) {
+  Camera camera;
+  camera.model = CameraModelId::kPinhole;
+  camera.width = size.x();
+  camera.height = size.y();
+  camera.params = {K(0, 0),
+                   K(1, 1),
+                   K(0, 2) + options.principal_point_offset,
+                   K(1, 2) + options.principal_point_offset};
+  camera_t camera_id = 0;
+  for (const auto& [id, existing] : reconstruction->cameras) {
+    if (existing.params == camera.params && existing.width == camera.width &&
+        existing.height == camera.height) {
+      camera_id = id;
+    }
+  }
+  if (camera_id == 0) {
+    camera_id = static_cast<camera_t>(reconstruction->cameras.size() + 1);
+    camera.camera_id = camera_id;
+    ValidateCamera(camera, context);
+    reconstruction->cameras.emplace(camera_id, camera);
+  }
+  return camera_id;
+}
+
+}  // namespace
+
 Reconstruction ReadMiddleburyParameters(
     std::istream& stream,
     const std::string& source,
@@ -43,10 +115,7 @@ Reconstruction ReadMiddleburyParameters(
   stream.imbue(std::locale::classic());
   std::string line;
   int line_number = 0;
-  auto fail = [&](const std::string& field, const std::string& what) {
-    throw InputError(source + ": line " + std::to_string(line_number) + ": field '" + field +
-                     "': " + what);
-  };
+  const LineError fail{source, line_number};
   long long count = -1;
   while (std::getline(stream, line)) {
     ++line_number;
@@ -73,15 +142,7 @@ Reconstruction ReadMiddleburyParameters(
     std::string name;
     parse >> name;
     double values[kNumValues];
-    for (int k = 0; k < kNumValues; ++k) {
-      std::string token;
-      if (!(parse >> token)) fail(kFieldNames[k], "missing");
-      std::istringstream number(token);
-      number.imbue(std::locale::classic());
-      if (!(number >> values[k]) || !number.eof() || !std::isfinite(values[k])) {
-        fail(kFieldNames[k], "'" + token + "' is not a finite number");
-      }
-    }
+    ParseValues(parse, fail, values);
     if (!names.insert(name).second) fail("name", "duplicate image name '" + name + "'");
 
     Eigen::Matrix3d K, R;
@@ -95,40 +156,12 @@ Reconstruction ReadMiddleburyParameters(
       fail("k31..k33", "the last row of K must be (0 0 1)");
     }
     if (!(K(0, 0) > 0.0) || !(K(1, 1) > 0.0)) fail("k11", "focal lengths must be positive");
-    // The files print R to about 7 significant digits, so it is orthonormal only to about 1e-6
-    // (the shipped dinoR_par.txt and dinoSR_par.txt: 1.6e-6). Within kRotationTolerance it is
-    // taken and replaced by the nearest rotation (SVD); beyond, it is not a rotation.
-    const double deviation = (R * R.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-    if (!(deviation <= kRotationTolerance) || std::abs(R.determinant() - 1.0) > 3.0 * kRotationTolerance) {
-      fail("r11..r33", "R is not a rotation matrix (R R^T differs from I by " +
-                           std::to_string(deviation) + ", det " + std::to_string(R.determinant()) + ")");
-    }
-    max_deviation = std::max(max_deviation, deviation);
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    R = svd.matrixU() * svd.matrixV().transpose();
+    R = CheckedRotation(R, fail, &max_deviation);
     const Eigen::Vector2i size = image_size(name);
 
-    Camera camera;
-    camera.model = CameraModelId::kPinhole;
-    camera.width = size.x();
-    camera.height = size.y();
-    camera.params = {K(0, 0),
-                     K(1, 1),
-                     K(0, 2) + options.principal_point_offset,
-                     K(1, 2) + options.principal_point_offset};
-    camera_t camera_id = 0;
-    for (const auto& [id, existing] : reconstruction.cameras) {
-      if (existing.params == camera.params && existing.width == camera.width &&
-          existing.height == camera.height) {
-        camera_id = id;
-      }
-    }
-    if (camera_id == 0) {
-      camera_id = static_cast<camera_t>(reconstruction.cameras.size() + 1);
-      camera.camera_id = camera_id;
-      ValidateCamera(camera, source + ": line " + std::to_string(line_number));
-      reconstruction.cameras.emplace(camera_id, camera);
-    }
+    const camera_t camera_id = CameraIdOf(K, size, options,
+                                          source + ": line " + std::to_string(line_number),
+                                          &reconstruction);
 
     Image image;
     image.image_id = next_image_id++;

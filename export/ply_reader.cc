@@ -332,6 +332,47 @@ uint8_t ColourByte(double value, const std::string& type) {
 
 }  // namespace
 
+namespace {
+
+// A list property's count and items; a face's vertex indices (`slot` kFaceList) are checked
+// against the `num_vertices` read so far and fanned into `triangles`. `polygon` is a buffer.
+void ReadListProperty(const std::string& path,
+                      const PlyProperty& property,
+                      Slot slot,
+                      uint64_t record,
+                      size_t num_vertices,
+                      ValueName what,
+                      PlyBody* body_io,
+                      std::vector<int>* polygon_buffer,
+                      std::vector<Eigen::Vector3i>* triangles) {
+  PlyBody& body = *body_io;
+  std::vector<int>& polygon = *polygon_buffer;
+  what.count = true;
+  const double count = body.Next(property.count_type, what);
+  what.count = false;
+  // Each item takes at least one byte (binary) or two characters (ASCII).
+  if (!(count >= 0.0) || count > static_cast<double>(body.remaining())) {
+    throw InputError(path + ": PLY list " + what.Text() + " announces " +
+                     std::to_string(count) + " items, more than the file holds");
+  }
+  polygon.clear();
+  for (int64_t k = 0; k < static_cast<int64_t>(count); ++k) {
+    const double item = body.Next(property.type, what);
+    if (slot != Slot::kFaceList) continue;
+    if (!(item >= 0.0) || item >= static_cast<double>(num_vertices)) {
+      throw InputError(path + ": face " + std::to_string(record) + " refers to vertex " +
+                       std::to_string(static_cast<long long>(item)) + " of " +
+                       std::to_string(num_vertices));
+    }
+    polygon.push_back(static_cast<int>(item));
+  }
+  for (size_t k = 2; k < polygon.size(); ++k) {
+    triangles->emplace_back(polygon[0], polygon[k - 1], polygon[k]);
+  }
+}
+
+}  // namespace
+
 PlyData ReadPly(const std::string& path) {
   const PlyHeader header = ParsePlyHeader(path);
   PlyBody body(path, header);
@@ -366,28 +407,8 @@ PlyData ReadPly(const std::string& path) {
         const PlyProperty& property = element.properties[p];
         ValueName what{&element.name, record, &property.name, false};
         if (!property.count_type.empty()) {
-          what.count = true;
-          const double count = body.Next(property.count_type, what);
-          what.count = false;
-          // Each item takes at least one byte (binary) or two characters (ASCII).
-          if (!(count >= 0.0) || count > static_cast<double>(body.remaining())) {
-            throw InputError(path + ": PLY list " + what.Text() + " announces " +
-                             std::to_string(count) + " items, more than the file holds");
-          }
-          polygon.clear();
-          for (int64_t k = 0; k < static_cast<int64_t>(count); ++k) {
-            const double item = body.Next(property.type, what);
-            if (slots[p] != Slot::kFaceList) continue;
-            if (!(item >= 0.0) || item >= static_cast<double>(data.xyz.size())) {
-              throw InputError(path + ": face " + std::to_string(record) + " refers to vertex " +
-                               std::to_string(static_cast<long long>(item)) + " of " +
-                               std::to_string(data.xyz.size()));
-            }
-            polygon.push_back(static_cast<int>(item));
-          }
-          for (size_t k = 2; k < polygon.size(); ++k) {
-            data.triangles.emplace_back(polygon[0], polygon[k - 1], polygon[k]);
-          }
+          ReadListProperty(path, property, slots[p], record, data.xyz.size(), what, &body,
+                           &polygon, &data.triangles);
           continue;
         }
         const double value = body.Next(property.type, what);

@@ -37,11 +37,43 @@ struct FileCloser {
   void operator()(std::FILE* file) const { std::fclose(file); }
 };
 
-bool StartsLikeJpeg(const std::string& path) {
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+bool StartsLikeJpeg(std::FILE* file) {
   unsigned char magic[3] = {0, 0, 0};
-  return file && std::fread(magic, 1, 3, file.get()) == 3 && magic[0] == 0xFF &&
-         magic[1] == 0xD8 && magic[2] == 0xFF;
+  const bool jpeg = std::fread(magic, 1, 3, file) == 3 && magic[0] == 0xFF && magic[1] == 0xD8 &&
+                    magic[2] == 0xFF;
+  std::rewind(file);
+  return jpeg;
+}
+
+std::unique_ptr<std::FILE, FileCloser> OpenForReading(const std::string& path) {
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  if (!file) throw InputError(path + ": cannot open for reading: " + std::strerror(errno));
+  return file;
+}
+
+// CheckJpegStrictly on an open file.
+void CheckJpegFile(const std::string& path, std::FILE* file) {
+  if (!StartsLikeJpeg(file)) return;
+  jpeg_decompress_struct info;
+  StrictJpegErrors errors;
+  info.err = jpeg_std_error(&errors.manager);
+  errors.manager.error_exit = JumpWithMessage;
+  errors.manager.emit_message = OnJpegMessage;
+  std::vector<JSAMPLE> row;
+  if (setjmp(errors.jump) != 0) {
+    jpeg_destroy_decompress(&info);
+    throw InputError(path + ": damaged JPEG (" + errors.message +
+                     "): raycarve does not carve with a photo or mask that cannot be read whole");
+  }
+  jpeg_create_decompress(&info);
+  jpeg_stdio_src(&info, file);
+  jpeg_read_header(&info, TRUE);
+  jpeg_start_decompress(&info);
+  row.resize(static_cast<size_t>(info.output_width) * info.output_components);
+  JSAMPROW rows[1] = {row.data()};
+  while (info.output_scanline < info.output_height) jpeg_read_scanlines(&info, rows, 1);
+  jpeg_finish_decompress(&info);
+  jpeg_destroy_decompress(&info);
 }
 
 }  // namespace
@@ -59,39 +91,14 @@ std::string WhyNotAFile(const std::string& path) {
 }
 
 void CheckJpegStrictly(const std::string& path) {
-  if (!StartsLikeJpeg(path)) return;
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
-  if (!file) throw InputError(path + ": cannot open for reading: " + std::strerror(errno));
-  jpeg_decompress_struct info;
-  StrictJpegErrors errors;
-  info.err = jpeg_std_error(&errors.manager);
-  errors.manager.error_exit = JumpWithMessage;
-  errors.manager.emit_message = OnJpegMessage;
-  std::vector<JSAMPLE> row;
-  if (setjmp(errors.jump) != 0) {
-    jpeg_destroy_decompress(&info);
-    throw InputError(path + ": damaged JPEG (" + errors.message +
-                     "): raycarve does not carve with a photo or mask that cannot be read whole");
-  }
-  jpeg_create_decompress(&info);
-  jpeg_stdio_src(&info, file.get());
-  jpeg_read_header(&info, TRUE);
-  jpeg_start_decompress(&info);
-  row.resize(static_cast<size_t>(info.output_width) * info.output_components);
-  JSAMPROW rows[1] = {row.data()};
-  while (info.output_scanline < info.output_height) jpeg_read_scanlines(&info, rows, 1);
-  jpeg_finish_decompress(&info);
-  jpeg_destroy_decompress(&info);
+  const std::unique_ptr<std::FILE, FileCloser> file = OpenForReading(path);
+  CheckJpegFile(path, file.get());
 }
 
 cv::Mat ReadImage(const std::string& path, int flags) {
   const std::string why = WhyNotAFile(path);
   if (!why.empty()) throw InputError(path + ": " + why);
-  {
-    std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
-    if (!file) throw InputError(path + ": cannot open for reading: " + std::strerror(errno));
-  }
-  CheckJpegStrictly(path);
+  CheckJpegFile(path, OpenForReading(path).get());
   // COLMAP reads the pixels as stored and registers them so; OpenCV would turn a photo by its
   // EXIF orientation (a phone held upright: 3000x4000 against COLMAP's 4000x3000, or upside
   // down: the same size, silently turned). IMREAD_UNCHANGED ignores the orientation already.

@@ -90,7 +90,7 @@ void CarvePipeline::RecordSeconds(const std::string& stage, double seconds) {
 
 void CarvePipeline::LockOutputs() {
   std::string output_path;
-  ResolveProjectPaths(ProjectRequestOf(request_, scope_.command), &output_path);
+  paths_ = ResolveProjectPaths(ProjectRequestOf(request_, scope_.command), &output_path);
   staged_ = std::make_unique<StagedOutputs>(output_path, request_.wait_for_output);
 }
 
@@ -103,6 +103,7 @@ void CarvePipeline::LoadViews() {
   ProjectRequest load = ProjectRequestOf(request_, scope_.command);
   load.min_images = scope_.min_images;
   load.hold_out_every = scope_.hold_out_every;
+  load.paths = paths_;
   project_ = LoadProject(load);
   // The held-out photos are kept apart, in name order; the rest are carved in load order.
   const std::set<std::string> held(project_.held_out.begin(), project_.held_out.end());

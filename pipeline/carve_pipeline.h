@@ -4,6 +4,7 @@
 #include <functional>
 #include <future>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -135,6 +136,7 @@ class CarvePipeline {
   std::vector<exporter::ColouredPoint> points_;
   std::vector<std::vector<uint32_t>> visibility_;  // per point, image indices (COLMAP's .vis)
   std::vector<std::filesystem::path> mask_targets_;  // per carved view, under the output folder
+  std::optional<WorkspacePaths> paths_;  // resolved by LockOutputs, reused by LoadViews
   std::unique_ptr<StagedOutputs> staged_;
   std::future<void> mesh_written_;  // the smooth mesh's file, written beside the cloud
   double export_seconds_ = 0.0;     // the cloud's sampling and the files

@@ -102,8 +102,10 @@ void CheckPhotosFitInMemory(const Reconstruction& reconstruction, int max_image_
 }
 
 WorkspacePaths ResolveProjectPaths(const ProjectRequest& request, std::string* output_path) {
-  const WorkspacePaths paths = ResolveWorkspace(request.workspace_path, request.input_path,
-                                                request.image_path, request.model_index);
+  const WorkspacePaths paths =
+      request.paths ? *request.paths
+                    : ResolveWorkspace(request.workspace_path, request.input_path,
+                                       request.image_path, request.model_index);
   *output_path = request.output_path;
   if (output_path->empty()) {
     if (request.workspace_path.empty()) throw InputError("raycarve " + request.command + ": give --output_path");

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,8 @@ struct ProjectRequest {
   int model_index = -1;
   ColourCalibrationMode colour_calibration = ColourCalibrationMode::kOff;
   int hold_out_every = 0;  // > 0: HoldOutImages before anything reads the sparse points
+  // The workspace when already resolved (CarvePipeline::LockOutputs); else ResolveWorkspace.
+  std::optional<WorkspacePaths> paths;
 };
 // The ProjectRequest of a carve request, for `command`.
 ProjectRequest ProjectRequestOf(const CarveRequest& request, const std::string& command);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "calib/calibrated_view.h"
+#include "carve/carver.h"
 #include "carve/surface_evidence.h"
 #include "carve/visibility.h"
 #include "carve/volume.h"
@@ -26,6 +27,19 @@ inline SyntheticSceneOptions SceneOptions(int views,
   options.height = height;
   options.num_surface_samples = surface_samples;
   options.backdrop = uniform_backdrop ? Backdrop::kUniform : Backdrop::kPatchwork;
+  return options;
+}
+
+// A small generated scene with 2,000 sparse points and a patchwork sky.
+inline SyntheticScene Scene(int views, int width, int height) {
+  return GenerateSyntheticScene(SceneOptions(views, width, height, false, 2000));
+}
+
+// Carve options with the grid's resolution and a fixed colour threshold.
+inline CarveOptions Options(int resolution, double threshold) {
+  CarveOptions options;
+  options.resolution = resolution;
+  options.threshold = threshold;
   return options;
 }
 

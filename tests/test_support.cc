@@ -1,6 +1,7 @@
 #include "tests/test_support.h"
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -80,6 +81,38 @@ int RunShell(const std::string& command, std::string* output) {
 std::string RaycarveBinary() {
   const char* binary = std::getenv("RAYCARVE_BINARY");
   return binary == nullptr ? std::string() : std::string(binary);
+}
+
+int RunRaycarve(const std::string& arguments, std::string* output) {
+  return RunShell("'" + RaycarveBinary() + "' " + arguments, output);
+}
+
+void ExpectUserError(const std::string& arguments, std::initializer_list<std::string> parts) {
+  std::string output;
+  const int status = RunRaycarve(arguments, &output);
+  EXPECT_EQ(status, 1) << arguments << "\n" << output;
+  EXPECT_NE(output.find("error: "), std::string::npos) << output;
+  for (const std::string& part : parts) {
+    EXPECT_NE(output.find(part), std::string::npos) << "'" << part << "' not in:\n" << output;
+  }
+  for (const char* crash :
+       {"Check failed", "Aborted", "Segmentation", "terminate", "AddressSanitizer", "unexpected error"}) {
+    EXPECT_EQ(output.find(crash), std::string::npos) << output;
+  }
+}
+
+double JsonNumber(const std::string& json, const std::string& key) {
+  const size_t at = json.find("\"" + key + "\":");
+  EXPECT_NE(at, std::string::npos) << key;
+  return at == std::string::npos ? NAN : std::stod(json.substr(at + key.size() + 3));
+}
+
+std::map<std::string, std::string> FolderSnapshot(const std::string& folder) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(folder)) {
+    if (entry.is_regular_file()) files[entry.path().string()] = ReadFileBytes(entry.path());
+  }
+  return files;
 }
 
 bool ColmapAvailable() {

@@ -1,6 +1,8 @@
 #pragma once
 
 #include <filesystem>
+#include <initializer_list>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -20,6 +22,19 @@ int RunShell(const std::string& command, std::string* output);
 
 // The built `raycarve` program (set by CTest in $RAYCARVE_BINARY).
 std::string RaycarveBinary();
+
+// Runs the built `raycarve` program with `arguments` (a shell command line's words).
+int RunRaycarve(const std::string& arguments, std::string* output);
+
+// Runs raycarve and expects exit status 1 with a message "error: ..." holding every part, and no
+// sign of a crash or a failed internal check.
+void ExpectUserError(const std::string& arguments, std::initializer_list<std::string> parts);
+
+// The number after "key": in a JSON text written by raycarve (fails the test when absent).
+double JsonNumber(const std::string& json, const std::string& key);
+
+// Every regular file under `folder` with its bytes.
+std::map<std::string, std::string> FolderSnapshot(const std::string& folder);
 
 // True when a `colmap` program is on the PATH.
 bool ColmapAvailable();

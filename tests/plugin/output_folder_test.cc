@@ -11,61 +11,24 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/test_support.h"
+#include "tests/plugin/project_fixture.h"
 
 namespace raycarve {
 namespace {
 
 namespace fs = std::filesystem;
 
-class OutputFolder : public ::testing::Test {
+// A studio project (plain backdrop: automatic masks) with the generator's exact masks.
+class OutputFolder : public testing::GeneratedProject {
  protected:
   static void SetUpTestSuite() {
-    root_ = new std::string(testing::MakeTemporaryDirectory("output_folder"));
-    std::string output;
-    // A studio project (plain backdrop: automatic masks) with the generator's exact masks.
-    ASSERT_EQ(Run("synth --output_path " + Project() +
-                      " --views 4 --width 96 --height 72 --points 300 --backdrop uniform",
-                  &output),
-              0)
-        << output;
+    MakeProject("output_folder", "--views 4 --width 96 --height 72 --points 300 --backdrop uniform");
   }
-  static void TearDownTestSuite() {
-    fs::remove_all(*root_);
-    delete root_;
-  }
-
-  static std::string Project() { return *root_ + "/project"; }
-
-  static int Run(const std::string& arguments, std::string* output) {
-    return testing::RunShell("'" + testing::RaycarveBinary() + "' " + arguments, output);
-  }
-
-  // Every file under `folder` with its bytes.
-  static std::map<std::string, std::string> Snapshot(const std::string& folder) {
-    std::map<std::string, std::string> files;
-    for (const auto& entry : fs::recursive_directory_iterator(folder)) {
-      if (entry.is_regular_file()) files[entry.path().string()] = testing::ReadFileBytes(entry.path());
-    }
-    return files;
-  }
-
-  // Exit status 1, one line naming every part, no crash.
-  static void ExpectRefused(const std::string& arguments, std::initializer_list<std::string> parts) {
-    std::string output;
-    EXPECT_EQ(Run(arguments, &output), 1) << arguments << "\n" << output;
-    for (const std::string& part : parts) {
-      EXPECT_NE(output.find(part), std::string::npos) << "'" << part << "' not in:\n" << output;
-    }
-    for (const char* crash : {"Check failed", "Aborted", "terminate", "unexpected error"}) {
-      EXPECT_EQ(output.find(crash), std::string::npos) << output;
-    }
-  }
-
-  static std::string* root_;
 };
 
-std::string* OutputFolder::root_ = nullptr;
+using testing::ExpectUserError;
+using testing::FolderSnapshot;
+
 
 TEST_F(OutputFolder, ALinkToTheUsersMasksInsideTheOutputIsRefusedNotFollowed) {
   // The user's masks elsewhere; an earlier carve's output folder whose masks/ became a link to
@@ -81,40 +44,40 @@ TEST_F(OutputFolder, ALinkToTheUsersMasksInsideTheOutputIsRefusedNotFollowed) {
       << output;
   fs::remove_all(out + "/masks");
   fs::create_directory_symlink(masks, out + "/masks");
-  const auto before = Snapshot(masks);
-  ExpectRefused("carve --workspace_path " + Project() + " --output_path " + out + " --resolution 16",
+  const auto before = FolderSnapshot(masks);
+  ExpectUserError("carve --workspace_path " + Project() + " --output_path " + out + " --resolution 16",
                 {out + "/masks", "symbolic link", masks});
-  EXPECT_EQ(Snapshot(masks), before);
+  EXPECT_EQ(FolderSnapshot(masks), before);
   // The same with --mask_path naming them.
-  ExpectRefused("carve --workspace_path " + Project() + " --output_path " + out +
+  ExpectUserError("carve --workspace_path " + Project() + " --output_path " + out +
                     " --resolution 16 --mask_path " + masks,
                 {"symbolic link"});
-  EXPECT_EQ(Snapshot(masks), before);
+  EXPECT_EQ(FolderSnapshot(masks), before);
   // A link where the mesh goes, to a user's file beside the output.
   const std::string users_file = *root_ + "/notes.ply";
   testing::WriteFile(users_file, "the user's own file\n");
   fs::remove(out + "/masks");
   fs::remove(out + "/mesh.ply");
   fs::create_symlink(users_file, out + "/mesh.ply");
-  ExpectRefused("carve --workspace_path " + Project() + " --output_path " + out + " --resolution 16",
+  ExpectUserError("carve --workspace_path " + Project() + " --output_path " + out + " --resolution 16",
                 {out + "/mesh.ply", "symbolic link"});
   EXPECT_EQ(testing::ReadFileBytes(users_file), "the user's own file\n");
 }
 
 TEST_F(OutputFolder, CalibrateHoldoutAndRenderNeverWriteIntoThePhotos) {
   const std::string photos = Project() + "/images";
-  const auto before = Snapshot(photos);
+  const auto before = FolderSnapshot(photos);
   // calibrate's undistorted/ a link to the photo folder.
   const std::string out = *root_ + "/calibrated";
   fs::create_directories(out);
   fs::create_directory_symlink(fs::absolute(photos), out + "/undistorted");
-  ExpectRefused("calibrate --workspace_path " + Project() + " --output_path " + out,
+  ExpectUserError("calibrate --workspace_path " + Project() + " --output_path " + out,
                 {out + "/undistorted", "symbolic link"});
   // holdout's folder a link to the photo folder (its images are named after the photos).
   const std::string held = *root_ + "/held";
   fs::create_directories(held);
   fs::create_directory_symlink(fs::absolute(photos), held + "/holdout");
-  ExpectRefused("holdout --workspace_path " + Project() + " --output_path " + held +
+  ExpectUserError("holdout --workspace_path " + Project() + " --output_path " + held +
                     " --resolution 16 --every 2",
                 {held + "/holdout", "symbolic link"});
   // render into the photo folder.
@@ -124,10 +87,10 @@ TEST_F(OutputFolder, CalibrateHoldoutAndRenderNeverWriteIntoThePhotos) {
                 &output),
             0)
       << output;
-  ExpectRefused("render --cloud_path " + *root_ + "/for_render/cloud.ply --input_path " +
+  ExpectUserError("render --cloud_path " + *root_ + "/for_render/cloud.ply --input_path " +
                     Project() + "/sparse/0 --image_path " + photos + " --output_path " + photos,
                 {"is the photo folder"});
-  EXPECT_EQ(Snapshot(photos), before);
+  EXPECT_EQ(FolderSnapshot(photos), before);
 }
 
 TEST_F(OutputFolder, OneRunAtATimeWritesIntoAFolderAndAKilledRunsLockDoesNotBlock) {
@@ -142,7 +105,7 @@ TEST_F(OutputFolder, OneRunAtATimeWritesIntoAFolderAndAKilledRunsLockDoesNotBloc
   ASSERT_EQ(flock(fd, LOCK_EX), 0);
   const std::string pid = std::to_string(getpid());
   ASSERT_EQ(pwrite(fd, pid.data(), pid.size(), 0), static_cast<ssize_t>(pid.size()));
-  ExpectRefused(carve, {out, "another raycarve run (process " + pid + ")", "--wait"});
+  ExpectUserError(carve, {out, "another raycarve run (process " + pid + ")", "--wait"});
   EXPECT_FALSE(fs::exists(out + "/report.json"));
   // Released (as when that run is killed: the kernel drops its lock), the file left behind with
   // the old process id does not block.

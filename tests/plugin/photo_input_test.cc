@@ -16,9 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int RunRaycarve(const std::string& arguments, std::string* output) {
-  return testing::RunShell("'" + testing::RaycarveBinary() + "' " + arguments, output);
-}
+using testing::RunRaycarve;
 
 // A generated studio project (plain backdrop) in `folder`.
 void MakeProject(const std::string& folder) {
@@ -39,12 +37,7 @@ void MakeGrey(const std::string& project, const std::string& name, int depth) {
   ASSERT_TRUE(cv::imwrite(path, grey));
 }
 
-// The number after "key": in report.json.
-double ReportNumber(const std::string& report, const std::string& key) {
-  const size_t at = report.find("\"" + key + "\":");
-  if (at == std::string::npos) return -1.0;
-  return std::stod(report.substr(at + key.size() + 3));
-}
+using testing::JsonNumber;
 
 TEST(PhotoInput, GreyPhotosAreCarvedAndNeverMaskedWhole) {
   const std::string root = testing::MakeTemporaryDirectory("photo_input_grey");
@@ -58,7 +51,7 @@ TEST(PhotoInput, GreyPhotosAreCarvedAndNeverMaskedWhole) {
     ASSERT_EQ(RunRaycarve("carve --workspace_path " + project + " --resolution 32", &output), 0) << output;
     EXPECT_EQ(output.find("kept nothing"), std::string::npos) << output;
     const std::string report = testing::ReadFileBytes(project + "/raycarve/report.json");
-    EXPECT_GT(ReportNumber(report, "cloud_points"), 1000) << report;
+    EXPECT_GT(JsonNumber(report, "cloud_points"), 1000) << report;
   }
   // One grey photo among colour ones.
   const std::string mixed = root + "/mixed";
@@ -68,7 +61,7 @@ TEST(PhotoInput, GreyPhotosAreCarvedAndNeverMaskedWhole) {
   ASSERT_EQ(RunRaycarve("carve --workspace_path " + mixed + " --resolution 32", &output), 0) << output;
   EXPECT_EQ(output.find("kept nothing"), std::string::npos) << output;
   const std::string report = testing::ReadFileBytes(mixed + "/raycarve/report.json");
-  EXPECT_GT(ReportNumber(report, "cloud_points"), 1000) << report;
+  EXPECT_GT(JsonNumber(report, "cloud_points"), 1000) << report;
   // No photo's mask is all background.
   for (const auto& entry : fs::directory_iterator(mixed + "/raycarve/masks")) {
     const cv::Mat mask = cv::imread(entry.path().string(), cv::IMREAD_GRAYSCALE);

@@ -11,11 +11,7 @@
 namespace raycarve {
 namespace {
 
-double JsonNumber(const std::string& json, const std::string& key) {
-  const size_t at = json.find("\"" + key + "\":");
-  EXPECT_NE(at, std::string::npos) << key;
-  return at == std::string::npos ? NAN : std::stod(json.substr(at + key.size() + 3));
-}
+using testing::JsonNumber;
 
 TEST(RealPhotos, TempleCarvesOntoItsSparsePointsAndRendersItsHeldOutSilhouettes) {
   RAYCARVE_REQUIRE_DATA("middlebury/templeSparseRing");

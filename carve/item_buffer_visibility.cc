@@ -44,16 +44,9 @@ void ItemBufferVisibility::Render() {
 }
 
 void ItemBufferVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels) {
-  const Eigen::Vector3i coordinates = volume_.grid().Voxel(voxel);
   const uint32_t item = static_cast<uint32_t>(voxel);
-  for (size_t v = 0; v < views_.size(); ++v) {
-    const CalibratedView& view = views_[v];
-    const Footprint footprint =
-        ComputeFootprint(view.P, view.width, view.height, volume_.grid(), coordinates);
-    const uint32_t* items = items_[v].data();
-    AppendMatchingPixels(footprint, view.width, static_cast<uint32_t>(v),
-                         [&](int pixel) { return items[pixel] == item; }, pixels);
-  }
+  AppendVoxelPixels(views_, volume_.grid(), voxel,
+                    [&](size_t v, int pixel) { return items_[v][pixel] == item; }, pixels);
 }
 
 void ItemBufferVisibility::UpdateAfterCarve(int64_t /*voxel*/,

@@ -63,18 +63,13 @@ void LayeredDepthVisibility::InsertVoxel(int64_t voxel, std::vector<int64_t>* ch
 }
 
 void LayeredDepthVisibility::ComputeVis(int64_t voxel, std::vector<PixelRef>* pixels) {
-  const Eigen::Vector3i coordinates = volume_.grid().Voxel(voxel);
   const uint32_t item = static_cast<uint32_t>(voxel);
-  for (size_t v = 0; v < views_.size(); ++v) {
-    const CalibratedView& view = views_[v];
-    const Footprint footprint =
-        ComputeFootprint(view.P, view.width, view.height, volume_.grid(), coordinates);
-    const int32_t* heads = heads_[v].data();
-    AppendMatchingPixels(
-        footprint, view.width, static_cast<uint32_t>(v),
-        [&](int pixel) { return heads[pixel] != -1 && nodes_[heads[pixel]].voxel == item; },
-        pixels);
-  }
+  AppendVoxelPixels(views_, volume_.grid(), voxel,
+                    [&](size_t v, int pixel) {
+                      const int32_t head = heads_[v][pixel];
+                      return head != -1 && nodes_[head].voxel == item;
+                    },
+                    pixels);
 }
 
 void LayeredDepthVisibility::UpdateAfterCarve(int64_t voxel,

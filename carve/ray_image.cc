@@ -323,68 +323,48 @@ bool RayImage::SkipEmptyBlocks(int pixel, const BlockOccupancy& blocks, int voxe
   constexpr int kShift = BlockOccupancy::kShift;
   constexpr int kSize = BlockOccupancy::kSize;
   const Eigen::Vector3i& n = grid_.dimensions();
-  int bx = voxel[0] >> kShift, by = voxel[1] >> kShift, bz = voxel[2] >> kShift;
+  const int bx = voxel[0] >> kShift, by = voxel[1] >> kShift, bz = voxel[2] >> kShift;
   const Eigen::Vector3i& nb = blocks.dimensions();
   const int64_t block_stride_y = nb.x(), block_stride_z = static_cast<int64_t>(nb.x()) * nb.y();
   int64_t block = bx + block_stride_y * by + block_stride_z * bz;
   if (blocks.IsOccupied(block)) return true;
   const Eigen::Vector3d d = GridDirection(pixel);
-  // Step's traversal on a grid of voxels kSize wide, per axis in scalars. The ray leaves the
+  // Step's traversal on a grid of voxels kSize wide, the state per axis. The ray leaves the
   // grid at t_exit: the last block along an axis may be partial (the grid ends at n, not at a
   // block edge), so leaving the blocks is not enough.
   double t_exit = kInfinity;
-  const auto axis_state = [&](int axis, int coordinate, int64_t stride, double* t_max,
-                              double* t_delta, int* step, int64_t* index_step) {
+  int entered[3] = {bx, by, bz}, step[3], end[3];
+  double t_max[3], t_delta[3];
+  int64_t index_step[3];
+  const int64_t stride[3] = {1, block_stride_y, block_stride_z};
+  for (int axis = 0; axis < 3; ++axis) {
     const bool up = d[axis] > 0.0;
     if (d[axis] != 0.0) {
       t_exit = std::min(t_exit, ((up ? n[axis] : 0) - centre_grid_[axis]) / d[axis]);
     }
-    *t_max = d[axis] == 0.0 ? kInfinity
-                            : ((coordinate + (up ? 1 : 0)) * kSize - centre_grid_[axis]) / d[axis];
-    *t_delta = kSize / std::abs(d[axis]);
-    *step = up ? 1 : -1;
-    *index_step = up ? stride : -stride;
-  };
-  double tx, ty, tz, dx, dy, dz;
-  int step_x, step_y, step_z;
-  int64_t index_x, index_y, index_z;
-  axis_state(0, bx, 1, &tx, &dx, &step_x, &index_x);
-  axis_state(1, by, block_stride_y, &ty, &dy, &step_y, &index_y);
-  axis_state(2, bz, block_stride_z, &tz, &dz, &step_z, &index_z);
-  // Leaving the blocks (or the grid, at t_exit) ends the search.
-  const int end_x = step_x > 0 ? nb.x() : -1, end_y = step_y > 0 ? nb.y() : -1,
-            end_z = step_z > 0 ? nb.z() : -1;
-  // The axis and parameter of the last step: where the ray enters the block it stops in.
+    t_max[axis] = d[axis] == 0.0
+                      ? kInfinity
+                      : ((entered[axis] + (up ? 1 : 0)) * kSize - centre_grid_[axis]) / d[axis];
+    t_delta[axis] = kSize / std::abs(d[axis]);
+    step[axis] = up ? 1 : -1;
+    index_step[axis] = up ? stride[axis] : -stride[axis];
+    // Leaving the blocks (or the grid, at t_exit) ends the search.
+    end[axis] = up ? nb[axis] : -1;
+  }
+  // The axis and parameter of the last step: where the ray enters the block it stops in. Ties go
+  // to the later axis.
   int axis;
   double t;
   do {
-    if (tx < ty && tx < tz) {
-      axis = 0;
-      t = tx;
-      bx += step_x;
-      if (bx == end_x) return false;
-      tx += dx;
-      block += index_x;
-    } else if (!(tx < ty) && ty < tz) {
-      axis = 1;
-      t = ty;
-      by += step_y;
-      if (by == end_y) return false;
-      ty += dy;
-      block += index_y;
-    } else {
-      axis = 2;
-      t = tz;
-      bz += step_z;
-      if (bz == end_z) return false;
-      tz += dz;
-      block += index_z;
-    }
-    if (t >= t_exit) return false;
+    axis = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+    t = t_max[axis];
+    entered[axis] += step[axis];
+    if (entered[axis] == end[axis] || t >= t_exit) return false;
+    t_max[axis] += t_delta[axis];
+    block += index_step[axis];
   } while (!blocks.IsOccupied(block));
   // The voxel where the ray enters the block: on the entered face along `axis`, and where the ray
   // is at that moment along the others (kept inside the block against rounding).
-  const int entered[3] = {bx, by, bz};
   for (int other = 0; other < 3; ++other) {
     const int first = entered[other] * kSize;
     const int last = std::min(first + kSize, n[other]) - 1;
@@ -422,15 +402,21 @@ uint32_t RayImage::FirstSolid(int pixel, const Volume& volume, const BlockOccupa
   }
 }
 
-int64_t RayImage::Advance(int pixel, const Volume& volume) {
+int64_t RayImage::StepFromCurrent(int pixel, const Volume& volume, bool skip_current,
+                                  int voxel[3]) const {
   const uint32_t key = keys_[pixel];
   if (key == kInactive) return kNoVoxel;
   const Eigen::Vector3i start = Unpack(key);
-  int voxel[3] = {start.x(), start.y(), start.z()};
+  for (int axis = 0; axis < 3; ++axis) voxel[axis] = start[axis];
   const Eigen::Vector3i& n = grid_.dimensions();
   const int end[3] = {n.x(), n.y(), n.z()};
-  const int64_t index =
-      Step(pixel, volume.solid_bits().data(), voxel, /*skip_current=*/false, kZero, end);
+  return Step(pixel, volume.solid_bits().data(), voxel, skip_current, kZero, end);
+}
+
+int64_t RayImage::Advance(int pixel, const Volume& volume) {
+  if (keys_[pixel] == kInactive) return kNoVoxel;
+  int voxel[3];
+  const int64_t index = StepFromCurrent(pixel, volume, /*skip_current=*/false, voxel);
   if (index == kNoVoxel) {
     keys_[pixel] = kInactive;
   } else {
@@ -441,13 +427,8 @@ int64_t RayImage::Advance(int pixel, const Volume& volume) {
 }
 
 int64_t RayImage::PeekBeyondCurrent(int pixel, const Volume& volume) const {
-  const uint32_t key = keys_[pixel];
-  if (key == kInactive) return kNoVoxel;
-  const Eigen::Vector3i start = Unpack(key);
-  int voxel[3] = {start.x(), start.y(), start.z()};
-  const Eigen::Vector3i& n = grid_.dimensions();
-  const int end[3] = {n.x(), n.y(), n.z()};
-  return Step(pixel, volume.solid_bits().data(), voxel, /*skip_current=*/true, kZero, end);
+  int voxel[3];
+  return StepFromCurrent(pixel, volume, /*skip_current=*/true, voxel);
 }
 
 }  // namespace raycarve

@@ -139,6 +139,9 @@ class RayImage {
                bool skip_current,
                const int lo[3],
                const int hi[3]) const;
+  // Step over the whole grid from the pixel's current voxel (kNoVoxel when the ray is inactive);
+  // `voxel` ends where Step leaves it.
+  int64_t StepFromCurrent(int pixel, const Volume& volume, bool skip_current, int voxel[3]) const;
   // From `voxel`, crosses empty blocks until the ray enters an occupied one (true; `voxel` is
   // then where it enters) or leaves the grid (false).
   bool SkipEmptyBlocks(int pixel, const BlockOccupancy& blocks, int voxel[3]) const;

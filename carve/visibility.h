@@ -4,7 +4,9 @@
 #include <string>
 #include <vector>
 
+#include "calib/calibrated_view.h"
 #include "carve/footprint.h"
+#include "carve/voxel_grid.h"
 
 namespace raycarve {
 
@@ -38,6 +40,20 @@ void AppendMatchingPixels(const Footprint& footprint, int width, uint32_t view, 
     }
   }
   pixels->resize(static_cast<size_t>(out - pixels->data()));
+}
+
+// Appends to `pixels`, view by view, every pixel of `voxel`'s footprint in each of `views` for
+// which matches(view index, pixel) holds: Vis(V) of the methods that keep a structure per view.
+template <typename Matches>
+void AppendVoxelPixels(const std::vector<CalibratedView>& views, const VoxelGrid& grid,
+                       int64_t voxel, Matches&& matches, std::vector<PixelRef>* pixels) {
+  const Eigen::Vector3i coordinates = grid.Voxel(voxel);
+  for (size_t v = 0; v < views.size(); ++v) {
+    const CalibratedView& view = views[v];
+    const Footprint footprint = ComputeFootprint(view.P, view.width, view.height, grid, coordinates);
+    AppendMatchingPixels(footprint, view.width, static_cast<uint32_t>(v),
+                         [&](int pixel) { return matches(v, pixel); }, pixels);
+  }
 }
 
 // How the carver learns which pixels see which voxel: the one thing in which ray casting, GVC

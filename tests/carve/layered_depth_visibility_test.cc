@@ -35,6 +35,16 @@ std::vector<int64_t> SurfaceVoxelsAlongRay(const Volume& volume,
   return voxels;
 }
 
+// Carves `voxel` from `volume` as the carver does and returns the voxels the lists report changed.
+std::vector<int64_t> CarveAndUpdate(int64_t voxel, Volume* volume, LayeredDepthVisibility* ldi) {
+  std::vector<PixelRef> vis;
+  ldi->ComputeVis(voxel, &vis);
+  std::vector<int64_t> exposed, changed;
+  volume->Carve(voxel, &exposed);
+  ldi->UpdateAfterCarve(voxel, vis, exposed, &changed);
+  return changed;
+}
+
 TEST(LayeredDepthVisibilityTest, ListsStaySortedAndMatchARebuildAndABruteForceAfterRandomCarvings) {
   const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(4, 64, 48));
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
@@ -42,18 +52,11 @@ TEST(LayeredDepthVisibilityTest, ListsStaySortedAndMatchARebuildAndABruteForceAf
   LayeredDepthVisibility ldi(views, volume);
 
   std::mt19937 random(5);
-  std::vector<PixelRef> vis;
-  std::vector<int64_t> exposed, changed;
   int carved = 0, compared_lists = 0, multi_layer = 0;
   for (int round = 0; round < 4; ++round) {
     for (int64_t voxel : volume.SurfaceVoxels()) {
       if (random() % 3 != 0) continue;
-      vis.clear();
-      ldi.ComputeVis(voxel, &vis);
-      exposed.clear();
-      changed.clear();
-      volume.Carve(voxel, &exposed);
-      ldi.UpdateAfterCarve(voxel, vis, exposed, &changed);
+      CarveAndUpdate(voxel, &volume, &ldi);
       ++carved;
     }
     const LayeredDepthVisibility rebuilt(views, volume);
@@ -86,8 +89,6 @@ TEST(LayeredDepthVisibilityTest, VisEqualsRayCastingAndCarvingReportsEveryVoxelT
   Volume volume(VoxelGrid(scene.object_box, 10));
   LayeredDepthVisibility ldi(views, volume);
   std::mt19937 random(9);
-  std::vector<PixelRef> vis;
-  std::vector<int64_t> exposed, changed;
   int checked = 0, gained = 0;
   for (int round = 0; round < 3; ++round) {
     for (int64_t voxel : volume.SurfaceVoxels()) {
@@ -96,12 +97,7 @@ TEST(LayeredDepthVisibilityTest, VisEqualsRayCastingAndCarvingReportsEveryVoxelT
       // be reported as changed.
       std::map<int64_t, size_t> before;
       for (int64_t other : volume.SurfaceVoxels()) before[other] = VisOf(&ldi, other).size();
-      vis.clear();
-      ldi.ComputeVis(voxel, &vis);
-      exposed.clear();
-      changed.clear();
-      volume.Carve(voxel, &exposed);
-      ldi.UpdateAfterCarve(voxel, vis, exposed, &changed);
+      const std::vector<int64_t> changed = CarveAndUpdate(voxel, &volume, &ldi);
       const std::set<int64_t> reported(changed.begin(), changed.end());
       for (int64_t other : volume.SurfaceVoxels()) {
         if (VisOf(&ldi, other).size() > before[other]) {

@@ -318,12 +318,18 @@ TEST(RayImage, RaysMissingTheBoxOrMaskedOutHaveNoVoxel) {
   EXPECT_EQ(open_rays.MemoryBytes(), 4u);  // one packed key a pixel
 }
 
-TEST(RayImage, StepsToTheNextSolidVoxelAfterCarving) {
-  Volume volume(kGrid);
+// One pixel whose ray falls straight down through the grid at (0.1, 0.1), initialised on `volume`.
+RayImage OnePixelLookingDown(const Volume& volume) {
   Eigen::Matrix3d down = Eigen::Matrix3d::Zero();
   down.col(2) = Eigen::Vector3d(0, 0, -1);
   RayImage rays(kGrid, down, Eigen::Vector3d(0.1, 0.1, 2), 1, 1);
   rays.Initialise(volume);
+  return rays;
+}
+
+TEST(RayImage, StepsToTheNextSolidVoxelAfterCarving) {
+  Volume volume(kGrid);
+  RayImage rays = OnePixelLookingDown(volume);
   const int64_t top = rays.CurrentVoxel(0);
   // Carve the top two voxels of the column: the ray skips both in one Advance.
   volume.Carve(top, nullptr);
@@ -336,10 +342,7 @@ TEST(RayImage, StepsToTheNextSolidVoxelAfterCarving) {
 
 TEST(RayImage, PeekingBeyondTheCurrentVoxelChangesNothingAndFindsWhatAdvanceWouldReach) {
   Volume volume(kGrid);
-  Eigen::Matrix3d down = Eigen::Matrix3d::Zero();
-  down.col(2) = Eigen::Vector3d(0, 0, -1);
-  RayImage rays(kGrid, down, Eigen::Vector3d(0.1, 0.1, 2), 1, 1);
-  rays.Initialise(volume);
+  RayImage rays = OnePixelLookingDown(volume);
   const int64_t top = rays.CurrentVoxel(0);
   const int64_t below = kGrid.Index(kGrid.Voxel(top) - Eigen::Vector3i(0, 0, 1));
   EXPECT_EQ(rays.PeekBeyondCurrent(0, volume), below);

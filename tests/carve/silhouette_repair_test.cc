@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <vector>
@@ -150,26 +151,33 @@ TEST_F(SilhouetteRepair, ClosesATunnelWithAMembraneNearTheSurroundingSurface) {
   // such steps leak in other photos and part the mesh.
   EXPECT_GT(summary.bridging_voxels, 0);
   EXPECT_LT(summary.bridging_voxels, summary.restored_voxels);
+  // The twelve edge neighbours: two coordinates off by one, the third the same.
+  std::vector<Eigen::Vector3i> edge_offsets;
+  for (int dx = -1; dx <= 1; ++dx) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dz = -1; dz <= 1; ++dz) {
+        if (std::abs(dx) + std::abs(dy) + std::abs(dz) == 2) edge_offsets.emplace_back(dx, dy, dz);
+      }
+    }
+  }
+  ASSERT_EQ(edge_offsets.size(), 12u);
   int edge_only = 0;
   for (int64_t index = 0; index < grid.num_voxels(); ++index) {
     if (before.IsSolid(index) || !volume.IsSolid(index)) continue;
     const Eigen::Vector3i cell = grid.Voxel(index);
-    for (int u = 0; u < 3; ++u) {
-      for (int w = u + 1; w < 3; ++w) {
-        for (int su = -1; su <= 1; su += 2) {
-          for (int sw = -1; sw <= 1; sw += 2) {
-            Eigen::Vector3i diagonal = cell, first = cell, second = cell;
-            diagonal[u] += su;
-            diagonal[w] += sw;
-            first[u] += su;
-            second[w] += sw;
-            if (!grid.Contains(diagonal) || !volume.IsSolid(grid.Index(diagonal))) continue;
-            const int64_t a = grid.Index(first), b = grid.Index(second);
-            edge_only += !volume.IsSolid(a) && !volume.IsSolid(b) &&
-                         (hull_->IsSolid(a) || hull_->IsSolid(b));
-          }
-        }
+    for (const Eigen::Vector3i& offset : edge_offsets) {
+      const Eigen::Vector3i diagonal = cell + offset;
+      if (!grid.Contains(diagonal) || !volume.IsSolid(grid.Index(diagonal))) continue;
+      // The two face neighbours shared by the voxel and its edge neighbour: one step of the
+      // offset each.
+      Eigen::Vector3i first = cell, second = cell;
+      int moved = 0;
+      for (int axis = 0; axis < 3; ++axis) {
+        if (offset[axis] == 0) continue;
+        (moved++ == 0 ? first : second)[axis] += offset[axis];
       }
+      const int64_t a = grid.Index(first), b = grid.Index(second);
+      edge_only += !volume.IsSolid(a) && !volume.IsSolid(b) && (hull_->IsSolid(a) || hull_->IsSolid(b));
     }
   }
   EXPECT_EQ(edge_only, 0);

@@ -16,25 +16,35 @@ namespace {
 using testing::Options;
 using testing::Scene;
 
-// The bits of a volume with the voxels set one by one.
-struct SolidBits {
-  explicit SolidBits(const VoxelGrid& grid) : grid(grid), bits((grid.num_voxels() + 63) / 64, 0) {}
+// Six views of the generated scene, a grid of 24 voxels over its box, and the bits of a volume
+// on it whose voxels the test sets one by one.
+class SolidComponents : public ::testing::Test {
+ protected:
+  SolidComponents()
+      : scene_(Scene(6, 120, 90)),
+        views_(testing::SceneViews(scene_)),
+        grid_(scene_.object_box, 24),
+        bits_((grid_.num_voxels() + 63) / 64, 0) {}
+
   void Set(int x, int y, int z) {
-    const int64_t i = grid.Index(Eigen::Vector3i(x, y, z));
-    bits[i >> 6] |= uint64_t{1} << (i & 63);
+    const int64_t i = grid_.Index(Eigen::Vector3i(x, y, z));
+    bits_[i >> 6] |= uint64_t{1} << (i & 63);
   }
-  const VoxelGrid& grid;
-  std::vector<uint64_t> bits;
+  // The volume of the voxels set so far (once).
+  Volume TakeVolume() { return Volume(grid_, std::move(bits_)); }
+
+  const SyntheticScene scene_;
+  const std::vector<CalibratedView> views_;
+  const VoxelGrid grid_;
+  std::vector<uint64_t> bits_;
 };
 
-TEST(IncrementalCarver, SmallComponentsAreCarvedAndTheirRaysStepOn) {
-  const SyntheticScene scene = Scene(6, 120, 90);
-  const std::vector<CalibratedView> views = testing::SceneViews(scene);
-  const VoxelGrid grid(scene.object_box, 24);
+TEST_F(SolidComponents, SmallComponentsAreCarvedAndTheirRaysStepOn) {
+  const std::vector<CalibratedView>& views = views_;
+  const VoxelGrid& grid = grid_;
   // A slab along the bottom (one big component), a lone voxel, a diagonal pair (26-connected:
   // one component of 2) and a 3x3x3 cube, all in empty space.
-  SolidBits bits(grid);
-  const auto set = [&](int x, int y, int z) { bits.Set(x, y, z); };
+  const auto set = [&](int x, int y, int z) { Set(x, y, z); };
   const Eigen::Vector3i& n = grid.dimensions();
   for (int y = 0; y < n.y(); ++y) {
     for (int x = 0; x < n.x(); ++x) set(x, y, 0), set(x, y, 1);
@@ -46,7 +56,7 @@ TEST(IncrementalCarver, SmallComponentsAreCarvedAndTheirRaysStepOn) {
       for (int x = 16; x < 19; ++x) set(x, y, z);
     }
   }
-  IncrementalCarver carver(views, Volume(grid, std::move(bits.bits)), Options(24, 30.0));
+  IncrementalCarver carver(views, TakeVolume(), Options(24, 30.0));
   const int64_t slab = 2 * static_cast<int64_t>(n.x()) * n.y();
   ASSERT_EQ(carver.volume().num_solid(), slab + 1 + 2 + 27);
   // Before any carving, so that the specks still stop rays. Components of 1 and 2 voxels go with
@@ -82,12 +92,10 @@ TEST(IncrementalCarver, SmallComponentsAreCarvedAndTheirRaysStepOn) {
 // fourth column of two layers, all of them surface: 1 per 8 surface voxels) a cube of 26
 // surface voxels should hold about 3.3: the bare cube goes, the one with a point stays, the lone
 // voxel (expected 0.13) stays, and so does the slab.
-TEST(IncrementalCarver, PiecesWithoutTheSparsePointsTheirSizePredictsAreCarved) {
-  const SyntheticScene scene = Scene(6, 120, 90);
-  const std::vector<CalibratedView> views = testing::SceneViews(scene);
-  const VoxelGrid grid(scene.object_box, 24);
-  SolidBits bits(grid);
-  const auto set = [&](int x, int y, int z) { bits.Set(x, y, z); };
+TEST_F(SolidComponents, PiecesWithoutTheSparsePointsTheirSizePredictsAreCarved) {
+  const std::vector<CalibratedView>& views = views_;
+  const VoxelGrid& grid = grid_;
+  const auto set = [&](int x, int y, int z) { Set(x, y, z); };
   const Eigen::Vector3i& n = grid.dimensions();
   std::vector<SurfacePoint> points;
   for (int y = 0; y < n.y(); ++y) {
@@ -110,7 +118,7 @@ TEST(IncrementalCarver, PiecesWithoutTheSparsePointsTheirSizePredictsAreCarved) 
   on_cube.xyz = grid.Centre(Eigen::Vector3i(15, 15, 8));  // just above the second cube
   points.push_back(on_cube);
   set(20, 4, 6);
-  IncrementalCarver carver(views, Volume(grid, std::move(bits.bits)), Options(24, 30.0));
+  IncrementalCarver carver(views, TakeVolume(), Options(24, 30.0));
   const int64_t solid = carver.volume().num_solid();
   int64_t components = 0;
   double expected = 0.0;

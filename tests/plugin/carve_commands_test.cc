@@ -19,27 +19,7 @@ namespace fs = std::filesystem;
 using testing::ExpectUserError;
 using testing::JsonNumber;
 
-// A generated project of 4 RADIAL photos of 96 x 72 pixels, 300 sparse points.
-class CarveCommands : public testing::GeneratedProject {
- protected:
-  static void SetUpTestSuite() {
-    MakeProject("carvecommands",
-                "--views 4 --width 96 --height 72 --points 300 --camera_model RADIAL");
-  }
-
-  // A copy of the project's model in `format` (BIN as written, or TXT) to corrupt.
-  static std::string CopyModel(const std::string& name, const std::string& format = "BIN") {
-    const std::string copy = *root_ + "/" + name;
-    fs::remove_all(copy);
-    std::string output;
-    EXPECT_EQ(Run("model_converter --input_path " + Project() + "/sparse/0 --output_path " + copy +
-                      " --output_type " + format,
-                  &output),
-              0)
-        << output;
-    return copy;
-  }
-};
+class CarveCommands : public testing::SmallRadialProject {};
 
 TEST_F(CarveCommands, CalibrateWritesViewsAndAReportWithExactReprojection) {
   const std::string out = *root_ + "/calibration";

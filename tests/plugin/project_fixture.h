@@ -33,7 +33,28 @@ class GeneratedProject : public ::testing::Test {
     return RunRaycarve(arguments, output);
   }
 
+  // A copy of the project's model in `format` (BIN as written, or TXT) to corrupt.
+  static std::string CopyModel(const std::string& name, const std::string& format = "BIN") {
+    const std::string copy = *root_ + "/" + name;
+    std::filesystem::remove_all(copy);
+    std::string output;
+    EXPECT_EQ(Run("model_converter --input_path " + Project() + "/sparse/0 --output_path " + copy +
+                      " --output_type " + format,
+                  &output),
+              0)
+        << output;
+    return copy;
+  }
+
   static inline std::string* root_ = nullptr;
+};
+
+// A project of 4 RADIAL photos of 96 x 72 pixels and 300 sparse points.
+class SmallRadialProject : public GeneratedProject {
+ protected:
+  static void SetUpTestSuite() {
+    MakeProject("radial_project", "--views 4 --width 96 --height 72 --points 300 --camera_model RADIAL");
+  }
 };
 
 }  // namespace testing

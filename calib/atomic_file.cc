@@ -8,6 +8,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <glog/logging.h>
@@ -28,6 +29,26 @@ void RenameIntoPlace(const std::string& temporary, const std::string& path) {
     std::filesystem::remove(temporary, error);
     throw InputError(path + ": cannot move the written file into place: " + error.message());
   }
+}
+
+std::string WriteFailureReason(const std::string& path, int saved_errno) {
+  if (saved_errno != 0) return std::strerror(saved_errno);
+  // Streams and libraries do not always keep errno: ask the file system.
+  struct statvfs info;
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  if (statvfs(folder.empty() ? "." : folder.c_str(), &info) == 0) {
+    if ((info.f_flag & ST_RDONLY) != 0) return std::strerror(EROFS);
+    if (info.f_bavail == 0 || info.f_favail == 0) return std::strerror(ENOSPC);
+  }
+  return "";
+}
+
+void ThrowWriteFailure(const std::string& temporary, const std::string& what, int saved_errno) {
+  std::string reason = WriteFailureReason(temporary, saved_errno);
+  if (reason.empty()) reason = "the write failed";
+  std::error_code ignored;
+  std::filesystem::remove(temporary, ignored);
+  throw InputError(temporary + ": cannot write " + what + ": " + reason);
 }
 
 void CheckNoLinkInside(const std::string& folder, const std::string& relative) {
@@ -117,6 +138,15 @@ StagedOutputs::~StagedOutputs() {
   std::error_code ignored;
   if (!staging_.empty()) std::filesystem::remove_all(staging_, ignored);
   if (lock_fd_ >= 0) close(lock_fd_);  // releases the lock
+}
+
+void StagedOutputs::Write(const std::function<void()>& write) const {
+  try {
+    write();
+  } catch (const InputError& error) {
+    throw InputError(std::string(error.what()) + "; nothing was replaced in " + folder_ +
+                     ": the outputs already there are as they were");
+  }
 }
 
 void StagedOutputs::MoveIntoPlace(const std::string& last) {

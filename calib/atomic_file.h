@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <string>
 
 namespace raycarve {
@@ -13,6 +14,16 @@ std::string TemporaryPathFor(const std::string& path);
 
 // Renames `temporary` to `path`; throws InputError naming `path` on failure.
 void RenameIntoPlace(const std::string& temporary, const std::string& path);
+
+// Why writing `path` failed: the system's reason `saved_errno` (errno just after the failure)
+// when it is one, else what the file system holding `path` says (full, read-only), else "" (no
+// reason known).
+std::string WriteFailureReason(const std::string& path, int saved_errno);
+
+// Removes `temporary` (a partial write) and throws InputError "<temporary>: cannot write <what>:
+// <reason>". Call it with errno as it was just after the failed write.
+[[noreturn]] void ThrowWriteFailure(const std::string& temporary, const std::string& what,
+                                    int saved_errno);
 
 // Throws InputError when a write of `relative` (a path relative to the output folder `folder`)
 // would go through or onto a symbolic link inside `folder`: raycarve does not follow links in
@@ -41,6 +52,10 @@ class StagedOutputs {
   StagedOutputs& operator=(const StagedOutputs&) = delete;
 
   const std::string& path() const { return staging_; }
+  // Runs `write`, which writes the outputs under path(); an InputError from it (a disk that
+  // fills, a file system that turns read-only) is thrown again saying that the outputs already in
+  // the folder were left as they were.
+  void Write(const std::function<void()>& write) const;
   void MoveIntoPlace(const std::string& last);
 
  private:

@@ -28,15 +28,14 @@ void WriteAtomically(const std::filesystem::path& path,
                      bool binary) {
   const std::string temporary = TemporaryPathFor(path.string());
   {
+    errno = 0;
     std::ofstream stream(temporary, binary ? std::ios::binary : std::ios::out);
     if (!stream) {
       throw InputError(temporary + ": cannot open for writing: " + std::strerror(errno));
     }
     write(stream);
-    stream.flush();
-    if (!stream) {
-      throw InputError(temporary + ": write failed");
-    }
+    stream.close();
+    if (!stream) ThrowWriteFailure(temporary, "the model file", errno);
   }
   RenameIntoPlace(temporary, path.string());
 }

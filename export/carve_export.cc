@@ -1,5 +1,6 @@
 #include "export/carve_export.h"
 
+#include <cerrno>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -297,6 +298,7 @@ std::vector<ColouredPoint> SampleMeshPoints(const ModelMesh& model,
 
 void WritePointVisibility(const std::vector<std::vector<uint32_t>>& visibility, const std::string& path) {
   const std::string temporary = TemporaryPathFor(path);
+  errno = 0;
   std::ofstream file(temporary, std::ios::binary);
   auto put = [&file](auto value) {
     // Little-endian on every platform this builds for (x86-64, arm64).
@@ -308,7 +310,7 @@ void WritePointVisibility(const std::vector<std::vector<uint32_t>>& visibility, 
     for (uint32_t image : images) put(image);
   }
   file.close();
-  if (!file) throw InputError(temporary + ": cannot write the point visibility");
+  if (!file) ThrowWriteFailure(temporary, "the point visibility", errno);
   RenameIntoPlace(temporary, path);
 }
 

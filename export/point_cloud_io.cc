@@ -1,5 +1,6 @@
 #include "export/point_cloud_io.h"
 
+#include <cerrno>
 #include <cmath>
 #include <fstream>
 
@@ -63,19 +64,21 @@ void WritePointCloudPly(const std::vector<ColouredPoint>& points, const std::str
   if (cloud.empty()) {
     // PCL refuses to write an empty cloud; an empty carve still gets a valid PLY, with the same
     // properties, that every reader opens.
+    errno = 0;
     std::ofstream file(temporary, std::ios::binary);
     file << "ply\nformat binary_little_endian 1.0\ncomment raycarve: no points\nelement vertex 0\n"
             "property float x\nproperty float y\nproperty float z\nproperty float nx\n"
             "property float ny\nproperty float nz\nproperty uchar red\nproperty uchar green\n"
             "property uchar blue\nend_header\n";
-    if (!file) throw InputError(temporary + ": cannot write the point cloud");
     file.close();
+    if (!file) ThrowWriteFailure(temporary, "the point cloud", errno);
     RenameIntoPlace(temporary, path);
     return;
   }
   pcl::PLYWriter writer;
+  errno = 0;
   if (writer.write(temporary, cloud, /*binary=*/true, /*use_camera=*/false) != 0) {
-    throw InputError(temporary + ": PCL could not write the point cloud");
+    ThrowWriteFailure(temporary, "the point cloud (PCL)", errno);
   }
   RenameIntoPlace(temporary, path);
 }

@@ -1,5 +1,6 @@
 #include "export/surface_mesh.h"
 
+#include <cerrno>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -514,14 +515,15 @@ void WriteMeshPly(const TriangleMesh& mesh, const std::string& path) {
   if (mesh.triangles.empty()) {
     // PCL refuses to write a mesh without vertices; an empty carve still gets a valid PLY with
     // the same elements and properties.
+    errno = 0;
     std::ofstream file(temporary, std::ios::binary);
     file << "ply\nformat binary_little_endian 1.0\ncomment raycarve: empty mesh\nelement vertex 0\n"
             "property float x\nproperty float y\nproperty float z\nproperty float nx\n"
             "property float ny\nproperty float nz\nproperty uchar red\nproperty uchar green\n"
             "property uchar blue\nelement face 0\nproperty list uchar int vertex_indices\n"
             "end_header\n";
-    if (!file) throw InputError(temporary + ": cannot write the mesh");
     file.close();
+    if (!file) ThrowWriteFailure(temporary, "the mesh", errno);
     RenameIntoPlace(temporary, path);
     return;
   }
@@ -557,8 +559,9 @@ void WriteMeshPly(const TriangleMesh& mesh, const std::string& path) {
                      static_cast<pcl::index_t>(t[2])};
     polygon_mesh.polygons.push_back(face);
   }
+  errno = 0;
   if (pcl::io::savePLYFileBinary(temporary, polygon_mesh) != 0) {
-    throw InputError(temporary + ": PCL could not write the mesh");
+    ThrowWriteFailure(temporary, "the mesh (PCL)", errno);
   }
   RenameIntoPlace(temporary, path);
 }

@@ -390,25 +390,27 @@ void CarvePipeline::WriteOutputs() {
   CHECK(staged_) << "PlanOutputs must run before WriteOutputs";
   const Clock::time_point start = Clock::now();
   const fs::path out(staged_->path());
-  exporter::WritePointCloudPly(points_, (out / "cloud.ply").string());
-  if (request_.mesh_kind == "voxels") {
-    const exporter::MeshSummary mesh = exporter::WriteVoxelMeshPly(*run_.result, (out / "mesh.ply").string());
-    run_.num_mesh_triangles = mesh.num_triangles;
-    run_.num_mesh_vertices = mesh.num_vertices;
-  } else {
-    exporter::WritePointVisibility(visibility_, (out / "cloud.ply.vis").string());
-    if (mesh_written_.valid()) mesh_written_.get();
-    WriteDenseWorkspace(out);
-  }
-  RecordSeconds("export", export_seconds_ + SecondsSince(start));
-  WriteMasks(out);
-  std::ostringstream csv;
-  csv << "seconds,carved,evaluated\n";
-  for (const CurveSample& sample : run_.result->statistics.curve) {
-    csv << sample.seconds << "," << sample.carved << "," << sample.evaluated << "\n";
-  }
-  WriteTextFileAtomically((out / "convergence.csv").string(), csv.str());
-  WriteTextFileAtomically((out / "report.json").string(), CarveReportJson(request_, run_));
+  staged_->Write([&] {
+    exporter::WritePointCloudPly(points_, (out / "cloud.ply").string());
+    if (request_.mesh_kind == "voxels") {
+      const exporter::MeshSummary mesh = exporter::WriteVoxelMeshPly(*run_.result, (out / "mesh.ply").string());
+      run_.num_mesh_triangles = mesh.num_triangles;
+      run_.num_mesh_vertices = mesh.num_vertices;
+    } else {
+      exporter::WritePointVisibility(visibility_, (out / "cloud.ply.vis").string());
+      if (mesh_written_.valid()) mesh_written_.get();
+      WriteDenseWorkspace(out);
+    }
+    RecordSeconds("export", export_seconds_ + SecondsSince(start));
+    WriteMasks(out);
+    std::ostringstream csv;
+    csv << "seconds,carved,evaluated\n";
+    for (const CurveSample& sample : run_.result->statistics.curve) {
+      csv << sample.seconds << "," << sample.carved << "," << sample.evaluated << "\n";
+    }
+    WriteTextFileAtomically((out / "convergence.csv").string(), csv.str());
+    WriteTextFileAtomically((out / "report.json").string(), CarveReportJson(request_, run_));
+  });
   staged_->MoveIntoPlace("report.json");
 }
 

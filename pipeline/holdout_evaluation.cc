@@ -259,16 +259,19 @@ HoldoutEvaluation EvaluateHeldOutViews(const CarveRequest& request, const Holdou
     }
     evaluation.carved = true;
   }
-  for (const CalibratedView& view : held_out) {
-    evaluation.views.push_back(ScoreView(scored, evaluation.render, grid, view, out));
-  }
-  AverageScores(&evaluation);
-  if (evaluation.render == "mesh" && evaluation.carved) {
-    // The model that was scored, for a look at it.
-    exporter::WriteMeshPly(scored.model.mesh, (out / "mesh.ply").string());
-    evaluation.wrote_mesh = true;
-  }
-  WriteTextFileAtomically((out / "holdout.json").string(), HoldoutJson(options, pipeline, scored, evaluation));
+  staged.Write([&] {
+    for (const CalibratedView& view : held_out) {
+      evaluation.views.push_back(ScoreView(scored, evaluation.render, grid, view, out));
+    }
+    AverageScores(&evaluation);
+    if (evaluation.render == "mesh" && evaluation.carved) {
+      // The model that was scored, for a look at it.
+      exporter::WriteMeshPly(scored.model.mesh, (out / "mesh.ply").string());
+      evaluation.wrote_mesh = true;
+    }
+    WriteTextFileAtomically((out / "holdout.json").string(),
+                            HoldoutJson(options, pipeline, scored, evaluation));
+  });
   staged.MoveIntoPlace("holdout.json");
   evaluation.output_folder = final_out.string();
   return evaluation;

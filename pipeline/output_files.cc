@@ -35,16 +35,12 @@ void CheckNotAProtectedFile(const std::string& output_path) {
 void WriteTextFileAtomically(const std::string& path, const std::string& text) {
   const std::string temporary = TemporaryPathFor(path);
   {
+    errno = 0;
     std::ofstream stream(temporary);
     if (!stream) throw InputError(temporary + ": cannot open for writing: " + std::strerror(errno));
     stream << text;
-    if (!stream.flush()) {
-      const std::string reason = std::strerror(errno);
-      stream.close();
-      std::error_code ignored;
-      std::filesystem::remove(temporary, ignored);
-      throw InputError(temporary + ": write failed (" + reason + "); " + path + " is unchanged");
-    }
+    stream.close();
+    if (!stream) ThrowWriteFailure(temporary, "the file (" + path + " is unchanged)", errno);
   }
   RenameIntoPlace(temporary, path);
 }
@@ -52,19 +48,19 @@ void WriteTextFileAtomically(const std::string& path, const std::string& text) {
 void WriteImageAtomically(const std::string& path, const cv::Mat& image) {
   const std::string temporary = TemporaryPathFor(path);
   bool written = false;
+  errno = 0;
   try {
     written = cv::imwrite(temporary, image);
   } catch (const cv::Exception& error) {
     throw InputError(temporary + ": cannot write the image (" + error.err + ")");
   }
   if (!written) {
-    // imwrite says no more: whether the folder takes a file says why.
-    std::ofstream probe(temporary);
-    const std::string reason = probe ? std::string("the encoder failed") : std::strerror(errno);
-    probe.close();
+    // imwrite says no more: errno or the file system says why, unless the encoder refused.
+    const std::string reason = WriteFailureReason(temporary, errno);
     std::error_code ignored;
     std::filesystem::remove(temporary, ignored);
-    throw InputError(temporary + ": cannot write the image: " + reason);
+    throw InputError(temporary + ": cannot write the image: " +
+                     (reason.empty() ? std::string("the encoder failed") : reason));
   }
   RenameIntoPlace(temporary, path);
 }

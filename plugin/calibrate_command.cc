@@ -262,10 +262,12 @@ int RunCalibrate(int argc, char** argv) {
   // last: an interrupted run leaves the previous set whole.
   StagedOutputs staged(output_path);
   const std::filesystem::path stage(staged.path());
-  WriteUndistorted(project.views, targets, root, stage);
+  staged.Write([&] {
+    WriteUndistorted(project.views, targets, root, stage);
+    WriteTextFileAtomically((stage / "report.json").string(),
+                            report.Json(project.model_path, project.image_path, views));
+  });
   const std::string report_path = (root / "report.json").string();
-  WriteTextFileAtomically((stage / "report.json").string(),
-                          report.Json(project.model_path, project.image_path, views));
   staged.MoveIntoPlace("report.json");
   std::cout << report.Table() << bounds.Summary() << "\n"
             << project.view_summary.Summary() << "\n"

@@ -131,6 +131,61 @@ TEST_F(OutputFolder, OneRunAtATimeWritesIntoAFolderAndAKilledRunsLockDoesNotBloc
   }
 }
 
+// A small file system of its own (tmpfs) for the output folder: needs root and a system that
+// lets it mount, else the test is skipped.
+class MountedFolder {
+ public:
+  explicit MountedFolder(const std::string& path) : path_(path) {
+    fs::create_directories(path_);
+    std::string output;
+    mounted_ = geteuid() == 0 &&
+               testing::RunShell("mount -t tmpfs -o size=4m tmpfs '" + path_ + "'", &output) == 0;
+  }
+  ~MountedFolder() {
+    std::string output;
+    if (mounted_) testing::RunShell("umount '" + path_ + "'", &output);
+  }
+  bool mounted() const { return mounted_; }
+  // Remounts the file system read-only.
+  bool MakeReadOnly() {
+    std::string output;
+    return testing::RunShell("mount -o remount,ro '" + path_ + "'", &output) == 0;
+  }
+
+ private:
+  std::string path_;
+  bool mounted_ = false;
+};
+
+TEST_F(OutputFolder, ADiskThatFillsOrTurnsReadOnlyLeavesTheEarlierOutputsWhole) {
+  MountedFolder disk(*root_ + "/small_disk");
+  if (!disk.mounted()) GTEST_SKIP() << "cannot mount a tmpfs here (needs root and CAP_SYS_ADMIN)";
+  const std::string out = *root_ + "/small_disk/out";
+  const std::string carve = "carve --workspace_path " + Project() + " --output_path " + out;
+  std::string output;
+  ASSERT_EQ(Run(carve + " --resolution 16", &output), 0) << output;
+  // Every output but the lock file, which holds the last run's process id.
+  const auto outputs = [&] {
+    auto files = FolderSnapshot(out);
+    files.erase(out + "/.raycarve.lock");
+    return files;
+  };
+  const auto before = outputs();
+  ASSERT_TRUE(before.count(out + "/cloud.ply"));
+  // Fill the disk, then carve finer: larger outputs that do not fit.
+  const std::string filler = *root_ + "/small_disk/filler";
+  testing::RunShell("dd if=/dev/zero of='" + filler + "' bs=64k 2> /dev/null", &output);
+  ExpectUserError(carve + " --resolution 48",
+                  {"No space left on device", "nothing was replaced in " + out,
+                   "the outputs already there are as they were"});
+  EXPECT_EQ(outputs(), before);
+  fs::remove(filler);
+  // The same disk read-only: the run cannot even take the folder's lock or stage; nothing changes.
+  ASSERT_TRUE(disk.MakeReadOnly());
+  ExpectUserError(carve + " --resolution 48", {out, "Read-only file system"});
+  EXPECT_EQ(outputs(), before);
+}
+
 TEST_F(OutputFolder, FilesystemFailuresAreInputErrorsNamingThePath) {
   // Permissions bind only an unprivileged user: as root, each command runs as nobody (setpriv).
   std::string as_user;

@@ -68,6 +68,17 @@ double PhysicalMemoryBytes() {
   return pages > 0 && page_size > 0 ? static_cast<double>(pages) * page_size : 0.0;
 }
 
+void CheckFitsInMemory(double bytes, const std::string& what, const std::string& how,
+                       const std::string& remedy) {
+  const double physical = PhysicalMemoryBytes();
+  if (physical <= 0.0 || bytes <= kUsableMemoryShare * physical) return;
+  std::ostringstream text;
+  text << std::setprecision(3) << what << " needs about " << bytes / (1 << 30) << " GiB (" << how
+       << "), more than " << 100 * kUsableMemoryShare << "% of this machine's "
+       << physical / (1 << 30) << " GiB: " << remedy;
+  throw InputError(text.str());
+}
+
 void CheckPhotosFitInMemory(const Reconstruction& reconstruction, int max_image_size,
                             double physical_bytes) {
   if (physical_bytes <= 0.0) physical_bytes = PhysicalMemoryBytes();

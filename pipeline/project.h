@@ -95,6 +95,12 @@ constexpr double kUsableMemoryShare = 0.75;
 // This machine's memory in bytes (0 when unknown).
 double PhysicalMemoryBytes();
 
+// Refuses, before it is allocated, work that needs about `bytes` when that is more than
+// kUsableMemoryShare of this machine's memory: InputError "<what> needs about X GiB (<how>), more
+// than 75% of this machine's Y GiB: <remedy>". Unknown memory: accepted.
+void CheckFitsInMemory(double bytes, const std::string& what, const std::string& how,
+                       const std::string& remedy);
+
 // Refuses, before any photo is read, a project whose photos (reduced to `max_image_size`) would
 // need more than kUsableMemoryShare of `physical_bytes` (0: this machine's memory): the
 // message gives the estimate and a --max_image_size that fits.

@@ -25,16 +25,11 @@ constexpr double kBytesPerMeshSample = 80.0;
 // Refuses, before anything is allocated, a --mesh_samples whose clouds would not fit in
 // kUsableMemoryShare of this machine's memory, with the count that fits.
 void CheckSamplesFitInMemory(int mesh_samples) {
-  const double physical = PhysicalMemoryBytes();
-  const double needed = kBytesPerMeshSample * mesh_samples;
-  if (physical <= 0.0 || needed <= kUsableMemoryShare * physical) return;
-  const long long fits = static_cast<long long>(kUsableMemoryShare * physical / kBytesPerMeshSample);
-  std::ostringstream text;
-  text << std::setprecision(3) << "--mesh_samples " << mesh_samples << ": comparing needs about "
-       << needed / (1 << 30) << " GiB (" << kBytesPerMeshSample << " bytes a sample), more than "
-       << 100 * kUsableMemoryShare << "% of this machine's " << physical / (1 << 30)
-       << " GiB: give at most " << fits;
-  throw InputError(text.str());
+  const double fits = kUsableMemoryShare * PhysicalMemoryBytes() / kBytesPerMeshSample;
+  CheckFitsInMemory(kBytesPerMeshSample * mesh_samples,
+                    "--mesh_samples " + std::to_string(mesh_samples) + ": comparing",
+                    std::to_string(static_cast<int>(kBytesPerMeshSample)) + " bytes a sample",
+                    "give at most " + std::to_string(static_cast<long long>(fits)));
 }
 
 }  // namespace

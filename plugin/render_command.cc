@@ -1,5 +1,7 @@
 // raycarve render: a coloured cloud drawn into the cameras of a COLMAP model.
+#include <algorithm>
 #include <cstdio>
+#include <string>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -18,8 +20,16 @@
 #include "plugin/option_parser.h"
 #include "pipeline/json_writer.h"
 #include "pipeline/output_files.h"
+#include "pipeline/project.h"
 
 namespace raycarve {
+namespace {
+
+// Memory a rendered pixel holds: the photo and the render (RGB), their side-by-side image, the
+// depth buffer, the silhouette and the BGR copies written.
+constexpr double kBytesPerRenderedPixel = 24.0;
+
+}  // namespace
 int RunRender(int argc, char** argv) {
   std::string input, model_path, image_path, output_path, names;
   double point_size = 0.0;
@@ -53,10 +63,21 @@ int RunRender(int argc, char** argv) {
   std::error_code error;
   std::filesystem::create_directories(output_path, error);
   if (error) throw InputError(output_path + ": cannot create: " + error.message());
+  // Each camera is drawn in turn: the largest one's images must fit.
+  double largest_pixels = 0.0;
+  for (const auto& [id, camera] : model.cameras) {
+    largest_pixels = std::max(largest_pixels, static_cast<double>(camera.width) * camera.height);
+  }
+  CheckFitsInMemory(kBytesPerRenderedPixel * largest_pixels,
+                    "raycarve render: a camera of " + model_path,
+                    std::to_string(static_cast<int>(largest_pixels)) + " pixels, " +
+                        std::to_string(static_cast<int>(kBytesPerRenderedPixel)) + " bytes each",
+                    "render a model with smaller cameras");
   int rendered = 0;
+  std::set<std::string> found;
   for (const auto& [id, image] : model.images) {
     if (!wanted.empty() && !wanted.count(image.name)) continue;
-    wanted.erase(image.name);
+    found.insert(image.name);
     const Camera& camera = model.cameras.at(image.camera_id);
     cv::Mat rgb(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC3,
                 cv::Scalar(0, 0, 0));
@@ -86,8 +107,10 @@ int RunRender(int argc, char** argv) {
     }
     ++rendered;
   }
-  if (!wanted.empty()) {
-    throw InputError(model_path + ": no image named '" + *wanted.begin() + "' in the model");
+  for (const std::string& missing : wanted) {
+    if (!found.count(missing)) {
+      throw InputError(model_path + ": no image named '" + missing + "' in the model");
+    }
   }
   std::printf("render: drew %zu points into %d cameras of %s; images in %s\n", points.size(),
               rendered, model_path.c_str(), output_path.c_str());

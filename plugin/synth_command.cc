@@ -4,6 +4,7 @@
 
 #include "calib/input_error.h"
 #include "calib/view_reader.h"
+#include "pipeline/project.h"
 #include "plugin/commands.h"
 #include "plugin/option_parser.h"
 #include "samples/synthetic_scene.h"
@@ -73,6 +74,13 @@ int RunSynth(int argc, char** argv) {
   SceneKindFromString(scene_kind, &options.scene);
   std::string reason;
   if (!options.IsValid(&reason)) throw InputError("raycarve synth: " + reason);
+  // Measured peak memory: about 4 bytes a photo pixel (photo and mask) and 36 bytes a sparse
+  // point's observation (its track and the image's point), counted here with room to spare.
+  const double pixels = static_cast<double>(options.num_views) * options.width * options.height;
+  const double observations = static_cast<double>(options.num_surface_samples) * options.num_views;
+  CheckFitsInMemory(8.0 * pixels + 48.0 * observations, "this scene",
+                    "8 bytes a photo pixel, 48 bytes a point in each view",
+                    "give fewer --views, --points or smaller --width and --height");
 
   LOG(INFO) << "rendering " << options.num_views << " views of " << options.width << "x"
             << options.height << " (" << camera_model << ")";

@@ -378,6 +378,30 @@ TEST_F(CarveCommands, BenchmarkComparesTheThreeMethodsInATableAPlotAndJson) {
   EXPECT_GT(cv::countNonZero(silhouette), 200);  // the carved scene covers much of the view
   EXPECT_TRUE(fs::is_regular_file(out + "/render/view002.png.side.png"));
   EXPECT_FALSE(fs::exists(out + "/render/view001.png.render.png"));
+  EXPECT_FALSE(fs::exists(out + "/render/view004.png.render.png"));
+  EXPECT_NE(output.find("into 1 cameras"), std::string::npos) << output;
+  // Exactly the named images, also where image ids are not in name order: the first and the
+  // last image's names swapped in a text copy of the model.
+  const std::string swapped = CopyModel("swapped_names", "TXT");
+  std::string images = testing::ReadFileBytes(swapped + "/images.txt");
+  const size_t first = images.find("view001.png"), last = images.find("view004.png");
+  ASSERT_NE(first, std::string::npos);
+  ASSERT_NE(last, std::string::npos);
+  images.replace(last, 11, "view001.png");
+  images.replace(first, 11, "view004.png");
+  testing::WriteFile(swapped + "/images.txt", images);
+  ASSERT_EQ(Run("render --input " + out + "/benchmark/cloud_ray.ply --input_path " + swapped +
+                    " --output_path " + out + "/render_swapped --image_names view004.png,view002.png",
+                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("into 2 cameras"), std::string::npos) << output;
+  for (const char* name : {"view001.png", "view003.png"}) {
+    EXPECT_FALSE(fs::exists(out + "/render_swapped/" + name + ".render.png")) << name;
+  }
+  for (const char* name : {"view002.png", "view004.png"}) {
+    EXPECT_TRUE(fs::exists(out + "/render_swapped/" + name + ".render.png")) << name;
+  }
   ExpectUserError("render --input " + out + "/benchmark/cloud_ray.ply --input_path " + Project() +
                       "/sparse/0 --output_path " + out + "/render --image_names nope.png",
                   {"no image named 'nope.png'"});

@@ -276,5 +276,15 @@ TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
   EXPECT_TRUE(fs::is_regular_file(few + "/out/cloud.ply"));
 }
 
+TEST_F(CommandLine, SizesThatAnOptionChoosesAreEstimatedBeforeAllocation) {
+  // Far more than any machine holds: refused with the estimate before anything is made.
+  ExpectUserError("synth --output_path " + *root_ + "/huge --views 100000000 --width 64 --height 48",
+                  {"this scene needs about", "GiB", "--views"});
+  EXPECT_FALSE(fs::exists(*root_ + "/huge"));
+  ExpectUserError("compare --reference_path " + *root_ + "/a.ply --input_path " + *root_ +
+                      "/b.ply --mesh_samples 2000000000",
+                  {"--mesh_samples 2000000000", "GiB", "give at most"});
+}
+
 }  // namespace
 }  // namespace raycarve

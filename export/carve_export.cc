@@ -1,12 +1,13 @@
 #include "export/carve_export.h"
 
-#include <cerrno>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <vector>
 
 #include <glog/logging.h>
 
@@ -166,6 +167,48 @@ std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid&
   return on_wall;
 }
 
+void RemoveGridWalls(ModelMesh* model) {
+  TriangleMesh& mesh = model->mesh;
+  CHECK(model->on_grid_wall.size() == mesh.vertices.size());
+  model->triangles_before_walls = static_cast<int64_t>(mesh.triangles.size());
+  std::vector<Eigen::Vector3i> kept;
+  kept.reserve(mesh.triangles.size());
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    if (model->on_grid_wall[t[0]] && model->on_grid_wall[t[1]] && model->on_grid_wall[t[2]]) {
+      ++model->wall_triangles_removed;
+    } else {
+      kept.push_back(t);
+    }
+  }
+  if (model->wall_triangles_removed == 0) return;
+  mesh.triangles = std::move(kept);
+  // The vertices still used, renumbered in order, with everything kept per vertex.
+  std::vector<int> new_index(mesh.vertices.size(), -1);
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    for (int j = 0; j < 3; ++j) new_index[t[j]] = 0;
+  }
+  int next = 0;
+  for (int& index : new_index) {
+    if (index == 0) index = next++;
+  }
+  const auto compact = [&](auto* values) {
+    if (values->size() != new_index.size()) return;
+    for (size_t i = 0; i < new_index.size(); ++i) {
+      if (new_index[i] >= 0) (*values)[new_index[i]] = std::move((*values)[i]);
+    }
+    values->resize(next);
+  };
+  compact(&mesh.vertices);
+  compact(&mesh.normals);
+  compact(&mesh.colours);
+  compact(&model->seen_by);
+  compact(&model->on_grid_wall);
+  compact(&model->refinement.pinned);
+  for (Eigen::Vector3i& t : mesh.triangles) {
+    for (int j = 0; j < 3; ++j) t[j] = new_index[t[j]];
+  }
+}
+
 std::string FinalSmoothingSummary(const ModelMesh& model, const ModelMeshOptions& options) {
   if (options.final_smoothing_iterations == 0 || model.refinement.passes == 0) {
     return "mesh final smoothing: none";
@@ -233,14 +276,17 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     fit.num_threads = options.num_threads;
     model.silhouettes = FitMeshToSilhouettes(views, fit, &model.mesh);
   }
+  // The walls are found on the final geometry and left out before colouring, so that the colour
+  // figures describe the mesh written.
+  model.on_grid_wall = GridWallVertices(model.mesh, grid);
+  model.grid_wall_vertices =
+      std::count(model.on_grid_wall.begin(), model.on_grid_wall.end(), uint8_t{1});
+  if (options.remove_grid_walls) RemoveGridWalls(&model);
   MeshColouringOptions colouring;
   colouring.min_views = options.min_views;
   colouring.depth_tolerance = grid.voxel_size();
   colouring.num_threads = options.num_threads;
   model.colouring = ColourMeshFromPhotos(views, colouring, &model.mesh, &model.seen_by);
-  model.on_grid_wall = GridWallVertices(model.mesh, grid);
-  model.grid_wall_vertices =
-      std::count(model.on_grid_wall.begin(), model.on_grid_wall.end(), uint8_t{1});
   return model;
 }
 

@@ -80,6 +80,12 @@ struct ModelMeshOptions {
   // the masks are pulled in onto their edges (by the median over the photos they are on the
   // outline of, at most a voxel a pass). 0: none.
   int silhouette_passes = 2;
+  // Triangles on the grid's wall (ModelMesh::on_grid_wall: all three corners on it) are left
+  // out of the mesh: the box cuts the scene there (a table or the ground running on beyond it,
+  // a backdrop the views see through it), which has no surface on the wall; the mesh is open
+  // where the box cuts. The box comes from the sparse points with a margin, so it does not lie
+  // on a surface they saw. false: kept, the mesh closed by the box.
+  bool remove_grid_walls = true;
   // Threads for refining and colouring (0 or less: every core); the mesh does not depend on it.
   int num_threads = 0;
   bool IsValid(std::string* reason) const;
@@ -100,8 +106,14 @@ struct ModelMesh {
   // a surface: the photos see the scene beyond the box through it. Within 1.5 voxels of one of
   // the box's faces, with the normal at most 60 degrees from that face's outward direction.
   std::vector<uint8_t> on_grid_wall;
-  int64_t grid_wall_vertices = 0;
+  int64_t grid_wall_vertices = 0;    // before the wall's triangles are left out
+  int64_t wall_triangles_removed = 0;
+  int64_t triangles_before_walls = 0;
 };
+
+// Leaves out the triangles whose three corners are on the grid's wall (model->on_grid_wall),
+// and the vertices no triangle uses any more (with their per-vertex data), counting them.
+void RemoveGridWalls(ModelMesh* model);
 // Per vertex of `mesh` (with normals), 1 where it lies on the wall of `grid` (see
 // ModelMesh::on_grid_wall).
 std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid& grid);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 
+#include <glog/logging.h>
 #include <opencv2/core.hpp>
 
 namespace raycarve {
@@ -77,6 +78,29 @@ cv::Mat SideBySide(const Rendering& rendering, const CalibratedView& view) {
   cv::Mat strip;
   cv::hconcat(std::vector<cv::Mat>{view.image, rendering.image, error}, strip);
   return strip;
+}
+
+SparseDepthAgreement MeasureSparseDepth(const Rendering& rendering, const CalibratedView& view,
+                                        const std::vector<Eigen::Vector3d>& points,
+                                        double tolerance) {
+  CHECK_EQ(rendering.depth.type(), CV_32FC1);
+  SparseDepthAgreement agreement;
+  for (const Eigen::Vector3d& point : points) {
+    const double depth = view.Depth(point);
+    if (!(depth > 0.0)) continue;
+    const Eigen::Vector2d pixel = view.Project(point);
+    const int col = static_cast<int>(std::floor(pixel.x())), row = static_cast<int>(std::floor(pixel.y()));
+    if (col < 0 || row < 0 || col >= rendering.depth.cols || row >= rendering.depth.rows) continue;
+    ++agreement.points;
+    const float drawn = rendering.depth.at<float>(row, col);
+    if (!std::isfinite(drawn)) continue;
+    if (std::abs(drawn - depth) <= tolerance) {
+      ++agreement.at_depth;
+    } else if (drawn < depth - tolerance) {
+      ++agreement.hidden;
+    }
+  }
+  return agreement;
 }
 
 }  // namespace exporter

@@ -1,6 +1,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
+
+#include <Eigen/Core>
 
 #include <opencv2/core.hpp>
 
@@ -31,6 +34,23 @@ double BlockMeanPsnr(const CalibratedView& view, int block);
 
 // photo | render | error (absolute difference, amplified 4x), side by side, RGB.
 cv::Mat SideBySide(const Rendering& rendering, const CalibratedView& view);
+
+// Whether a model's depth agrees with sparse points that a held-out view saw (and two or more
+// other photos triangulated): a measure that a model cannot win by painting a backdrop on the
+// volume's walls. Each point inside the view's frame and in front of it is looked up in the
+// rendering's depth buffer at its pixel: `at_depth` where the model is drawn within `tolerance`
+// of the point's depth, `hidden` where it is drawn nearer by more than that (something the
+// photo did not see stands in front), the rest with nothing drawn there or the model behind.
+struct SparseDepthAgreement {
+  int points = 0;
+  int at_depth = 0;
+  int hidden = 0;
+  double AtDepthShare() const { return points > 0 ? static_cast<double>(at_depth) / points : 0.0; }
+  double HiddenShare() const { return points > 0 ? static_cast<double>(hidden) / points : 0.0; }
+};
+SparseDepthAgreement MeasureSparseDepth(const Rendering& rendering, const CalibratedView& view,
+                                        const std::vector<Eigen::Vector3d>& points,
+                                        double tolerance);
 
 }  // namespace exporter
 }  // namespace raycarve

@@ -1,15 +1,15 @@
 #include "export/surface_mesh.h"
 
-#include <cerrno>
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <utility>
 #include <fstream>
 #include <numeric>
 #include <unordered_map>
+#include <utility>
 
 #include <glog/logging.h>
 #include <opencv2/core.hpp>

@@ -137,10 +137,33 @@ void CarvePipeline::LoadViews() {
   RecordSeconds("load_project", SecondsSince(start));
 }
 
+void CarvePipeline::DecideMasks() {
+  // Masks are decided for the capture, not per photo: a backdrop that the automatic rule found in
+  // fewer than half of the photos (a beige forest floor in one photo of an unmasked capture, sky
+  // and ground in some photos of a facade) is not the capture's backdrop. Its masks would switch
+  // the carve to the masked rules and score those held-out views inside them: they go, and every
+  // photo is used whole.
+  const ViewReaderSummary& summary = project_.view_summary;
+  int automatic = 0, photos = 0;
+  for (const PhotoMaskInfo& photo : summary.photos) {
+    automatic += photo.source == "backdrop";
+    ++photos;
+  }
+  if (summary.masks_from_files > 0 || automatic == 0 || 2 * automatic >= photos) return;
+  for (std::vector<CalibratedView>* views : {&carved_, &held_out_}) {
+    for (CalibratedView& view : *views) view.mask.release();
+  }
+  run_.backdrop_masks_dropped = automatic;
+  run_.masks_from_backdrop = 0;
+  LOG(WARNING) << "the automatic backdrop was found in " << automatic << " of " << photos
+               << " photos only: a minority, not the capture's backdrop; carving without masks";
+}
+
 void CarvePipeline::AgreeMasks() {
   CHECK(loaded_);
+  DecideMasks();
   const ViewReaderSummary& summary = project_.view_summary;
-  if (!request_.agree_masks || summary.masks_from_backdrop == 0 || summary.masks_from_files > 0) {
+  if (!request_.agree_masks || run_.masks_from_backdrop == 0 || summary.masks_from_files > 0) {
     return;
   }
   const Clock::time_point start = Clock::now();
@@ -286,6 +309,8 @@ void CarvePipeline::MakeSurface() {
   run_.mesh_final_smoothing_mean_move = model_.final_smoothing_mean_move;
   run_.mesh_small_components_removed = model_.small_components_removed;
   run_.mesh_grid_wall_vertices = model_.grid_wall_vertices;
+  run_.mesh_wall_triangles_removed = model_.wall_triangles_removed;
+  run_.mesh_triangles_before_walls = model_.triangles_before_walls;
   RecordSeconds("mesh", SecondsSince(start));
 }
 

@@ -45,6 +45,8 @@ struct CarveRun {
   int num_missing_images = 0;
   int masks_from_files = 0;
   int masks_from_backdrop = 0;
+  // Automatic backdrop masks found in a minority of the photos: not used (see AgreeMasks).
+  int backdrop_masks_dropped = 0;
   std::vector<PhotoMaskInfo> mask_photos;  // per view: where its mask came from, what was found
   std::vector<std::string> view_names;     // the views carved, in carve order
   ColourCalibration colour;
@@ -63,6 +65,8 @@ struct CarveRun {
   double mesh_final_smoothing_mean_move = 0.0;  // world units
   int64_t mesh_small_components_removed = 0;
   int64_t mesh_grid_wall_vertices = 0;  // on the grid's wall: left out of the cloud
+  int64_t mesh_wall_triangles_removed = 0;  // left out of the mesh (on the wall, no sparse point)
+  int64_t mesh_triangles_before_walls = 0;
   // Cloud.
   size_t num_cloud_points = 0;
   // The model's sparse points inside the grid against the cloud (accuracy: their 90% distance).
@@ -94,7 +98,9 @@ class CarvePipeline {
   // (StagedOutputs' lock), so that a second run into it is refused before any work.
   void LockOutputs();
   void LoadViews();    // model, bounds, photos undistorted and masked, colour calibration
-  void AgreeMasks();   // the carved views' backdrop masks agree across them (AgreeMasks)
+  // Automatic backdrop masks found in a minority of the photos go (DecideMasks); then the carved
+  // views' backdrop masks agree across them (raycarve::AgreeMasks).
+  void AgreeMasks();
   void CheckVolume();  // the grid fits in memory (CheckCarveFits) and the photos see the volume
   void PlanOutputs();  // what the outputs must not overwrite; the staging folder, made at once
   void Carve();        // incremental voxel colouring over the carved views
@@ -122,6 +128,7 @@ class CarvePipeline {
   const CarveRun& run() const { return run_; }
 
  private:
+  void DecideMasks();
   void RecordSeconds(const std::string& stage, double seconds);
   void WriteMasks(const std::filesystem::path& staging) const;
   void WriteDenseWorkspace(const std::filesystem::path& staging);

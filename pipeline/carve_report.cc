@@ -48,6 +48,7 @@ void WriteOptions(const CarveRequest& request, const CarveRun& run, JsonWriter& 
       .Key("background").Value(request.background)
       .Key("masks_from_files").Value(run.masks_from_files)
       .Key("masks_from_backdrop").Value(run.masks_from_backdrop)
+      .Key("backdrop_masks_dropped").Value(run.backdrop_masks_dropped)
       .Key("background_tolerance").Value(request.view_options.background.tolerance)
       .Key("mask_graph_cut").Value(request.view_options.background.refine)
       .Key("visual_hull").Value(request.options.visual_hull)
@@ -279,6 +280,13 @@ void WriteMesh(const CarveRequest& request, const CarveRun& run, JsonWriter& jso
         .Key("components").Value(static_cast<int64_t>(t.components))
         .Key("small_components_removed").Value(run.mesh_small_components_removed)
         .Key("grid_wall_vertices").Value(run.mesh_grid_wall_vertices)
+        .Key("remove_box_walls").Value(request.mesh.remove_grid_walls)
+        .Key("box_wall_triangles_removed").Value(run.mesh_wall_triangles_removed)
+        .Key("box_wall_share")
+        .Value(run.mesh_triangles_before_walls > 0
+                   ? static_cast<double>(run.mesh_wall_triangles_removed) /
+                         run.mesh_triangles_before_walls
+                   : 0.0)
         .Key("boundary_edges").Value(static_cast<int64_t>(t.boundary_edges))
         .Key("non_manifold_edges").Value(static_cast<int64_t>(t.non_manifold_edges))
         .Key("non_manifold_vertices").Value(static_cast<int64_t>(t.non_manifold_vertices))

@@ -33,6 +33,8 @@ struct ScoredModel {
   double point_size = 0.0;
   exporter::ModelMesh model;
   std::string thresholds;
+  // Per held-out name, the sparse points it saw (LoadedProject::held_out_points).
+  const std::map<std::string, std::vector<Eigen::Vector3d>>* held_out_points = nullptr;
 };
 
 // The held-out views' masks replaced by those in `mask_path` (<photo name>.png, as --mask_path),
@@ -122,6 +124,14 @@ HeldOutViewScore ScoreView(const ScoredModel& scored,
     rendering = exporter::RenderPoints(scored.points, view, scored.point_size);
   }
   result.score = exporter::ScoreRendering(rendering, view);
+  const auto seen = scored.held_out_points->find(view.name);
+  if (seen != scored.held_out_points->end()) {
+    std::vector<Eigen::Vector3d> inside;
+    for (const Eigen::Vector3d& point : seen->second) {
+      if (grid.Box().contains(point)) inside.push_back(point);
+    }
+    result.sparse_depth = exporter::MeasureSparseDepth(rendering, view, inside, 2.0 * grid.voxel_size());
+  }
   // The mesh is scored beside the voxel volume it was made from, drawn into the same view.
   result.volume_score = result.score;
   if (render == "mesh" && carve != nullptr) {
@@ -143,6 +153,9 @@ HeldOutViewScore ScoreView(const ScoredModel& scored,
 void AverageScores(HoldoutEvaluation* evaluation) {
   double psnr = 0.0, iou = 0.0, block = 0.0, volume_psnr = 0.0, volume_iou = 0.0;
   for (const HeldOutViewScore& view : evaluation->views) {
+    evaluation->sparse_depth.points += view.sparse_depth.points;
+    evaluation->sparse_depth.at_depth += view.sparse_depth.at_depth;
+    evaluation->sparse_depth.hidden += view.sparse_depth.hidden;
     psnr += view.score.psnr;
     block += view.block_psnr;
     volume_psnr += view.volume_score.psnr;
@@ -199,6 +212,9 @@ std::string HoldoutJson(const HoldoutOptions& options,
         .Key("block_mean_psnr_db").Value(view.block_psnr)
         .Key("volume_psnr_db").Value(view.volume_score.psnr)
         .Key("volume_silhouette_iou").Value(view.volume_score.silhouette_iou)
+        .Key("sparse_points").Value(view.sparse_depth.points)
+        .Key("sparse_at_depth_share").Value(view.sparse_depth.AtDepthShare())
+        .Key("sparse_hidden_share").Value(view.sparse_depth.HiddenShare())
         .EndObject();
   }
   json.EndArray();
@@ -207,6 +223,10 @@ std::string HoldoutJson(const HoldoutOptions& options,
       .Key("mean_block_mean_psnr_db").Value(evaluation.mean_block_psnr)
       .Key("mean_volume_psnr_db").Value(evaluation.mean_volume_psnr)
       .Key("mean_volume_silhouette_iou").Value(evaluation.mean_volume_iou)
+      .Key("sparse_points").Value(evaluation.sparse_depth.points)
+      .Key("sparse_at_depth_share").Value(evaluation.sparse_depth.AtDepthShare())
+      .Key("sparse_hidden_share").Value(evaluation.sparse_depth.HiddenShare())
+      .Key("sparse_depth_tolerance_voxels").Value(2.0)
       .EndObject();
   return json.str();
 }
@@ -241,6 +261,7 @@ HoldoutEvaluation EvaluateHeldOutViews(const CarveRequest& request, const Holdou
   evaluation.render = options.render;
   ScoredModel scored;
   scored.point_size = grid.voxel_size();
+  scored.held_out_points = &pipeline.project().held_out_points;
   if (!options.model_path.empty()) {
     ReadGivenModel(options, &scored, &evaluation.render);
   } else {

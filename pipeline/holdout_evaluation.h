@@ -26,6 +26,9 @@ struct HeldOutViewScore {
   int uncoloured_pixels = 0;            // --render volume: solid voxels no photo coloured
   int block = 1;                        // block PSNR's block side, pixels (about a voxel)
   double block_psnr = 0.0;              // the photo against its own block means
+  // The model's depth against the sparse points this view saw (inside the volume, triangulated
+  // from two or more other photos), within two voxels.
+  exporter::SparseDepthAgreement sparse_depth;
 };
 
 struct HoldoutEvaluation {
@@ -39,6 +42,8 @@ struct HoldoutEvaluation {
   double mean_block_psnr = 0.0;
   double mean_volume_psnr = 0.0;
   double mean_volume_iou = -1.0;
+  // Over every held-out view's sparse points together (SparseDepthAgreement).
+  exporter::SparseDepthAgreement sparse_depth;
   std::string output_folder;  // <output>/holdout: holdout.json, <view>.png, mesh.ply
 };
 

@@ -143,7 +143,8 @@ LoadedProject LoadProject(const ProjectRequest& request) {
                      std::to_string(request.min_images));
   }
   if (request.hold_out_every > 0) {
-    project.held_out = HoldOutImages(request.hold_out_every, &project.reconstruction);
+    project.held_out = HoldOutImages(request.hold_out_every, &project.reconstruction,
+                                     &project.held_out_points);
     LOG(INFO) << "holding out " << project.held_out.size() << " of " << registered
               << " images (every " << request.hold_out_every << "th in name order); "
               << project.reconstruction.points3D.size()
@@ -255,7 +256,9 @@ std::vector<SurfacePoint> SurfacePointsOf(const Reconstruction& reconstruction,
   return points;
 }
 
-std::vector<std::string> HoldOutImages(int every, Reconstruction* reconstruction) {
+std::vector<std::string> HoldOutImages(
+    int every, Reconstruction* reconstruction,
+    std::map<std::string, std::vector<Eigen::Vector3d>>* seen_points) {
   CHECK_GT(every, 0);
   std::vector<std::pair<std::string, image_t>> by_name;
   for (const auto& [id, image] : reconstruction->images) by_name.emplace_back(image.name, id);
@@ -268,6 +271,15 @@ std::vector<std::string> HoldOutImages(int every, Reconstruction* reconstruction
   }
   for (auto it = reconstruction->points3D.begin(); it != reconstruction->points3D.end();) {
     std::vector<TrackElement>& track = it->second.track;
+    if (seen_points != nullptr) {
+      std::set<image_t> others, held_seeing;
+      for (const TrackElement& e : track) (held.count(e.image_id) ? held_seeing : others).insert(e.image_id);
+      if (others.size() >= 2) {
+        for (image_t id : held_seeing) {
+          (*seen_points)[reconstruction->images.at(id).name].push_back(it->second.xyz);
+        }
+      }
+    }
     track.erase(std::remove_if(track.begin(), track.end(),
                                [&](const TrackElement& e) { return held.count(e.image_id) > 0; }),
                 track.end());

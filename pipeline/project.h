@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,6 +33,8 @@ struct LoadedProject {
   // With hold_out_every: the names of the held-out images (their observations were removed from
   // the sparse points before anything used them).
   std::vector<std::string> held_out;
+  // Per held-out name, the sparse points it saw that two or more other images keep.
+  std::map<std::string, std::vector<Eigen::Vector3d>> held_out_points;
 };
 
 // Reliable sparse points as surface evidence for carving: points inside `box` seen by at least
@@ -46,8 +49,11 @@ std::vector<SurfacePoint> SurfacePointsOf(const Reconstruction& reconstruction,
 
 // Holds out every `every`-th image in name order (the first, then every k-th after it): their
 // observations leave the sparse points' tracks, and points left with fewer than two go. Returns
-// the held-out names, in name order.
-std::vector<std::string> HoldOutImages(int every, Reconstruction* reconstruction);
+// the held-out names, in name order. `seen_points` (when given) gets, per held-out name, the
+// points that image saw which two or more other images keep (triangulated without it).
+std::vector<std::string> HoldOutImages(
+    int every, Reconstruction* reconstruction,
+    std::map<std::string, std::vector<Eigen::Vector3d>>* seen_points = nullptr);
 
 // The explicit box when request.bbox is given, else ComputeBounds; throws InputError on bad
 // options. `source` names the model in messages.

@@ -56,6 +56,21 @@ std::string MaskSummary(const std::vector<PhotoMaskInfo>& photos) {
 }
 
 // The summary printed at the end: what was carved, from what, and what was written.
+// What the mesh is: closed, or open only where the box's walls were left out, or neither.
+std::string MeshShape(const CarveRun& run) {
+  const exporter::MeshTopology& t = run.mesh_topology;
+  if (t.IsClosedManifold()) return "closed and 2-manifold";
+  if (run.mesh_wall_triangles_removed > 0 && t.non_manifold_edges == 0) {
+    // Where two removed stretches of wall meet at a corner, two sheets of surface touch at a
+    // vertex: said, not hidden.
+    return "open where the box cuts the scene" +
+           (t.non_manifold_vertices > 0
+                ? " (" + std::to_string(t.non_manifold_vertices) + " vertices where two sheets touch)"
+                : std::string());
+  }
+  return "NOT closed 2-manifold (see report.json)";
+}
+
 void PrintSummary(const CarveRequest& request, const CarveRun& run) {
   const CarveStatistics& s = run.result->statistics;
   std::string sparse_line = "none in the volume";
@@ -69,7 +84,12 @@ void PrintSummary(const CarveRequest& request, const CarveRun& run) {
                       : "");
     sparse_line = text;
   }
-  const std::string mask_line = MaskSummary(run.mask_photos);
+  const std::string mask_line =
+      run.backdrop_masks_dropped > 0
+          ? "a backdrop found in " + std::to_string(run.backdrop_masks_dropped) + " of " +
+                std::to_string(run.mask_photos.size()) +
+                " photos only (a minority): not the capture's, every photo used whole"
+          : MaskSummary(run.mask_photos);
   std::string silhouette_line;
   if (s.silhouette_repair.views > 0) {
     silhouette_line = "  silhouettes     " + std::to_string(s.silhouette_repair.lost_pixels) +
@@ -164,10 +184,13 @@ void PrintAfterSummary(const CarveRequest& request, const CarveRun& run) {
                 run.num_mesh_triangles, run.num_mesh_vertices,
                 static_cast<long long>(run.mesh_topology.components),
                 run.mesh_topology.components == 1 ? "" : "s",
-                run.mesh_topology.IsClosedManifold() ? "closed and 2-manifold"
-                                                     : "NOT closed 2-manifold (see report.json)",
-                100.0 * c.SeenShare(), request.mesh.min_views, c.mean_views);
-    if (run.mesh_grid_wall_vertices > 0) {
+                MeshShape(run).c_str(), 100.0 * c.SeenShare(), request.mesh.min_views,
+                c.mean_views);
+    if (run.mesh_wall_triangles_removed > 0) {
+      std::printf("                  %.1f%% of the surface lay on the volume box's walls, where the "
+                  "box cuts the scene: left out of the mesh and the cloud\n",
+                  100.0 * run.mesh_wall_triangles_removed / run.mesh_triangles_before_walls);
+    } else if (run.mesh_grid_wall_vertices > 0) {
       std::printf("                  %lld vertices on the volume box's walls, where the box cuts the "
                   "scene: in the mesh, left out of the cloud\n",
                   static_cast<long long>(run.mesh_grid_wall_vertices));

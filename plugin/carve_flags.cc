@@ -172,6 +172,11 @@ void AddMeshFlags(OptionParser* parser, CarveRequest* request) {
                      "smooth mesh: after the final smoothing, passes pulling the outline's "
                      "vertices that stand beyond the masks in onto the masks' edges (the median "
                      "over the photos; at most a voxel a pass); 0: none");
+  parser->AddDefault("mesh_remove_box_walls", &request->mesh.remove_grid_walls,
+                     "smooth mesh: leave out the surface on the volume box's walls (where the box "
+                     "cuts the scene, e.g. a table or the ground running on beyond it, or a "
+                     "backdrop seen through it); the mesh is open there. 0: keep it, the mesh "
+                     "closed by the box");
 }
 
 void AddThreadFlags(OptionParser* parser, CarveRequest* request) {

@@ -28,6 +28,13 @@ void PrintEvaluation(const HoldoutEvaluation& evaluation) {
               masks ? std::to_string(evaluation.mean_iou).c_str() : "n/a (no masks)",
               evaluation.mean_block_psnr, evaluation.output_folder.c_str(),
               evaluation.output_folder.c_str(), evaluation.wrote_mesh ? " and mesh.ply" : "");
+  const exporter::SparseDepthAgreement& depth = evaluation.sparse_depth;
+  if (depth.points > 0) {
+    std::printf("sparse points the held-out photos saw (%d, triangulated from 2+ other photos, "
+                "inside the volume): %.1f%% drawn at their depth (within 2 voxels), %.1f%% hidden "
+                "behind something nearer\n",
+                depth.points, 100.0 * depth.AtDepthShare(), 100.0 * depth.HiddenShare());
+  }
   if (evaluation.wrote_mesh) {
     std::printf("the voxel volume drawn into the same views: PSNR %.2f dB, silhouette IoU %s "
                 "(the mesh: %+.2f dB)\n",

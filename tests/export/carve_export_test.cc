@@ -131,8 +131,27 @@ TEST(CarveExport, TheSmoothMeshIsClosedAndNearerTheTruthAndItsPhotoColoursBeatVo
   const double voxel = result.volume.grid().voxel_size();
   const ModelMesh model = MeshCarvedModel(result, views, ModelMeshOptions());
   ASSERT_FALSE(model.mesh.empty());
+  // The box cuts the ground: the mesh is open there and nowhere else (every boundary edge has
+  // both ends on the wall's rim); kept, the walls close it.
   const MeshTopology topology = AnalyseTopology(model.mesh);
-  EXPECT_TRUE(topology.IsClosedManifold());
+  EXPECT_GT(model.wall_triangles_removed, 0);
+  EXPECT_EQ(topology.non_manifold_edges, 0);
+  std::map<std::pair<int, int>, int> edge_uses;
+  for (const Eigen::Vector3i& t : model.mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      ++edge_uses[std::minmax(t[k], t[(k + 1) % 3])];
+    }
+  }
+  int boundary = 0;
+  for (const auto& [edge, uses] : edge_uses) {
+    if (uses != 1) continue;
+    ++boundary;
+    EXPECT_TRUE(model.on_grid_wall[edge.first] && model.on_grid_wall[edge.second]);
+  }
+  EXPECT_GT(boundary, 0);
+  ModelMeshOptions with_walls;
+  with_walls.remove_grid_walls = false;
+  EXPECT_TRUE(AnalyseTopology(MeshCarvedModel(result, views, with_walls).mesh).IsClosedManifold());
   ASSERT_EQ(model.mesh.colours.size(), model.mesh.vertices.size());
   ASSERT_EQ(model.seen_by.size(), model.mesh.vertices.size());
   EXPECT_EQ(model.colouring.from_photos + model.colouring.from_neighbours + model.colouring.uncoloured,
@@ -225,6 +244,7 @@ TEST(CarveExport, RefinementPassesStopWhenTheMeshStopsMoving) {
   const CarveResult& result = carved.result;
   const double voxel = result.volume.grid().voxel_size();
   ModelMeshOptions options;
+  options.remove_grid_walls = false;  // the refinement's own figures, on the closed mesh
   options.refine_passes = 0;
   const ModelMesh unrefined = MeshCarvedModel(result, views, options);
   ASSERT_FALSE(unrefined.mesh.empty());
@@ -295,12 +315,15 @@ TEST(CarveExport, FinalSmoothingKeepsWhatThePhotosPinAndSmoothsThePlain) {
   for (CalibratedView& view : plain) {
     view.image = cv::Mat(view.image.size(), view.image.type(), cv::Scalar(150, 150, 150));
   }
-  ModelMeshOptions unsmoothed;
+  // Closed meshes (the box's walls kept), whose topology the smoothing must keep.
+  ModelMeshOptions smoothed;
+  smoothed.remove_grid_walls = false;
+  ModelMeshOptions unsmoothed = smoothed;
   unsmoothed.final_smoothing_iterations = 0;
   for (const bool is_plain : {false, true}) {
     const std::vector<CalibratedView>& views = is_plain ? plain : textured;
     const ModelMesh before = MeshCarvedModel(result, views, unsmoothed);
-    const ModelMesh after = MeshCarvedModel(result, views, ModelMeshOptions());
+    const ModelMesh after = MeshCarvedModel(result, views, smoothed);
     ASSERT_FALSE(after.mesh.empty());
     ASSERT_EQ(after.refinement.pinned.size(), after.mesh.vertices.size());
     for (float pinned : after.refinement.pinned) {
@@ -383,6 +406,30 @@ TEST(CarveExport, TheGridsWallsAreMarkedAndLeftOutOfTheCloud) {
     // (its edge rounded by smoothing) or on the cube.
     EXPECT_GT(point.xyz.z(), 6.0 * voxel) << point.xyz.transpose();
   }
+
+  // The mesh leaves the walls out too: what stays is the slab's top (its rim a voxel down the
+  // walls at most) and the whole cube, with their per-vertex data.
+  const TriangleMesh before = model.mesh;
+  int cube_triangles = 0;
+  for (const Eigen::Vector3i& t : before.triangles) cube_triangles += before.vertices[t[0]].z() > 0.45;
+  RemoveGridWalls(&model);
+  EXPECT_EQ(model.triangles_before_walls, static_cast<int64_t>(before.triangles.size()));
+  EXPECT_GT(model.wall_triangles_removed, static_cast<int64_t>(before.triangles.size()) / 3);
+  ASSERT_EQ(model.mesh.triangles.size(), before.triangles.size() - model.wall_triangles_removed);
+  ASSERT_EQ(model.seen_by.size(), model.mesh.vertices.size());
+  ASSERT_EQ(model.on_grid_wall.size(), model.mesh.vertices.size());
+  ASSERT_EQ(model.mesh.normals.size(), model.mesh.vertices.size());
+  int kept_cube = 0;
+  for (const Eigen::Vector3i& t : model.mesh.triangles) {
+    const Eigen::Vector3f centre =
+        (model.mesh.vertices[t[0]] + model.mesh.vertices[t[1]] + model.mesh.vertices[t[2]]) / 3.0f;
+    kept_cube += centre.z() > 0.45;
+    EXPECT_GT(centre.z(), 6.0 * voxel) << centre.transpose();  // no bottom, no side below the rim
+  }
+  EXPECT_EQ(kept_cube, cube_triangles);
+  std::vector<int> used(model.mesh.vertices.size(), 0);
+  for (const Eigen::Vector3i& t : model.mesh.triangles) used[t[0]] = used[t[1]] = used[t[2]] = 1;
+  EXPECT_EQ(std::count(used.begin(), used.end(), 0), 0);  // no vertex left without a triangle
 }
 
 TEST(CarveExport, AnEmptyCarveGivesAnEmptyMesh) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "export/holdout_score.h"
 #include "tests/test_support.h"
 
 namespace raycarve {
@@ -50,6 +51,32 @@ TEST(RenderMesh, ARectangleCoversExactlyThePixelCentresInsideItAtItsDepth) {
       }
     }
   }
+}
+
+TEST(MeasureSparseDepth, PointsAtTheDrawnDepthBehindItInFrontOfItAndOutside) {
+  const CalibratedView view = Straight();
+  TriangleMesh mesh;  // pixels 10..30 across, 5..20 down, at depth 4
+  mesh.vertices = {Unproject(view, 10, 5, 4), Unproject(view, 30, 5, 4), Unproject(view, 30, 20, 4),
+                   Unproject(view, 10, 20, 4)};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const Rendering rendering = RenderMesh(mesh, view);
+  const auto at = [&](double x, double y, double z) -> Eigen::Vector3d {
+    return Unproject(view, x, y, z).cast<double>();
+  };
+  const std::vector<Eigen::Vector3d> points = {
+      at(15.5, 10.5, 4.1),   // on the surface, within the tolerance: at depth
+      at(20.5, 12.5, 3.8),   // likewise, a little in front
+      at(25.5, 15.5, 6.0),   // behind it: hidden by the surface
+      at(12.5, 7.5, 2.0),    // in front of it: the model lies behind the point
+      at(35.5, 25.5, 4.0),   // where nothing is drawn
+      at(45.5, 10.5, 4.0),   // outside the frame: not counted
+      Eigen::Vector3d(0, 0, -3)};  // behind the camera: not counted
+  const SparseDepthAgreement agreement = MeasureSparseDepth(rendering, view, points, 0.5);
+  EXPECT_EQ(agreement.points, 5);
+  EXPECT_EQ(agreement.at_depth, 2);
+  EXPECT_EQ(agreement.hidden, 1);
+  EXPECT_DOUBLE_EQ(agreement.AtDepthShare(), 0.4);
+  EXPECT_DOUBLE_EQ(agreement.HiddenShare(), 0.2);
 }
 
 TEST(RenderMesh, TheNearestTriangleWinsAndColoursBlendPerspectiveCorrectly) {

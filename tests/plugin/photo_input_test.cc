@@ -147,5 +147,39 @@ TEST(PhotoInput, ImplausibleValuesAreRefusedSayingWhichAndWhy) {
           {"view001.png", "folds the image"});
 }
 
+// Masks are decided for the capture: the same cameras and scene photographed in front of a plain
+// backdrop (automatic masks) and under a patchwork sky (none); photos of the second replace some
+// of the first's.
+TEST(PhotoInput, ABackdropFoundInAMinorityOfThePhotosIsNotUsed) {
+  const std::string root = testing::MakeTemporaryDirectory("photo_input_minority");
+  const std::string scene = " --views 6 --width 128 --height 96 --points 400 --backdrop ";
+  std::string output;
+  ASSERT_EQ(RunRaycarve("synth --output_path " + root + "/natural" + scene + "patchwork", &output), 0)
+      << output;
+  for (const int replaced : {4, 2}) {
+    const std::string project = root + "/studio" + std::to_string(replaced);
+    ASSERT_EQ(RunRaycarve("synth --output_path " + project + scene + "uniform", &output), 0) << output;
+    for (int view = 1; view <= replaced; ++view) {
+      const std::string name = "/images/view00" + std::to_string(view) + ".png";
+      fs::copy_file(root + "/natural" + name, project + name, fs::copy_options::overwrite_existing);
+    }
+    ASSERT_EQ(RunRaycarve("carve --workspace_path " + project + " --resolution 32", &output), 0)
+        << output;
+    const std::string report = testing::ReadFileBytes(project + "/raycarve/report.json");
+    if (replaced == 4) {
+      // 2 of 6 with a backdrop: a minority, dropped; every photo carved whole.
+      EXPECT_NE(output.find("a backdrop found in 2 of 6 photos only (a minority)"), std::string::npos)
+          << output;
+      EXPECT_EQ(JsonNumber(report, "backdrop_masks_dropped"), 2);
+      EXPECT_EQ(JsonNumber(report, "masks_from_backdrop"), 0);
+      EXPECT_FALSE(fs::exists(project + "/raycarve/masks"));
+    } else {
+      // 4 of 6: the capture's backdrop, its masks used.
+      EXPECT_EQ(JsonNumber(report, "backdrop_masks_dropped"), 0);
+      EXPECT_EQ(JsonNumber(report, "masks_from_backdrop"), 4);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace raycarve

@@ -14,6 +14,9 @@ namespace exporter {
 
 namespace {
 
+// The largest coordinate a PLY vertex may have (see ReadPly).
+constexpr float kMaxPlyCoordinate = 1e30f;
+
 // An element of a PLY header as parsed, with what its records need at least.
 struct Element {
   PlyElement element;
@@ -430,6 +433,13 @@ PlyData ReadPly(const std::string& path) {
       if (!point.allFinite()) {
         throw InputError(path + ": vertex " + std::to_string(record) +
                          " has a non-finite coordinate (NaN or infinity)");
+      }
+      // Differences of coordinates (extents, distances, k-d tree splits) must stay finite in
+      // float: beyond 1e30 no scene is measured, and FLANN's tree recursed without end there.
+      if ((point.array().abs() > kMaxPlyCoordinate).any()) {
+        throw InputError(path + ": vertex " + std::to_string(record) +
+                         " has a coordinate beyond 1e30 (" + std::to_string(point.x()) + ", " +
+                         std::to_string(point.y()) + ", " + std::to_string(point.z()) + ")");
       }
       data.xyz.push_back(point);
       if (normals) {

@@ -160,11 +160,17 @@ std::vector<Eigen::Vector3f> ReadComparablePoints(const std::string& path, int m
     for (const Eigen::Vector3i& corners : data.triangles) {
       const std::array<Eigen::Vector3f, 3> triangle = {data.xyz[corners[0]], data.xyz[corners[1]],
                                                       data.xyz[corners[2]]};
-      total += 0.5 * (triangle[1] - triangle[0]).cross(triangle[2] - triangle[0]).norm();
+      const Eigen::Vector3d a = triangle[0].cast<double>(), b = triangle[1].cast<double>(),
+                            c = triangle[2].cast<double>();
+      total += 0.5 * (b - a).cross(c - a).norm();
       triangles.push_back(triangle);
       cumulative_area.push_back(total);
     }
     if (!(total > 0.0)) throw InputError(path + ": the mesh has no surface area to sample");
+    if (!std::isfinite(total)) {
+      throw InputError(path + ": the mesh's triangles are too large to sample (their area "
+                              "overflows; coordinates near the float range's end)");
+    }
     std::mt19937 random(12345);
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
     points.reserve(mesh_samples);
@@ -181,8 +187,15 @@ std::vector<Eigen::Vector3f> ReadComparablePoints(const std::string& path, int m
         b = 1.0 - b;
       }
       const auto& tri = triangles[t];
-      points.push_back(tri[0] + static_cast<float>(a) * (tri[1] - tri[0]) +
-                       static_cast<float>(b) * (tri[2] - tri[0]));
+      const Eigen::Vector3d corner = tri[0].cast<double>();
+      const Eigen::Vector3f sample = (corner + a * (tri[1].cast<double>() - corner) +
+                                      b * (tri[2].cast<double>() - corner))
+                                         .cast<float>();
+      if (!sample.allFinite()) {
+        throw InputError(path + ": a point sampled on the mesh leaves the float range (its "
+                                "coordinates are near the range's end)");
+      }
+      points.push_back(sample);
     }
   }
   if (points.empty()) throw InputError(path + ": holds no points");

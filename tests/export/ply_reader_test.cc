@@ -156,6 +156,11 @@ TEST(PlyReader, RefusesBodiesThatLieWithTheFileAndTheValueNamed) {
   ExpectRefused("ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nproperty double y\n"
                 "property double z\nend_header\n1e308 0 0\n",
                 "vertex 0 has a non-finite coordinate");
+  // A float that is finite but so large that differences overflow (found by fuzzing: FLANN's
+  // k-d tree recursed until the stack ran out on such a mesh).
+  ExpectRefused(xyz_header + three_floats + Bytes(1.0f, false) + Bytes(3e38f, false) +
+                    Bytes(0.0f, false),
+                "vertex 1 has a coordinate beyond 1e30");
   // A face naming a vertex the file does not have.
   ExpectRefused("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                 "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"

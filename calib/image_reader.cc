@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <csetjmp>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -93,6 +94,48 @@ std::string WhyNotAFile(const std::string& path) {
 void CheckJpegStrictly(const std::string& path) {
   const std::unique_ptr<std::FILE, FileCloser> file = OpenForReading(path);
   CheckJpegFile(path, file.get());
+}
+
+cv::Size ReadImageSize(const std::string& path) {
+  const std::string why = WhyNotAFile(path);
+  if (!why.empty()) throw InputError(path + ": " + why);
+  const std::unique_ptr<std::FILE, FileCloser> file = OpenForReading(path);
+  if (StartsLikeJpeg(file.get())) {
+    jpeg_decompress_struct info;
+    StrictJpegErrors errors;
+    info.err = jpeg_std_error(&errors.manager);
+    errors.manager.error_exit = JumpWithMessage;
+    errors.manager.emit_message = OnJpegMessage;
+    if (setjmp(errors.jump) != 0) {
+      jpeg_destroy_decompress(&info);
+      throw InputError(path + ": damaged JPEG header (" + errors.message + ")");
+    }
+    jpeg_create_decompress(&info);
+    jpeg_stdio_src(&info, file.get());
+    jpeg_read_header(&info, TRUE);
+    const cv::Size size(static_cast<int>(info.image_width), static_cast<int>(info.image_height));
+    jpeg_destroy_decompress(&info);
+    return size;
+  }
+  // PNG: the signature, then the IHDR chunk's width and height, big-endian.
+  unsigned char head[24] = {0};
+  static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (std::fread(head, 1, sizeof(head), file.get()) == sizeof(head) &&
+      std::memcmp(head, kPng, 8) == 0 && std::memcmp(head + 12, "IHDR", 4) == 0) {
+    const auto big_endian = [&](int at) {
+      return (static_cast<uint32_t>(head[at]) << 24) | (static_cast<uint32_t>(head[at + 1]) << 16) |
+             (static_cast<uint32_t>(head[at + 2]) << 8) | head[at + 3];
+    };
+    const uint32_t width = big_endian(16), height = big_endian(20);
+    if (width == 0 || height == 0 || width > 1u << 30 || height > 1u << 30) {
+      throw InputError(path + ": PNG header gives a size of " + std::to_string(width) + " x " +
+                       std::to_string(height));
+    }
+    return cv::Size(static_cast<int>(width), static_cast<int>(height));
+  }
+  const cv::Mat image = ReadImage(path, cv::IMREAD_UNCHANGED);
+  if (image.empty()) throw InputError(path + ": not an image OpenCV can read");
+  return image.size();
 }
 
 cv::Mat ReadImage(const std::string& path, int flags) {

@@ -16,6 +16,11 @@ std::string WhyNotAFile(const std::string& path);
 // message; a file that is not a JPEG passes.
 void CheckJpegStrictly(const std::string& path);
 
+// The stored size (width x height, before any EXIF orientation, as COLMAP reads it) of an image
+// file, from its header where the format allows (JPEG, PNG), else by decoding it. Throws
+// InputError naming the path when it cannot be read.
+cv::Size ReadImageSize(const std::string& path);
+
 // cv::imread as COLMAP reads a photo (the stored pixels, whatever its EXIF orientation says),
 // that never throws OpenCV's exceptions at the caller, and decodes strictly: a file that is not
 // a readable regular file, a JPEG that libjpeg would only warn about (cut short, corrupt), or a

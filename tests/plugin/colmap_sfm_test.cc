@@ -238,5 +238,47 @@ TEST(ColmapSfm, RefusesMissingColmapTooFewPhotosAndExistingProjects) {
   fs::remove_all(root);
 }
 
+// A phone's photos in portrait and landscape: COLMAP refuses one camera for them, so sfm gives
+// each photo its own; COLMAP's progress is shown as it runs.
+TEST(ColmapSfm, PhotosOfTwoSizesRegisterWithACameraEach) {
+  RAYCARVE_REQUIRE_COLMAP();
+  const std::string root = testing::MakeTemporaryDirectory("colmap_sfm_two_sizes");
+  std::string log;
+  for (const std::string& part : {std::string("a --views 8 --width 480 --height 360"),
+                                  std::string("b --views 7 --width 360 --height 480 --seed 7")}) {
+    ASSERT_EQ(testing::RunShell(Raycarve() + "synth --texture detailed --backdrop room "
+                                             "--output_path " + root + "/" + part,
+                                &log),
+              0)
+        << log;
+  }
+  fs::create_directories(root + "/photos");
+  for (const char* part : {"a", "b"}) {
+    for (const auto& entry : fs::directory_iterator(root + "/" + part + "/images")) {
+      fs::copy_file(entry.path(), root + "/photos/" + part + "_" + entry.path().filename().string());
+    }
+  }
+  // One camera for all is refused before COLMAP runs, with the reason.
+  EXPECT_EQ(testing::RunShell(Raycarve() + "sfm --image_path " + root + "/photos --workspace_path " +
+                                  root + "/one_camera --single_camera 1",
+                              &log),
+            1);
+  EXPECT_NE(log.find("2 different sizes"), std::string::npos) << log;
+  ASSERT_EQ(testing::RunShell(Raycarve() + "sfm --image_path " + root + "/photos --workspace_path " +
+                                  root + "/sfm --num_threads 1",
+                              &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("photos of 2 sizes (7 of 360x480, 8 of 480x360): one camera per photo"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("colmap| Processed file [15/15]"), std::string::npos) << log;
+  const Reconstruction model = ReadModel(root + "/sfm/sparse/0");
+  EXPECT_EQ(model.cameras.size(), model.images.size());
+  // Measured: 15 of 15 registered.
+  EXPECT_GE(model.images.size(), 13u) << log;
+  fs::remove_all(root);
+}
+
 }  // namespace
 }  // namespace raycarve

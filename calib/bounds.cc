@@ -1,10 +1,13 @@
 #include "calib/bounds.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <vector>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <glog/logging.h>
 
 #include "calib/input_error.h"
@@ -102,6 +105,7 @@ std::string Bounds::Summary() const {
          << " short tracks, " << num_high_error << " high error";
     if (num_unframed > 0) text << ", " << num_unframed << " of the room around (framed by few photos)";
     text << " dropped; " << num_trimmed_outside << " trimmed as outliers)";
+    if (around_focus) text << ", narrowed to the points framed around the cameras' focus";
   }
   return text.str();
 }
@@ -187,6 +191,114 @@ Bounds ExplicitBounds(const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
   bounds.box = Eigen::AlignedBox3d(min, max);
   bounds.is_explicit = true;
   return bounds;
+}
+
+std::string CaptureLayout::Summary() const {
+  std::ostringstream text;
+  text.precision(3);
+  text << (object_centred ? "cameras around a point (object-centred)"
+                          : "cameras facing one way (a scene)")
+       << ": seen from their common focus they fill a cone of " << cone_half_angle_degrees
+       << " degrees, widest gap around it " << largest_gap_degrees << " degrees; the focus in front of "
+       << focus_in_front << " of " << cameras;
+  return text.str();
+}
+
+CaptureLayout DescribeCapture(const Reconstruction& reconstruction) {
+  CaptureLayout layout;
+  std::vector<Eigen::Vector3d> centres, axes;
+  std::vector<double> half_fields;
+  for (const auto& [id, image] : reconstruction.images) {
+    const Eigen::Vector3d centre = image.ProjectionCenter();
+    // The optical axis: the camera's z axis in the world.
+    const Eigen::Vector3d axis =
+        image.cam_from_world.rotation.inverse() * Eigen::Vector3d::UnitZ();
+    if (!centre.allFinite() || !axis.allFinite()) continue;
+    centres.push_back(centre);
+    axes.push_back(axis.normalized());
+    const auto camera = reconstruction.cameras.find(image.camera_id);
+    if (camera != reconstruction.cameras.end() && camera->second.FocalLengthX() > 0.0) {
+      const double half_side = 0.5 * std::min(camera->second.width, camera->second.height);
+      half_fields.push_back(std::atan(half_side / camera->second.FocalLengthX()));
+    }
+  }
+  layout.cameras = static_cast<int>(centres.size());
+  if (centres.size() < 2) return layout;
+  // Least squares: sum over cameras of (I - a a^T) (x - c) = 0.
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d right = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < centres.size(); ++i) {
+    const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - axes[i] * axes[i].transpose();
+    normal += across;
+    right += across * centres[i];
+  }
+  // Symmetric and positive semi-definite: singular only when every axis is parallel.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normal);
+  if (!(eigen.eigenvalues()(0) > 1e-6 * eigen.eigenvalues()(2))) return layout;
+  layout.focus = normal.ldlt().solve(right);
+  std::vector<double> distances;
+  std::vector<Eigen::Vector3d> directions;
+  Eigen::Vector3d direction_sum = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < centres.size(); ++i) {
+    const Eigen::Vector3d to_camera = centres[i] - layout.focus;
+    distances.push_back(to_camera.norm());
+    if (to_camera.norm() > 0.0) {
+      directions.push_back(to_camera.normalized());
+      direction_sum += directions.back();
+    }
+    layout.focus_in_front += axes[i].dot(layout.focus - centres[i]) > 0.0;
+  }
+  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+  layout.camera_distance = distances[distances.size() / 2];
+  // The directions about their mean: the cone's half angle, and their azimuths around it.
+  const double kDegrees = 180.0 / M_PI;
+  const Eigen::Vector3d mean =
+      direction_sum.norm() > 1e-9 ? direction_sum.normalized() : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d u = mean.unitOrthogonal(), v = mean.cross(u);
+  std::vector<double> azimuths;
+  for (const Eigen::Vector3d& d : directions) {
+    layout.cone_half_angle_degrees = std::max(
+        layout.cone_half_angle_degrees, std::acos(std::clamp(d.dot(mean), -1.0, 1.0)) * kDegrees);
+    const Eigen::Vector3d across = d - d.dot(mean) * mean;
+    if (across.norm() > 1e-9) azimuths.push_back(std::atan2(across.dot(v), across.dot(u)) * kDegrees);
+  }
+  std::sort(azimuths.begin(), azimuths.end());
+  if (azimuths.size() >= 2) {
+    layout.largest_gap_degrees = 360.0 - (azimuths.back() - azimuths.front());
+    for (size_t i = 1; i < azimuths.size(); ++i) {
+      layout.largest_gap_degrees = std::max(layout.largest_gap_degrees, azimuths[i] - azimuths[i - 1]);
+    }
+  }
+  const bool ring = layout.largest_gap_degrees <= kMaxObjectGapDegrees &&
+                    layout.cone_half_angle_degrees >= kMinRingConeDegrees;
+  const bool arc = layout.cone_half_angle_degrees >= kMinArcConeDegrees;
+  layout.object_centred = layout.focus_in_front == layout.cameras && (ring || arc);
+  // The points a photo centred on the focus frames.
+  double half_field = 0.5;
+  if (!half_fields.empty()) {
+    std::nth_element(half_fields.begin(), half_fields.begin() + half_fields.size() / 2,
+                     half_fields.end());
+    half_field = half_fields[half_fields.size() / 2];
+  }
+  const double radius = layout.camera_distance * std::tan(half_field);
+  std::array<std::vector<double>, 3> coordinates;
+  for (const auto& [id, point] : reconstruction.points3D) {
+    if (point.track.size() < 2 || (point.xyz - layout.focus).norm() > radius) continue;
+    for (int axis = 0; axis < 3; ++axis) coordinates[axis].push_back(point.xyz[axis]);
+  }
+  layout.focus_box_points = static_cast<int>(coordinates[0].size());
+  if (layout.focus_box_points < 20) return layout;
+  Eigen::Vector3d low, high;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<double>& values = coordinates[axis];
+    std::sort(values.begin(), values.end());
+    const size_t trim = values.size() / 50;
+    low[axis] = values[trim];
+    high[axis] = values[values.size() - 1 - trim];
+  }
+  const double margin = 0.1 * (high - low).maxCoeff();
+  layout.focus_box = Eigen::AlignedBox3d(low.array() - margin, high.array() + margin);
+  return layout;
 }
 
 }  // namespace raycarve

@@ -40,6 +40,7 @@ struct BoundsOptions {
 struct Bounds {
   Eigen::AlignedBox3d box;
   bool is_explicit = false;     // given by the user, not computed
+  bool around_focus = false;    // the box around the cameras' focus (CaptureLayout::focus_box)
   int num_points = 0;           // points in the model
   int num_used = 0;             // points that passed the filters
   int num_short_track = 0;      // dropped for track length
@@ -60,5 +61,39 @@ Bounds ComputeBounds(const Reconstruction& reconstruction,
 // An explicit box (for --bbox): throws InputError when a coordinate is not finite or min >= max
 // on an axis.
 Bounds ExplicitBounds(const Eigen::Vector3d& min, const Eigen::Vector3d& max);
+
+// How the cameras of a capture stand, from their poses alone: around a point they all look at
+// (an object-centred capture: a turntable, a walk around a statue) or facing one way (a scene: a
+// facade, a room, a forward-facing capture).
+struct CaptureLayout {
+  // The point nearest every camera's optical axis (least squares), and the median distance of
+  // the cameras from it.
+  Eigen::Vector3d focus = Eigen::Vector3d::Zero();
+  double camera_distance = 0.0;
+  // Seen from the focus, the cameras' directions: the widest angle between one of them and
+  // their mean (the cone they fill), and the widest gap between them going round the mean.
+  double cone_half_angle_degrees = 0.0;
+  double largest_gap_degrees = 360.0;
+  // Cameras with the focus in front of them (positive depth), of all.
+  int focus_in_front = 0;
+  int cameras = 0;
+  // Object-centred: the focus in front of every camera, and the cameras all round it (no gap
+  // wider than kMaxObjectGapDegrees, the cone at least kMinRingConeDegrees: a ring at any
+  // height) or over a wide arc (the cone at least kMinArcConeDegrees). A forward-facing grid
+  // fills a narrow cone; a walk along a facade leaves a gap of half a turn.
+  bool object_centred = false;
+  // The sparse points that most photos would frame around the focus: within the cameras' median
+  // half field of view of it (at camera_distance), trimmed at 2% per axis, plus 10% margin. Empty
+  // when fewer than 20 points lie there.
+  Eigen::AlignedBox3d focus_box;
+  int focus_box_points = 0;
+  std::string Summary() const;
+};
+constexpr double kMaxObjectGapDegrees = 150.0;
+constexpr double kMinRingConeDegrees = 20.0;
+constexpr double kMinArcConeDegrees = 60.0;
+
+// Describes `reconstruction`'s cameras (at least 2 images; otherwise a default layout).
+CaptureLayout DescribeCapture(const Reconstruction& reconstruction);
 
 }  // namespace raycarve

@@ -41,6 +41,7 @@ struct CarveRun {
   std::string image_path;
   std::string output_path;
   Bounds bounds;
+  CaptureLayout layout;
   int num_views = 0;  // the views carved
   int num_missing_images = 0;
   int masks_from_files = 0;

@@ -137,7 +137,23 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
       .Key("min").Value(JsonArray(run.bounds.box.min()))
       .Key("max").Value(JsonArray(run.bounds.box.max()))
       .Key("explicit").Value(run.bounds.is_explicit)
+      .Key("around_focus").Value(run.bounds.around_focus)
       .EndObject();
+  const CaptureLayout& layout = run.layout;
+  json.Key("capture").BeginObject()
+      .Key("kind").Value(std::string(layout.object_centred ? "object" : "scene"))
+      .Key("cone_half_angle_degrees").Value(layout.cone_half_angle_degrees)
+      .Key("largest_gap_degrees").Value(layout.largest_gap_degrees)
+      .Key("focus").Value(JsonArray(layout.focus))
+      .Key("camera_distance").Value(layout.camera_distance)
+      .Key("focus_in_front").Value(layout.focus_in_front)
+      .Key("cameras").Value(layout.cameras)
+      .Key("focus_box_points").Value(layout.focus_box_points);
+  if (!layout.focus_box.isEmpty()) {
+    json.Key("focus_box_min").Value(JsonArray(layout.focus_box.min()))
+        .Key("focus_box_max").Value(JsonArray(layout.focus_box.max()));
+  }
+  json.EndObject();
   json.Key("statistics").BeginObject()
       .Key("visibility").Value(s.visibility)
       .Key("grid").Value(std::vector<double>{static_cast<double>(s.dimensions.x()),

@@ -33,6 +33,11 @@ constexpr int kDefaultMinComponentVoxels = 8;
 struct BoundsRequest {
   BoundsOptions options;
   std::string bbox;  // "min_x,min_y,min_z,max_x,max_y,max_z"; empty: from the sparse points
+  // What the capture is, for the box: "object" (the box around the cameras' common focus,
+  // CaptureLayout::focus_box), "scene" (every sparse point the filters keep), or "auto": object
+  // when the cameras stand around a point and the photos have no masks (masks already bound an
+  // object), else scene.
+  std::string capture = "auto";
 };
 
 // Everything the carve pipeline takes: where the project is, and each stage's options.

@@ -127,6 +127,29 @@ WorkspacePaths ResolveProjectPaths(const ProjectRequest& request, std::string* o
   return paths;
 }
 
+void ChooseCaptureBox(const BoundsRequest& request, LoadedProject* project) {
+  if (project->bounds.is_explicit || request.capture == "scene") return;
+  const ViewReaderSummary& masks = project->view_summary;
+  // As CarvePipeline decides masks: files, or a backdrop found in half of the photos or more.
+  const bool masked = masks.masks_from_files > 0 ||
+                      (masks.masks_from_backdrop > 0 && 2 * masks.masks_from_backdrop >=
+                                                            static_cast<int>(masks.photos.size()));
+  const CaptureLayout& layout = project->layout;
+  const bool object = request.capture == "object" || (layout.object_centred && !masked);
+  if (!object) return;
+  if (layout.focus_box.isEmpty()) {
+    LOG(WARNING) << "too few sparse points around the cameras' focus (" << layout.focus_box_points
+                 << "): the box keeps every sparse point";
+    return;
+  }
+  const Eigen::AlignedBox3d box = layout.focus_box.intersection(project->bounds.box);
+  if (box.isEmpty() || box.isApprox(project->bounds.box)) return;
+  project->bounds.box = box;
+  project->bounds.around_focus = true;
+  LOG(INFO) << "volume: the box around the cameras' focus (" << layout.focus_box_points
+            << " sparse points framed there; --capture " << request.capture << ")";
+}
+
 LoadedProject LoadProject(const ProjectRequest& request) {
   LoadedProject project;
   const WorkspacePaths paths = ResolveProjectPaths(request, &project.output_path);
@@ -152,6 +175,8 @@ LoadedProject LoadProject(const ProjectRequest& request) {
   }
   project.bounds = ResolveBounds(project.reconstruction, request.bounds, paths.model_path);
   LOG(INFO) << project.bounds.Summary();
+  project.layout = DescribeCapture(project.reconstruction);
+  LOG(INFO) << "capture: " << project.layout.Summary();
   CheckPhotosFitInMemory(project.reconstruction, request.view_options.max_image_size);
   LOG(INFO) << "loading and undistorting " << registered << " photos from " << paths.image_path;
   ViewReaderOptions reader_options = request.view_options;
@@ -182,6 +207,7 @@ LoadedProject LoadProject(const ProjectRequest& request) {
                    "where that at least halves the spread: different exposures)";
     }
   }
+  ChooseCaptureBox(request.bounds, &project);
   project.surface_points =
       SurfacePointsOf(project.reconstruction, project.views, project.bounds.box);
   return project;

@@ -25,6 +25,7 @@ struct LoadedProject {
   std::string output_path;
   Reconstruction reconstruction;
   Bounds bounds;
+  CaptureLayout layout;  // how the cameras stand (DescribeCapture), after any hold-out
   std::vector<CalibratedView> views;
   ViewReaderSummary view_summary;
   ColourCalibration colour;  // estimated unless off (points_used 0 otherwise); see its `applied`
@@ -91,6 +92,11 @@ WorkspacePaths ResolveProjectPaths(const ProjectRequest& request, std::string* o
 // calibration nor the surface points see the held-out views (which are still loaded). Throws
 // InputError naming the command or the file on bad input.
 LoadedProject LoadProject(const ProjectRequest& request);
+
+// The capture's box (BoundsRequest::capture): for an object, the computed box narrowed to the
+// one around the cameras' focus (CaptureLayout::focus_box), marked Bounds::around_focus; an
+// explicit box, a scene, or too few points there leave it as it is.
+void ChooseCaptureBox(const BoundsRequest& request, LoadedProject* project);
 
 // Memory held per photo pixel while carving (the photo, its undistorted view, validity and mask,
 // rays and their statistics): 13.6 bytes measured as the peak resident memory of carving 100

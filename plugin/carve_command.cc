@@ -16,6 +16,10 @@
 namespace raycarve {
 namespace {
 
+// A share of the surface on the box's walls from which the summary says what would help: a
+// tenth of the model is a cut that a user sees at once.
+constexpr double kGuidanceWallShare = 0.1;
+
 // One line on where the masks came from: per source the count, and for backdrop masks the
 // colours found (those of the first such photo), frames and the median object share.
 std::string MaskSummary(const std::vector<PhotoMaskInfo>& photos) {
@@ -128,6 +132,7 @@ void PrintSummary(const CarveRequest& request, const CarveRun& run) {
       "  process memory  %.1f MiB at its peak (resident: photos, views, grid, mesh)\n"
       "  surface         %lld voxels, %lld seen by the photos, %zu by %d or more\n"
       "  sparse points   %s\n"
+      "  capture         %s\n"
       "  masks           %s\n"
       "%s"
       "  outputs         %s/cloud.ply (%zu points, seen by %d+ photos), mesh.ply (%zu triangles),\n"
@@ -142,10 +147,48 @@ void PrintSummary(const CarveRequest& request, const CarveRun& run) {
       s.levels.size(), level_line.c_str(), s.carve_seconds, s.setup_seconds,
       s.ThreadsText().c_str(), s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,
-      sparse_line.c_str(), mask_line.c_str(), silhouette_line.c_str(), run.output_path.c_str(),
+      sparse_line.c_str(),
+      (run.layout.Summary() +
+       (run.bounds.around_focus ? "\n                  the volume: the box around their focus" : ""))
+          .c_str(),
+      mask_line.c_str(),
+      silhouette_line.c_str(), run.output_path.c_str(),
       run.num_cloud_points,
       request.mesh_kind == "smooth" ? request.cloud_min_views : request.options.min_views,
       run.num_mesh_triangles, run.output_path.c_str());
+}
+
+// The share of the surface the box cut (before the walls were left out), 0 when unknown.
+double WallShare(const CarveRun& run) {
+  return run.mesh_triangles_before_walls > 0
+             ? static_cast<double>(run.mesh_wall_triangles_removed) / run.mesh_triangles_before_walls
+             : 0.0;
+}
+
+// What to do next when the capture has no masks and the box cuts much of its surroundings: the
+// box around what the cameras look at, and masks.
+void PrintGuidance(const CarveRequest& request, const CarveRun& run) {
+  const bool masked = run.masks_from_files + run.masks_from_backdrop > 0;
+  if (masked || run.bounds.is_explicit || WallShare(run) < kGuidanceWallShare) return;
+  std::printf("  next            the volume's box cuts the %s around the subject (%.0f%% of the "
+              "surface lay on its walls):\n",
+              run.layout.object_centred ? "surroundings" : "scene", 100.0 * WallShare(run));
+  const Eigen::AlignedBox3d& focus = run.layout.focus_box;
+  const bool box_hint = run.layout.object_centred && !focus.isEmpty() && !run.bounds.around_focus;
+  if (box_hint) {
+    const std::string project = request.workspace_path.empty()
+                                    ? "--input_path " + run.model_path + " --image_path " +
+                                          run.image_path
+                                    : "--workspace_path " + request.workspace_path;
+    std::printf("                  to carve what the cameras look at (%d sparse points framed "
+                "around their common focus):\n"
+                "                  raycarve carve %s --bbox %.4g,%.4g,%.4g,%.4g,%.4g,%.4g\n",
+                run.layout.focus_box_points, project.c_str(), focus.min().x(), focus.min().y(),
+                focus.min().z(), focus.max().x(), focus.max().y(), focus.max().z());
+  }
+  std::printf("                  %s the subject's masks (--mask_path, one <photo>.png per photo, "
+              "white on the subject): the carve then keeps the subject alone\n",
+              box_hint ? "or give" : "give");
 }
 
 // Warnings, COLMAP's mesher line and the mesh's figures, after the summary.
@@ -196,6 +239,7 @@ void PrintAfterSummary(const CarveRequest& request, const CarveRun& run) {
                   static_cast<long long>(run.mesh_grid_wall_vertices));
     }
   }
+  PrintGuidance(request, run);
 }
 
 }  // namespace

@@ -218,6 +218,12 @@ void AddWorkspaceFlags(OptionParser* parser, const WorkspaceFlags& flags) {
 
 void AddBoundsFlags(OptionParser* parser, BoundsRequest* bounds) {
   parser->BeginGroup("Bounds");
+  parser->AddDefault("capture", &bounds->capture,
+                     "what the photos show, for the volume's box: object (the box around the "
+                     "sparse points framed where the cameras' axes meet), scene (every sparse "
+                     "point the filters below keep), auto: object when the cameras stand around a "
+                     "point and the photos have no masks",
+                     {"auto", "object", "scene"});
   parser->AddDefault("min_track_length", &bounds->options.min_track_length,
                      "sparse points seen in fewer images are ignored when bounding the volume");
   parser->AddDefault("max_reprojection_error", &bounds->options.max_reprojection_error,

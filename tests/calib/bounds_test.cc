@@ -1,6 +1,9 @@
 #include "calib/bounds.h"
 
+#include <cmath>
 #include <random>
+#include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -32,6 +35,96 @@ void AddPoints(const Eigen::AlignedBox3d& box,
 }
 
 const Eigen::AlignedBox3d kObject(Eigen::Vector3d(-1, -2, 0), Eigen::Vector3d(1, 2, 3));
+
+// A model of pinhole cameras (640x480, f 500) at `centres`, each looking at `targets[i]` with
+// its image's up towards +z, and 400 points spread over a sphere of radius 0.5 at the origin.
+Reconstruction CamerasLookingAt(const std::vector<Eigen::Vector3d>& centres,
+                                const std::vector<Eigen::Vector3d>& targets) {
+  Reconstruction model;
+  Camera camera;
+  camera.camera_id = 1;
+  camera.model = CameraModelId::kPinhole;
+  camera.width = 640;
+  camera.height = 480;
+  camera.params = {500, 500, 320, 240};
+  model.cameras[1] = camera;
+  for (size_t i = 0; i < centres.size(); ++i) {
+    const Eigen::Vector3d z = (targets[i] - centres[i]).normalized();
+    const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+    const Eigen::Vector3d y = z.cross(x);
+    Eigen::Matrix3d rows;
+    rows << x.transpose(), y.transpose(), z.transpose();
+    Image image;
+    image.image_id = static_cast<image_t>(i + 1);
+    image.camera_id = 1;
+    image.name = "view" + std::to_string(i) + ".png";
+    image.cam_from_world.rotation = Eigen::Quaterniond(rows);
+    image.cam_from_world.translation = -(rows * centres[i]);
+    model.images[image.image_id] = image;
+  }
+  std::mt19937 random(3);
+  std::normal_distribution<double> normal;
+  for (int p = 0; p < 400; ++p) {
+    Point3D point;
+    point.xyz = 0.5 * Eigen::Vector3d(normal(random), normal(random), normal(random)).normalized();
+    point.track = {{1, 0}, {2, 0}};
+    model.points3D[static_cast<point3D_t>(p + 1)] = point;
+  }
+  return model;
+}
+
+TEST(DescribeCapture, TellsCamerasAroundAPointFromCamerasFacingOneWay) {
+  const double kPi = 3.14159265358979;
+  std::vector<Eigen::Vector3d> centres, targets;
+  // A ring high above the object (60 degrees up), all looking at it: object-centred.
+  for (int i = 0; i < 12; ++i) {
+    const double a = 2.0 * kPi * i / 12;
+    centres.emplace_back(2.0 * std::cos(a), 2.0 * std::sin(a), 2.0 * std::tan(kPi / 3));
+    targets.emplace_back(0, 0, 0);
+  }
+  CaptureLayout layout = DescribeCapture(CamerasLookingAt(centres, targets));
+  EXPECT_TRUE(layout.object_centred) << layout.Summary();
+  EXPECT_LT(layout.focus.norm(), 1e-6);
+  EXPECT_NEAR(layout.camera_distance, 4.0, 1e-6);
+  EXPECT_NEAR(layout.cone_half_angle_degrees, 30.0, 1e-6);
+  EXPECT_NEAR(layout.largest_gap_degrees, 30.0, 1e-6);
+  // The points a photo frames around the focus: the sphere, with a tenth of margin.
+  EXPECT_EQ(layout.focus_box_points, 400);
+  EXPECT_NEAR(layout.focus_box.max().x(), 0.5 + 0.1, 0.05);
+  // Half a ring at the object's height: a wide arc, object-centred.
+  centres.clear();
+  targets.clear();
+  for (int i = 0; i < 9; ++i) {
+    const double a = kPi * i / 8;
+    centres.emplace_back(3.0 * std::cos(a), 3.0 * std::sin(a), 0.3);
+    targets.emplace_back(0, 0, 0);
+  }
+  layout = DescribeCapture(CamerasLookingAt(centres, targets));
+  EXPECT_TRUE(layout.object_centred) << layout.Summary();
+  // A forward-facing grid of 4 x 3 cameras 5 units in front of a scene, all converging on it:
+  // a narrow cone, a scene.
+  centres.clear();
+  targets.clear();
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 4; ++col) {
+      centres.emplace_back(-0.75 + 0.5 * col, -5.0, -0.5 + 0.5 * row);
+      targets.emplace_back(0, 0, 0);
+    }
+  }
+  layout = DescribeCapture(CamerasLookingAt(centres, targets));
+  EXPECT_FALSE(layout.object_centred) << layout.Summary();
+  EXPECT_LT(layout.cone_half_angle_degrees, kMinRingConeDegrees);
+  // A walk along a facade: cameras on a line 4 units in front of it, each looking straight
+  // ahead at the wall (axes parallel but for a slight turn towards the middle): a scene.
+  centres.clear();
+  targets.clear();
+  for (int i = 0; i < 10; ++i) {
+    centres.emplace_back(-4.5 + i, -4.0, 0.0);
+    targets.emplace_back(0.9 * (-4.5 + i), 0.0, 0.0);
+  }
+  layout = DescribeCapture(CamerasLookingAt(centres, targets));
+  EXPECT_FALSE(layout.object_centred) << layout.Summary();
+}
 
 TEST(Bounds, ContainTheObjectAndIgnoreFarOutliers) {
   std::mt19937_64 random(3);

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Unmasked captures with known truth (not a test). For each generated scene (raycarve synth, 12
+# views of 320x240, its exact masks deleted so that raycarve sees what a user without masks
+# has): carve and holdout (--every 4) at the defaults and with the colour test off
+# (--threshold 1000000), and report
+#   - the capture raycarve found (object / scene) and whether the box went round the focus;
+#   - the share of the surface on the volume box's walls (left out of the mesh);
+#   - the cloud against the scene's truth (truth.ply): precision, completeness and F-score at
+#     two voxels (raycarve compare);
+#   - held-out photos: whole-photo PSNR, and the share of their sparse points (triangulated from
+#     the other photos) the mesh draws at their depth and hides behind something nearer.
+# Prints a Markdown table and writes out/unmasked_table/table.json.
+# Usage: scripts/run_unmasked_table.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+command -v python3 > /dev/null || { echo "run_unmasked_table.sh needs python3" >&2; exit 1; }
+scripts/setup.sh raycarve >&2
+rc=build/plugin/raycarve
+out=out/unmasked_table
+rm -rf "$out"
+mkdir -p "$out"
+rows="$out/rows.jsonl"
+: > "$rows"
+for scene in "room ring" "room arc" "patchwork ring" "patchwork arc"; do
+  set -- $scene
+  backdrop=$1 layout=$2 name="$1_$2"
+  dir="$out/$name"
+  $rc synth --output_path "$dir/scene" --backdrop "$backdrop" --layout "$layout" --views 12 \
+    --width 320 --height 240 > "$dir.synth.log" 2>&1
+  rm -rf "$dir/scene/masks"
+  for run in defaults colour_off; do
+    flags=""
+    [ "$run" = colour_off ] && flags="--threshold 1000000"
+    $rc carve --workspace_path "$dir/scene" --output_path "$dir/$run" $flags > "$dir.$run.carve.log" 2>&1
+    voxel=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["statistics"]["voxel_size"])' "$dir/$run/report.json")
+    $rc compare --reference_path "$dir/scene/truth.ply" --input_path "$dir/$run/cloud.ply" \
+      --threshold "$(python3 -c "print(2 * $voxel)")" --output_path "$dir/$run/compare.json" > "$dir.$run.compare.log" 2>&1
+    $rc holdout --workspace_path "$dir/scene" --output_path "$dir/$run" --every 4 $flags > "$dir.$run.holdout.log" 2>&1
+    python3 - "$name" "$run" "$dir/$run" >> "$rows" <<'EOF'
+import json, sys
+name, run, folder = sys.argv[1:4]
+report = json.load(open(folder + "/report.json"))
+compare = json.load(open(folder + "/compare.json"))
+holdout = json.load(open(folder + "/holdout/holdout.json"))
+def find(obj, key):
+    if isinstance(obj, dict):
+        if key in obj:
+            return obj[key]
+        for value in obj.values():
+            found = find(value, key)
+            if found is not None:
+                return found
+    return None
+print(json.dumps({
+    "scene": name, "run": run,
+    "capture": report["capture"]["kind"], "around_focus": report["bounds"]["around_focus"],
+    "box_wall_share": find(report, "box_wall_share"),
+    "precision": find(compare, "precision"), "completeness": find(compare, "completeness"),
+    "f_score": find(compare, "f_score"),
+    "psnr_db": holdout["mean_psnr_db"], "sparse_points": holdout["sparse_points"],
+    "at_depth": holdout["sparse_at_depth_share"], "hidden": holdout["sparse_hidden_share"]}))
+EOF
+  done
+done
+python3 - "$rows" "$out/table.json" <<'EOF'
+import json, sys
+rows = [json.loads(line) for line in open(sys.argv[1])]
+json.dump(rows, open(sys.argv[2], "w"), indent=1)
+print("| scene | run | capture (box) | on box walls | precision | completeness | F-score | held-out PSNR | sparse at depth | hidden |")
+print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|")
+for r in rows:
+    print("| %s | %s | %s%s | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.2f dB | %.1f%% | %.1f%% |" % (
+        r["scene"], r["run"], r["capture"], " (focus)" if r["around_focus"] else "",
+        100 * r["box_wall_share"], 100 * r["precision"], 100 * r["completeness"],
+        100 * r["f_score"], r["psnr_db"], 100 * r["at_depth"], 100 * r["hidden"]))
+EOF

@@ -69,7 +69,9 @@ std::string MeshShape(const CarveRun& run) {
     // vertex: said, not hidden.
     return "open where the box cuts the scene" +
            (t.non_manifold_vertices > 0
-                ? " (" + std::to_string(t.non_manifold_vertices) + " vertices where two sheets touch)"
+                ? " (" + std::to_string(t.non_manifold_vertices) +
+                      (t.non_manifold_vertices == 1 ? " vertex" : " vertices") +
+                      " where two sheets touch)"
                 : std::string());
   }
   return "NOT closed 2-manifold (see report.json)";

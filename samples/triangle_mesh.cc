@@ -158,12 +158,15 @@ Eigen::Vector3d TriangleMesh::PointOn(int triangle, double r1, double r2,
   return (1.0 - u - v) * vertices_[t[0]] + u * vertices_[t[1]] + v * vertices_[t[2]];
 }
 
-TriangleMesh ReadBezierTeapot(const std::string& path, int tessellation, double scale,
-                              const Eigen::Vector3d& offset) {
+namespace {
+
+using Patch = std::array<int, 16>;
+
+// The patch file: "vertices N", N lines "x y z", "patches M", M lines of 16 control-point indices.
+void ReadTeapotPatches(const std::string& path, std::vector<Eigen::Vector3d>* control,
+                       std::vector<Patch>* patches) {
   std::ifstream file(path);
   if (!file) throw InputError(path + ": cannot open the teapot's patch file");
-  std::vector<Eigen::Vector3d> control;
-  std::vector<std::array<int, 16>> patches;
   std::string line;
   int line_number = 0;
   int expected_vertices = -1, expected_patches = -1;
@@ -182,7 +185,7 @@ TriangleMesh ReadBezierTeapot(const std::string& path, int tessellation, double 
     }
     if (word == "patches") {
       if (!(fields >> expected_patches) || expected_patches < 1) fail("bad patch count");
-      if (static_cast<int>(control.size()) != expected_vertices) fail("fewer vertices than stated");
+      if (static_cast<int>(control->size()) != expected_vertices) fail("fewer vertices than stated");
       continue;
     }
     fields.clear();
@@ -190,71 +193,94 @@ TriangleMesh ReadBezierTeapot(const std::string& path, int tessellation, double 
     if (expected_patches < 0) {
       Eigen::Vector3d p;
       if (expected_vertices < 0 || !(fields >> p.x() >> p.y() >> p.z())) fail("expected 'x y z'");
-      control.push_back(p);
+      control->push_back(p);
     } else {
-      std::array<int, 16> patch;
+      Patch patch;
       for (int& index : patch) {
-        if (!(fields >> index) || index < 0 || index >= static_cast<int>(control.size())) {
-          fail("expected 16 control-point indices below " + std::to_string(control.size()));
+        if (!(fields >> index) || index < 0 || index >= static_cast<int>(control->size())) {
+          fail("expected 16 control-point indices below " + std::to_string(control->size()));
         }
       }
-      patches.push_back(patch);
+      patches->push_back(patch);
     }
   }
-  if (expected_patches < 0 || static_cast<int>(patches.size()) != expected_patches) {
+  if (expected_patches < 0 || static_cast<int>(patches->size()) != expected_patches) {
     throw InputError(path + ": expected " + std::to_string(expected_patches) + " patches, read " +
-                     std::to_string(patches.size()));
+                     std::to_string(patches->size()));
   }
+}
+
+// The patch's unit normal at (u, v); at a collapsed edge (the lid's knob, the bottom's centre),
+// where the tangents are parallel, the normal a little way in.
+Eigen::Vector3d PatchNormal(const std::vector<Eigen::Vector3d>& control, const Patch& patch,
+                            double u, double v, const Eigen::Vector3d& su, const Eigen::Vector3d& sv) {
+  Eigen::Vector3d normal = su.cross(sv);
+  if (normal.norm() < 1e-9) {
+    double bu[4], du[4], bv[4], dv[4];
+    Bernstein(std::clamp(u, 1e-3, 1 - 1e-3), bu, du);
+    Bernstein(std::clamp(v, 1e-3, 1 - 1e-3), bv, dv);
+    Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = a;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) {
+        a += du[r] * bv[c] * control[patch[r * 4 + c]];
+        b += bu[r] * dv[c] * control[patch[r * 4 + c]];
+      }
+    }
+    normal = a.cross(b);
+  }
+  return normal.normalized();
+}
+
+// Appends the patch's (n + 1)^2 grid of points (scaled, moved) with normals, and its triangles
+// of non-zero area.
+void TessellatePatch(const std::vector<Eigen::Vector3d>& control, const Patch& patch, int n,
+                     double scale, const Eigen::Vector3d& offset,
+                     std::vector<Eigen::Vector3d>* vertices, std::vector<Eigen::Vector3d>* normals,
+                     std::vector<std::array<int, 3>>* triangles) {
+  const int base = static_cast<int>(vertices->size());
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= n; ++j) {
+      const double u = static_cast<double>(i) / n, v = static_cast<double>(j) / n;
+      double bu[4], du[4], bv[4], dv[4];
+      Bernstein(u, bu, du);
+      Bernstein(v, bv, dv);
+      Eigen::Vector3d point = Eigen::Vector3d::Zero(), su = point, sv = point;
+      for (int r = 0; r < 4; ++r) {
+        for (int c = 0; c < 4; ++c) {
+          const Eigen::Vector3d& p = control[patch[r * 4 + c]];
+          point += bu[r] * bv[c] * p;
+          su += du[r] * bv[c] * p;
+          sv += bu[r] * dv[c] * p;
+        }
+      }
+      vertices->push_back(scale * point + offset);
+      normals->push_back(PatchNormal(control, patch, u, v, su, sv));
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const int a = base + i * (n + 1) + j, b = a + 1, c = a + (n + 1), d = c + 1;
+      for (const std::array<int, 3>& t : {std::array<int, 3>{a, c, b}, std::array<int, 3>{b, c, d}}) {
+        const std::vector<Eigen::Vector3d>& x = *vertices;
+        const double area = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).norm();
+        if (area > 1e-14 * scale * scale) triangles->push_back(t);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+TriangleMesh ReadBezierTeapot(const std::string& path, int tessellation, double scale,
+                              const Eigen::Vector3d& offset) {
+  std::vector<Eigen::Vector3d> control;
+  std::vector<Patch> patches;
+  ReadTeapotPatches(path, &control, &patches);
   std::vector<Eigen::Vector3d> vertices, normals;
   std::vector<std::array<int, 3>> triangles;
   const int n = tessellation;
-  for (const std::array<int, 16>& patch : patches) {
-    const int base = static_cast<int>(vertices.size());
-    for (int i = 0; i <= n; ++i) {
-      for (int j = 0; j <= n; ++j) {
-        double bu[4], du[4], bv[4], dv[4];
-        Bernstein(static_cast<double>(i) / n, bu, du);
-        Bernstein(static_cast<double>(j) / n, bv, dv);
-        Eigen::Vector3d point = Eigen::Vector3d::Zero(), su = point, sv = point;
-        for (int r = 0; r < 4; ++r) {
-          for (int c = 0; c < 4; ++c) {
-            const Eigen::Vector3d& p = control[patch[r * 4 + c]];
-            point += bu[r] * bv[c] * p;
-            su += du[r] * bv[c] * p;
-            sv += bu[r] * dv[c] * p;
-          }
-        }
-        Eigen::Vector3d normal = su.cross(sv);
-        // A collapsed edge (lid knob, bottom centre): nudge inwards for a direction.
-        if (normal.norm() < 1e-9) {
-          double bu2[4], du2[4], bv2[4], dv2[4];
-          const double ui = std::clamp(static_cast<double>(i) / n, 1e-3, 1 - 1e-3);
-          const double vj = std::clamp(static_cast<double>(j) / n, 1e-3, 1 - 1e-3);
-          Bernstein(ui, bu2, du2);
-          Bernstein(vj, bv2, dv2);
-          Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = a;
-          for (int r = 0; r < 4; ++r) {
-            for (int c = 0; c < 4; ++c) {
-              a += du2[r] * bv2[c] * control[patch[r * 4 + c]];
-              b += bu2[r] * dv2[c] * control[patch[r * 4 + c]];
-            }
-          }
-          normal = a.cross(b);
-        }
-        vertices.push_back(scale * point + offset);
-        normals.push_back(normal.normalized());
-      }
-    }
-    for (int i = 0; i < n; ++i) {
-      for (int j = 0; j < n; ++j) {
-        const int a = base + i * (n + 1) + j, b = a + 1, c = a + (n + 1), d = c + 1;
-        for (const std::array<int, 3>& t : {std::array<int, 3>{a, c, b}, std::array<int, 3>{b, c, d}}) {
-          const double area =
-              (vertices[t[1]] - vertices[t[0]]).cross(vertices[t[2]] - vertices[t[0]]).norm();
-          if (area > 1e-14 * scale * scale) triangles.push_back(t);
-        }
-      }
-    }
+  for (const Patch& patch : patches) {
+    TessellatePatch(control, patch, n, scale, offset, &vertices, &normals, &triangles);
   }
   // Outward normals: the patches' parameterisations do not agree on a side. A point just off a
   // patch's middle along its normal is inside the closed surface when a ray from it crosses the

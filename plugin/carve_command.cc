@@ -172,9 +172,16 @@ double WallShare(const CarveRun& run) {
 void PrintGuidance(const CarveRequest& request, const CarveRun& run) {
   const bool masked = run.masks_from_files + run.masks_from_backdrop > 0;
   if (masked || run.bounds.is_explicit || WallShare(run) < kGuidanceWallShare) return;
-  std::printf("  next            the volume's box cuts the %s around the subject (%.0f%% of the "
-              "surface lay on its walls):\n",
-              run.layout.object_centred ? "surroundings" : "scene", 100.0 * WallShare(run));
+  if (run.layout.object_centred) {
+    std::printf("  next            the volume's box cuts the surroundings around the subject (%.0f%% "
+                "of the surface lay on its walls):\n",
+                100.0 * WallShare(run));
+  } else {
+    std::printf("  next            a scene: the box holds the sparse points several photos share, and "
+                "cuts what runs on beyond them (%.0f%% of the surface lay on its walls). To carve "
+                "one subject alone:\n",
+                100.0 * WallShare(run));
+  }
   const Eigen::AlignedBox3d& focus = run.layout.focus_box;
   const bool box_hint = run.layout.object_centred && !focus.isEmpty() && !run.bounds.around_focus;
   if (box_hint) {

@@ -25,8 +25,9 @@ int RunSynth(int argc, char** argv) {
   std::string layout = "ring";
   parser.AddDefault("layout", &layout,
                     "where the cameras stand: a ring around the scene, a hemisphere (12 to 72 "
-                    "degrees up), an arc (the ring's front 150 degrees), or close (a ring at 0.6 "
-                    "of the distance, the ground leaving the frames)",
+                    "degrees up), an arc (the ring's front 150 degrees), close (a ring at 0.6 "
+                    "of the distance, the ground leaving the frames), or forward (forward-facing: "
+                    "a grid of positions on one side, as in front of a facade)",
                     CameraLayoutNames());
   parser.AddDefault("width", &options.width, "photo width in pixels");
   parser.AddDefault("height", &options.height, "photo height in pixels");

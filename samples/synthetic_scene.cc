@@ -135,7 +135,9 @@ bool EnumFromName(const std::vector<std::string>& names, const std::string& text
 
 }  // namespace
 
-std::vector<std::string> CameraLayoutNames() { return {"ring", "hemisphere", "arc", "close"}; }
+std::vector<std::string> CameraLayoutNames() {
+  return {"ring", "hemisphere", "arc", "close", "forward"};
+}
 
 std::string CameraLayoutToString(CameraLayout layout) {
   return CameraLayoutNames()[static_cast<int>(layout)];
@@ -166,6 +168,16 @@ std::vector<Eigen::Vector3d> CameraCentres(CameraLayout layout, int num_views) {
         const double height = 2.6 + 0.6 * std::sin(3.0 * angle);
         centres.emplace_back(ring_radius * std::cos(angle), ring_radius * std::sin(angle),
                              height);
+        break;
+      }
+      case CameraLayout::kForward: {
+        // Rows of four (the last may be shorter) on a plane facing the scene from the side the
+        // ring starts at, as a photographer steps sideways and up in front of a facade.
+        const int column = i % 4, row = i / 4, rows = (num_views + 3) / 4;
+        const Eigen::Vector3d front(std::cos(0.3), std::sin(0.3), 0.0);
+        const Eigen::Vector3d side(-front.y(), front.x(), 0.0);
+        centres.push_back(kCameraTarget + ring_radius * front + (column - 1.5) / 1.5 * side +
+                          Eigen::Vector3d(0.0, 0.0, 1.2 + (rows > 1 ? 0.8 * row / (rows - 1) : 0.0)));
         break;
       }
       case CameraLayout::kHemisphere: {

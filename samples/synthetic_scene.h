@@ -54,6 +54,7 @@ enum class CameraLayout {
   kHemisphere,  // over a dome from 12 to 72 degrees up, area-uniform, on a golden-angle spiral
   kArc,         // the ring's front 150 degrees only, as where a wall stops the photographer
   kClose,       // a ring at 0.6 of the distance: the ground square leaves the frames
+  kForward,     // forward-facing: a grid 2 wide and 0.8 high, 5 in front, all looking at the scene
 };
 std::string CameraLayoutToString(CameraLayout layout);
 bool CameraLayoutFromString(const std::string& text, CameraLayout* layout);

@@ -22,7 +22,7 @@ rm -rf "$out"
 mkdir -p "$out"
 rows="$out/rows.jsonl"
 : > "$rows"
-for scene in "room ring" "room arc" "patchwork ring" "patchwork arc"; do
+for scene in "room ring" "room arc" "room forward" "patchwork ring" "patchwork arc" "patchwork forward"; do
   set -- $scene
   backdrop=$1 layout=$2 name="$1_$2"
   dir="$out/$name"

@@ -64,5 +64,23 @@ TEST(UnmaskedCapture, TheSubjectIsCarvedInItsOwnBoxWithoutTheBoxsWalls) {
   EXPECT_LT(JsonNumber(colour_off, "sparse_at_depth_share"), 0.5);
 }
 
+// Forward-facing photos (a grid of positions in front of the scene, as before a facade): a scene,
+// whose box keeps every sparse point the filters keep.
+TEST(UnmaskedCapture, ForwardFacingPhotosAreASceneAndKeepTheSparsePointsBox) {
+  const std::string root = testing::MakeTemporaryDirectory("unmasked_forward");
+  std::string output;
+  ASSERT_EQ(RunRaycarve("synth --output_path " + root + " --layout forward --backdrop room "
+                        "--views 8 --width 128 --height 96 --points 600",
+                        &output),
+            0)
+      << output;
+  fs::remove_all(root + "/masks");
+  ASSERT_EQ(RunRaycarve("carve --workspace_path " + root + " --resolution 32", &output), 0) << output;
+  EXPECT_NE(output.find("cameras facing one way (a scene)"), std::string::npos) << output;
+  const std::string report = testing::ReadFileBytes(root + "/raycarve/report.json");
+  EXPECT_NE(report.find("\"kind\": \"scene\""), std::string::npos);
+  EXPECT_NE(report.find("\"around_focus\": false"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace raycarve

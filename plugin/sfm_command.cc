@@ -198,6 +198,11 @@ void RunColmapSteps(const SfmOptions& o, const SfmPlan& plan, const std::string&
   std::vector<std::string> match = {"--database_path", database.string(),
                                     "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads",
                                     threads};
+  if (plan.matcher == "exhaustive") {
+    // Blocks of 10 photos rather than COLMAP's 50: the same pairs, and a progress line per block
+    // (25 photos of 12 MP matched in one block printed nothing for two minutes).
+    match.insert(match.end(), {"--ExhaustiveMatching.block_size", "10"});
+  }
   if (plan.matcher == "sequential") {
     match.insert(match.end(), {"--SequentialMatching.overlap", "20",
                                "--SequentialMatching.quadratic_overlap", "1"});

@@ -273,6 +273,7 @@ TEST(ColmapSfm, PhotosOfTwoSizesRegisterWithACameraEach) {
             std::string::npos)
       << log;
   EXPECT_NE(log.find("colmap| Processed file [15/15]"), std::string::npos) << log;
+  EXPECT_NE(log.find("colmap| Matching block [2/2, 2/2]"), std::string::npos) << log;
   const Reconstruction model = ReadModel(root + "/sfm/sparse/0");
   EXPECT_EQ(model.cameras.size(), model.images.size());
   // Measured: 15 of 15 registered.

@@ -345,7 +345,8 @@ void WriteMesh(const CarveRequest& request, const CarveRun& run, JsonWriter& jso
 }  // namespace
 
 void WriteRunIdentity(JsonWriter& json) {
-  json.Key("raycarve_version").Value(Version())
+  json.Key("schema_version").Value(kReportSchemaVersion)
+      .Key("raycarve_version").Value(Version())
       .Key("commit").Value(BuildCommit())
       .Key("command_line").Value(RunCommandLine())
       .Key("start_time").Value(RunStartTime());

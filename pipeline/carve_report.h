@@ -12,8 +12,14 @@ namespace raycarve {
 // each stage's seconds, the outputs and the mesh. Fed from the pipeline's stage results.
 std::string CarveReportJson(const CarveRequest& request, const CarveRun& run);
 
-// The run's identity at the head of every report: raycarve_version, commit, command_line and
-// start_time, as keys of the open object.
+// The version of the reports' layout (report.json, holdout.json), written as "schema_version":
+// raised whenever a field is renamed, removed or changes its meaning or unit, so that a program
+// reading them can tell. 1: the first to carry it (this round's capture, box-wall and sparse-depth
+// fields included).
+constexpr int kReportSchemaVersion = 1;
+
+// The run's identity at the head of every report: schema_version, raycarve_version, commit,
+// command_line and start_time, as keys of the open object.
 void WriteRunIdentity(JsonWriter& json);
 
 // The process's peak resident memory so far, in MiB (getrusage).

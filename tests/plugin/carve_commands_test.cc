@@ -99,6 +99,7 @@ TEST_F(CarveCommands, CarveWritesCloudMeshReportAndCurve) {
   EXPECT_GT(JsonNumber(report, "evaluated"), carved);
   EXPECT_GT(JsonNumber(report, "peak_memory_bytes"), 0);
   EXPECT_EQ(JsonNumber(report, "resolution"), 40);
+  EXPECT_EQ(JsonNumber(report, "schema_version"), 1);
   EXPECT_NE(report.find("\"carve\":"), std::string::npos);  // a stage timing
   const std::string csv = testing::ReadFileBytes(out + "/convergence.csv");
   EXPECT_EQ(csv.rfind("seconds,carved,evaluated\n", 0), 0u);

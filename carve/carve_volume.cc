@@ -44,11 +44,16 @@ void ChooseLevelThresholds(const std::vector<CalibratedView>& level_views,
   const bool auto_pattern = options.consistency == ConsistencyMethod::kPatchCorrelation &&
                             (options.auto_threshold || options.auto_pattern_threshold);
   if (!options.auto_threshold && !auto_pattern) return;
-  level_statistics->estimate = EstimateThreshold(
-      level_views, level_grid, options.surface_points, options.consistency, options.min_views,
-      std::any_of(level_views.begin(), level_views.end(),
-                  [](const CalibratedView& view) { return !view.mask.empty(); }),
-      options.auto_threshold_quantile, level_options->threshold, options.pattern_threshold);
+  ThresholdRule rule;
+  rule.test_method = options.consistency;
+  rule.min_views = options.min_views;
+  rule.masked = std::any_of(level_views.begin(), level_views.end(),
+                            [](const CalibratedView& view) { return !view.mask.empty(); });
+  rule.quantile = options.auto_threshold_quantile;
+  rule.fallback = level_options->threshold;
+  rule.pattern_fallback = options.pattern_threshold;
+  level_statistics->estimate =
+      EstimateThreshold(level_views, level_grid, options.surface_points, rule);
   level_statistics->threshold_from_data =
       level_statistics->estimate.points_judged >= kMinThresholdPoints;
   if (options.auto_threshold) level_options->threshold = level_statistics->estimate.threshold;

@@ -160,17 +160,15 @@ void MeasurePointErrors(const std::vector<CalibratedView>& views,
 ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
                                     const VoxelGrid& grid,
                                     const std::vector<SurfacePoint>& points,
-                                    ConsistencyMethod test_method,
-                                    int min_views,
-                                    bool masked,
-                                    double quantile,
-                                    double fallback,
-                                    double pattern_fallback,
-                                    int min_points) {
+                                    const ThresholdRule& rule) {
+  const ConsistencyMethod test_method = rule.test_method;
+  const bool masked = rule.masked;
+  const double quantile = rule.quantile;
+  const int min_points = rule.min_points;
   ThresholdEstimate estimate;
   estimate.quantile = quantile;
   const bool patterns = test_method == ConsistencyMethod::kPatchCorrelation;
-  MeasurePointErrors(views, grid, points, test_method, min_views, &estimate);
+  MeasurePointErrors(views, grid, points, test_method, rule.min_views, &estimate);
   estimate.masked = masked;
   auto choose = [&](const std::vector<double>& surface, const std::vector<double>& front) {
     return masked || front.empty() ? ThresholdEstimate::Quantile(surface, quantile)
@@ -187,11 +185,11 @@ ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
       estimate.front_errors.begin() + std::min(drop, estimate.front_errors.size()),
       estimate.front_errors.end());
   estimate.threshold = estimate.points_judged >= min_points ? choose(rule_surface, rule_front)
-                                                            : fallback;
+                                                            : rule.fallback;
   estimate.pattern_threshold =
       static_cast<int>(estimate.surface_pattern_errors.size()) >= min_points
           ? choose(estimate.surface_pattern_errors, estimate.front_pattern_errors)
-          : pattern_fallback;
+          : rule.pattern_fallback;
   if (!patterns) estimate.pattern_threshold = std::numeric_limits<double>::infinity();
   return estimate;
 }

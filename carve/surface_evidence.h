@@ -72,13 +72,25 @@ struct ThresholdEstimate {
   std::string Summary() const;
 };
 
-// Measures the errors of `test_method` at `grid` over `points` (see ThresholdEstimate) and
+// How EstimateThreshold measures and chooses.
+struct ThresholdRule {
+  ConsistencyMethod test_method = ConsistencyMethod::kMeanColour;
+  int min_views = 2;
+  // The views have object masks, so the visual hull has removed the empty space the views see
+  // against the background.
+  bool masked = false;
+  double quantile = 0.99;         // with masks: the share of the surface voxels kept
+  double fallback = 0.0;          // the threshold when too few points can be judged
+  double pattern_fallback = 0.0;  // likewise the pattern threshold
+  int min_points = kMinThresholdPoints;
+};
+
+// Measures the errors of rule.test_method at `grid` over `points` (see ThresholdEstimate) and
 // chooses the threshold (likewise the pattern threshold, from the textured voxels):
-// - `masked` (the views have object masks, so the visual hull has removed the empty space the
-//   views see against the background): the `quantile` of the surface voxels' errors, the
-//   smallest threshold that keeps that share of them. What colour leaves is bounded by the hull,
-//   while a wrongly carved surface voxel leaves a hole that the voxels behind it, seen through
-//   it, widen: the errors cost unequally.
+// - masked: the `quantile` of the surface voxels' errors, the smallest threshold that keeps
+//   that share of them. What colour leaves is bounded by the hull, while a wrongly carved surface
+//   voxel leaves a hole that the voxels behind it, seen through it, widen: the errors cost
+//   unequally.
 // - not masked: colour alone must carve all of the empty space: the smallest threshold at which
 //   the share of surface voxels carved is at most kFrontWeight times the share of front voxels
 //   kept (EqualError).
@@ -87,13 +99,7 @@ struct ThresholdEstimate {
 ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
                                     const VoxelGrid& grid,
                                     const std::vector<SurfacePoint>& points,
-                                    ConsistencyMethod test_method,
-                                    int min_views,
-                                    bool masked,
-                                    double quantile,
-                                    double fallback,
-                                    double pattern_fallback,
-                                    int min_points = kMinThresholdPoints);
+                                    const ThresholdRule& rule);
 
 // The statistics of one voxel in one view as EstimateThreshold gathers them: the usable pixels
 // of `view` whose ray meets the cube of `voxel` (added to `stats`).

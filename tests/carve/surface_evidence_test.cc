@@ -18,6 +18,18 @@ SyntheticScene TexturedScene() {
   return GenerateSyntheticScene(options);
 }
 
+// The rule the tests use: two views, the 99% quantile with masks.
+ThresholdRule Rule(ConsistencyMethod method, bool masked, double fallback, double pattern_fallback) {
+  ThresholdRule rule;
+  rule.test_method = method;
+  rule.min_views = 2;
+  rule.masked = masked;
+  rule.quantile = 0.99;
+  rule.fallback = fallback;
+  rule.pattern_fallback = pattern_fallback;
+  return rule;
+}
+
 TEST(ThresholdEstimate, QuantilesInterpolateAndTheEqualErrorPointSitsBetweenTheLists) {
   const std::vector<double> values = {0, 10, 20, 30, 40};
   EXPECT_DOUBLE_EQ(ThresholdEstimate::Quantile(values, 0.0), 0.0);
@@ -72,8 +84,8 @@ TEST(EstimateThreshold, SeparatesTheSurfaceFromTheSpaceInFrontAndChoosesByTheDoc
   const std::vector<SurfacePoint> points = testing::SceneSurfacePoints(scene);
   ASSERT_GT(points.size(), 100u);
   const VoxelGrid grid(scene.object_box, 96);
-  const ThresholdEstimate unmasked = EstimateThreshold(
-      views, grid, points, ConsistencyMethod::kMeanColour, 2, false, 0.99, -7.0, 0.5);
+  const ThresholdEstimate unmasked =
+      EstimateThreshold(views, grid, points, Rule(ConsistencyMethod::kMeanColour, false, -7.0, 0.5));
   EXPECT_EQ(unmasked.points_judged, static_cast<int>(unmasked.surface_errors.size()));
   EXPECT_GT(unmasked.points_judged, static_cast<int>(points.size()) * 9 / 10);
   ASSERT_GT(unmasked.front_errors.size(), points.size() / 2);
@@ -93,16 +105,16 @@ TEST(EstimateThreshold, SeparatesTheSurfaceFromTheSpaceInFrontAndChoosesByTheDoc
   EXPECT_LT(unmasked.threshold, front_median);
   EXPECT_GT(unmasked.FrontCarved(), 0.5);
 
-  const ThresholdEstimate masked = EstimateThreshold(
-      testing::SceneViews(scene, /*with_masks=*/true), grid, points, ConsistencyMethod::kMeanColour,
-      2, true, 0.99, -7.0, 0.5);
+  const ThresholdEstimate masked =
+      EstimateThreshold(testing::SceneViews(scene, /*with_masks=*/true), grid, points,
+                        Rule(ConsistencyMethod::kMeanColour, true, -7.0, 0.5));
   EXPECT_NEAR(masked.threshold, ThresholdEstimate::Quantile(masked.surface_errors, 0.99), 1e-9);
   EXPECT_GT(masked.threshold, unmasked.threshold);
 
   // Too few points: the fallback.
   const std::vector<SurfacePoint> few(points.begin(), points.begin() + 5);
-  const ThresholdEstimate fallback = EstimateThreshold(
-      views, grid, few, ConsistencyMethod::kMeanColour, 2, false, 0.99, -7.0, 0.5);
+  const ThresholdEstimate fallback =
+      EstimateThreshold(views, grid, few, Rule(ConsistencyMethod::kMeanColour, false, -7.0, 0.5));
   EXPECT_EQ(fallback.threshold, -7.0);
 }
 
@@ -124,9 +136,9 @@ TEST(PatchCorrelation, IgnoresExposureAndWhiteBalanceAndTellsTheSurfaceFromTheSp
   const std::vector<SurfacePoint> points = testing::SceneSurfacePoints(scene);
   const VoxelGrid grid(scene.object_box, 96);
   const ThresholdEstimate plain = EstimateThreshold(
-      views, grid, points, ConsistencyMethod::kPatchCorrelation, 2, false, 0.99, 30, 0.5);
+      views, grid, points, Rule(ConsistencyMethod::kPatchCorrelation, false, 30, 0.5));
   const ThresholdEstimate changed = EstimateThreshold(
-      exposed, grid, points, ConsistencyMethod::kPatchCorrelation, 2, false, 0.99, 30, 0.5);
+      exposed, grid, points, Rule(ConsistencyMethod::kPatchCorrelation, false, 30, 0.5));
   std::cout << "plain photos: " << plain.Summary() << "\nexposure changed: " << changed.Summary()
             << "\n";
   ASSERT_GT(plain.surface_pattern_errors.size(), points.size() / 2);

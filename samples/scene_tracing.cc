@@ -287,14 +287,12 @@ Rigid3d LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
 }
 
 // Renders the photo and the object mask (pixels where most rays hit the scene).
-cv::Mat Render(const SceneGeometry& geometry,
-               const Camera& camera,
-               const Rigid3d& cam_from_world,
-               int supersampling,
-               Backdrop backdrop,
-               bool detail,
-               double specular,
-               cv::Mat* mask) {
+cv::Mat Render(const SceneGeometry& geometry, const Camera& camera, const Rigid3d& cam_from_world,
+               const SyntheticSceneOptions& options, cv::Mat* mask) {
+  const int supersampling = options.supersampling;
+  const Backdrop backdrop = options.backdrop;
+  const bool detail = options.detail_texture;
+  const double specular = options.specular;
   const Rigid3d world_from_cam = cam_from_world.Inverse();
   cv::Mat photo(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC3);
   mask->create(photo.size(), CV_8UC1);

@@ -63,16 +63,10 @@ Eigen::Vector3d RoomColour(const Eigen::Vector3d& point);
 Eigen::Vector3d SurfaceColour(const Hit& hit, bool detail = false);
 // A camera at `centre` looking at `target`, y down in the photo.
 Rigid3d LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target);
-// A photo of the scene through `camera` (with its distortion), `supersampling`^2 rays a pixel;
-// *mask (when given) the exact object mask.
-cv::Mat Render(const SceneGeometry& geometry,
-               const Camera& camera,
-               const Rigid3d& cam_from_world,
-               int supersampling,
-               Backdrop backdrop,
-               bool detail,
-               double specular,
-               cv::Mat* mask);
+// A photo of the scene through `camera` (with its distortion), with the options' supersampling^2
+// rays a pixel, backdrop, detail texture and specular highlights; *mask the exact object mask.
+cv::Mat Render(const SceneGeometry& geometry, const Camera& camera, const Rigid3d& cam_from_world,
+               const SyntheticSceneOptions& options, cv::Mat* mask);
 // A point on the objects or the ground, uniform over their area.
 Hit SampleSurface(const SceneGeometry& g, std::mt19937_64* random);
 // Whether `point` is the first surface along its ray in `image`, and its pixel there.

@@ -366,8 +366,7 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
     image.name = name;
     image.cam_from_world = LookAt(centre, kCameraTarget);
     cv::Mat mask;
-    cv::Mat photo = Render(geometry, camera, image.cam_from_world, options.supersampling,
-                           options.backdrop, options.detail_texture, options.specular, &mask);
+    cv::Mat photo = Render(geometry, camera, image.cam_from_world, options, &mask);
     if (options.exposure_spread > 0.0) {
       // An automatic exposure: the whole photo brighter or darker, by a gain that varies from
       // photo to photo over [1 - spread, 1 + spread].

@@ -102,8 +102,8 @@ struct ObjectMaskReport {
 };
 
 // The object mask (CV_8UC1, 255 = object) of a photo whose backdrop is `model`:
-//  - the frame, and pixels within `tolerance` of a backdrop colour, are backdrop;
-//  - with `refine`, GrabCut (OpenCV) then decides over colour models of both, from: the frame
+//  - the frame, and pixels within options.tolerance of a backdrop colour, are backdrop;
+//  - with options.refine, GrabCut (OpenCV) then decides over colour models of both, from: the frame
 //    and pixels of the backdrop's colours as sure backdrop, pixels that are only a shade of them (shadows, vignetting, gradients: a gain in
 //    [kShadowGain, kLightGain], reached from the backdrop's colours through neighbours that
 //    differ by at most half the tolerance) as probable backdrop, the rest as probable object,
@@ -115,8 +115,7 @@ struct ObjectMaskReport {
 //  - then cleaned of specks (opening 3x3) and pinholes (closing 5x5).
 cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
                             const BackdropModel& model,
-                            double tolerance,
-                            bool refine,
+                            const BackgroundOptions& options,
                             const std::vector<Eigen::Vector2d>& object_seeds,
                             const std::vector<cv::Point>& box_hull,
                             ObjectMaskReport* report);

@@ -266,11 +266,12 @@ void RefineOutlineAtFullSize(const cv::Mat& rgb, const BackdropModel& model, dou
 
 cv::Mat ObjectMaskFromModel(const cv::Mat& rgb,
                             const BackdropModel& model,
-                            double tolerance,
-                            bool refine,
+                            const BackgroundOptions& options,
                             const std::vector<Eigen::Vector2d>& object_seeds,
                             const std::vector<cv::Point>& box_hull,
                             ObjectMaskReport* report) {
+  const double tolerance = options.tolerance;
+  const bool refine = options.refine;
   CHECK_EQ(rgb.type(), CV_8UC3);
   CHECK(model.found);
   ObjectMaskReport local;

@@ -151,8 +151,7 @@ cv::Mat BackdropMask(const Reconstruction& reconstruction, const Image& image, c
   if (!info->backdrop.found) {
     LOG(WARNING) << path << ": " << info->backdrop.Summary() << "; no backdrop mask";
   } else {
-    mask = ObjectMaskFromModel(rgb, info->backdrop, options.background.tolerance,
-                               options.background.refine, seeds,
+    mask = ObjectMaskFromModel(rgb, info->backdrop, options.background, seeds,
                                VolumeOutline(camera, image, options.volume), &info->mask);
     info->source = "backdrop";
   }

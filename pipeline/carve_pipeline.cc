@@ -139,24 +139,17 @@ void CarvePipeline::LoadViews() {
 }
 
 void CarvePipeline::DecideMasks() {
-  // Masks are decided for the capture, not per photo: a backdrop that the automatic rule found in
-  // fewer than half of the photos (a beige forest floor in one photo of an unmasked capture, sky
-  // and ground in some photos of a facade) is not the capture's backdrop. Its masks would switch
-  // the carve to the masked rules and score those held-out views inside them: they go, and every
-  // photo is used whole.
-  const ViewReaderSummary& summary = project_.view_summary;
-  int automatic = 0, photos = 0;
-  for (const PhotoMaskInfo& photo : summary.photos) {
-    automatic += photo.source == "backdrop";
-    ++photos;
-  }
-  if (summary.masks_from_files > 0 || automatic == 0 || 2 * automatic >= photos) return;
+  // Minority masks would switch the carve to the masked rules and score those held-out views
+  // inside them: they go, and every photo is used whole.
+  const int dropped = MinorityBackdropMasks(project_.view_summary);
+  if (dropped == 0) return;
   for (std::vector<CalibratedView>* views : {&carved_, &held_out_}) {
     for (CalibratedView& view : *views) view.mask.release();
   }
-  run_.backdrop_masks_dropped = automatic;
+  run_.backdrop_masks_dropped = dropped;
   run_.masks_from_backdrop = 0;
-  LOG(WARNING) << "the automatic backdrop was found in " << automatic << " of " << photos
+  LOG(WARNING) << "the automatic backdrop was found in " << dropped << " of "
+               << project_.view_summary.photos.size()
                << " photos only: a minority, not the capture's backdrop; carving without masks";
 }
 

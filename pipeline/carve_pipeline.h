@@ -68,6 +68,12 @@ struct CarveRun {
   int64_t mesh_grid_wall_vertices = 0;  // on the grid's wall: left out of the cloud
   int64_t mesh_wall_triangles_removed = 0;  // left out of the mesh (on the wall, no sparse point)
   int64_t mesh_triangles_before_walls = 0;
+  // The share of the mesh's triangles that lay on the box's walls and were left out (0 when none).
+  double WallShare() const {
+    return mesh_triangles_before_walls > 0
+               ? static_cast<double>(mesh_wall_triangles_removed) / mesh_triangles_before_walls
+               : 0.0;
+  }
   // Cloud.
   size_t num_cloud_points = 0;
   // The model's sparse points inside the grid against the cloud (accuracy: their 90% distance).

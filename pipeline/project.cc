@@ -127,13 +127,23 @@ WorkspacePaths ResolveProjectPaths(const ProjectRequest& request, std::string* o
   return paths;
 }
 
+int MinorityBackdropMasks(const ViewReaderSummary& summary) {
+  int automatic = 0, given = 0;
+  for (const PhotoMaskInfo& photo : summary.photos) {
+    automatic += photo.source == "backdrop";
+    given += photo.source == "file" || photo.source == "colour";
+  }
+  const int photos = static_cast<int>(summary.photos.size());
+  return given > 0 || automatic == 0 || 2 * automatic >= photos ? 0 : automatic;
+}
+
+bool CaptureIsMasked(const ViewReaderSummary& summary) {
+  return summary.masks_from_files + summary.masks_from_backdrop > MinorityBackdropMasks(summary);
+}
+
 void ChooseCaptureBox(const BoundsRequest& request, LoadedProject* project) {
   if (project->bounds.is_explicit || request.capture == "scene") return;
-  const ViewReaderSummary& masks = project->view_summary;
-  // As CarvePipeline decides masks: files, or a backdrop found in half of the photos or more.
-  const bool masked = masks.masks_from_files > 0 ||
-                      (masks.masks_from_backdrop > 0 && 2 * masks.masks_from_backdrop >=
-                                                            static_cast<int>(masks.photos.size()));
+  const bool masked = CaptureIsMasked(project->view_summary);
   const CaptureLayout& layout = project->layout;
   const bool object = request.capture == "object" || (layout.object_centred && !masked);
   if (!object) return;

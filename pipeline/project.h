@@ -93,6 +93,15 @@ WorkspacePaths ResolveProjectPaths(const ProjectRequest& request, std::string* o
 // InputError naming the command or the file on bad input.
 LoadedProject LoadProject(const ProjectRequest& request);
 
+// Masks are decided for the capture, not per photo: automatic backdrop masks found in fewer
+// than half of the photos (a beige forest floor in one photo of an unmasked capture, sky and
+// ground in some photos of a facade) are not the capture's backdrop. The number of such masks
+// to drop (0 when there are mask files, masks from a given colour, or the backdrop holds in half
+// of the photos or more).
+int MinorityBackdropMasks(const ViewReaderSummary& summary);
+// Whether the capture is carved with masks once MinorityBackdropMasks are dropped.
+bool CaptureIsMasked(const ViewReaderSummary& summary);
+
 // The capture's box (BoundsRequest::capture): for an object, the computed box narrowed to the
 // one around the cameras' focus (CaptureLayout::focus_box), marked Bounds::around_focus; an
 // explicit box, a scene, or too few points there leave it as it is.

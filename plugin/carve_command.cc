@@ -160,27 +160,20 @@ void PrintSummary(const CarveRequest& request, const CarveRun& run) {
       run.num_mesh_triangles, run.output_path.c_str());
 }
 
-// The share of the surface the box cut (before the walls were left out), 0 when unknown.
-double WallShare(const CarveRun& run) {
-  return run.mesh_triangles_before_walls > 0
-             ? static_cast<double>(run.mesh_wall_triangles_removed) / run.mesh_triangles_before_walls
-             : 0.0;
-}
-
 // What to do next when the capture has no masks and the box cuts much of its surroundings: the
 // box around what the cameras look at, and masks.
 void PrintGuidance(const CarveRequest& request, const CarveRun& run) {
   const bool masked = run.masks_from_files + run.masks_from_backdrop > 0;
-  if (masked || run.bounds.is_explicit || WallShare(run) < kGuidanceWallShare) return;
+  if (masked || run.bounds.is_explicit || run.WallShare() < kGuidanceWallShare) return;
   if (run.layout.object_centred) {
     std::printf("  next            the volume's box cuts the surroundings around the subject (%.0f%% "
                 "of the surface lay on its walls):\n",
-                100.0 * WallShare(run));
+                100.0 * run.WallShare());
   } else {
     std::printf("  next            a scene: the box holds the sparse points several photos share, and "
                 "cuts what runs on beyond them (%.0f%% of the surface lay on its walls). To carve "
                 "one subject alone:\n",
-                100.0 * WallShare(run));
+                100.0 * run.WallShare());
   }
   const Eigen::AlignedBox3d& focus = run.layout.focus_box;
   const bool box_hint = run.layout.object_centred && !focus.isEmpty() && !run.bounds.around_focus;
@@ -241,7 +234,7 @@ void PrintAfterSummary(const CarveRequest& request, const CarveRun& run) {
     if (run.mesh_wall_triangles_removed > 0) {
       std::printf("                  %.1f%% of the surface lay on the volume box's walls, where the "
                   "box cuts the scene: left out of the mesh and the cloud\n",
-                  100.0 * run.mesh_wall_triangles_removed / run.mesh_triangles_before_walls);
+                  100.0 * run.WallShare());
     } else if (run.mesh_grid_wall_vertices > 0) {
       std::printf("                  %lld vertices on the volume box's walls, where the box cuts the "
                   "scene: in the mesh, left out of the cloud\n",

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <map>
+#include <set>
 #include <cmath>
 #include <sstream>
 #include <vector>
@@ -298,7 +300,102 @@ CaptureLayout DescribeCapture(const Reconstruction& reconstruction) {
   }
   const double margin = 0.1 * (high - low).maxCoeff();
   layout.focus_box = Eigen::AlignedBox3d(low.array() - margin, high.array() + margin);
+  const std::vector<Eigen::Vector3d> occluders = FindOccluders(reconstruction, layout.focus_box);
+  layout.occluder_points = static_cast<int>(occluders.size());
+  if (layout.occluder_points >= kMinOccluderPoints) {
+    // The box grows to hold them (trimmed as the focus points are), so that the carve sees what
+    // stands in front of the subject instead of painting the subject with it.
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<double> values;
+      for (const Eigen::Vector3d& point : occluders) values.push_back(point[axis]);
+      std::sort(values.begin(), values.end());
+      const size_t trim = values.size() / 50;
+      layout.focus_box.min()[axis] =
+          std::min(layout.focus_box.min()[axis], values[trim] - margin);
+      layout.focus_box.max()[axis] =
+          std::max(layout.focus_box.max()[axis], values[values.size() - 1 - trim] + margin);
+    }
+  }
   return layout;
+}
+
+std::vector<Eigen::Vector3d> FindOccluders(const Reconstruction& reconstruction,
+                                           const Eigen::AlignedBox3d& box) {
+  // Per image: the pixels and depths of the points inside the box that it does not observe
+  // although they lie in its frame, in buckets of the neighbourhood's size.
+  struct Hidden {
+    Eigen::Vector2d pixel;
+    double depth;
+  };
+  struct ImageBuckets {
+    double cell = 1.0;
+    int columns = 1;
+    std::map<int64_t, std::vector<Hidden>> buckets;
+  };
+  std::map<image_t, ImageBuckets> hidden;
+  std::map<image_t, std::set<point3D_t>> observed;
+  for (const auto& [point_id, point] : reconstruction.points3D) {
+    for (const TrackElement& element : point.track) observed[element.image_id].insert(point_id);
+  }
+  const auto project = [&](const Image& image, const Eigen::Vector3d& xyz, Eigen::Vector2d* pixel,
+                           double* depth) {
+    const auto camera = reconstruction.cameras.find(image.camera_id);
+    if (camera == reconstruction.cameras.end()) return false;
+    const Eigen::Vector3d local = image.cam_from_world * xyz;
+    if (!(local.z() > 0.0)) return false;
+    *pixel = camera->second.ImgFromCam(local.hnormalized());
+    *depth = local.z();
+    return pixel->allFinite() && pixel->x() >= 0.0 && pixel->y() >= 0.0 &&
+           pixel->x() < camera->second.width && pixel->y() < camera->second.height;
+  };
+  for (const auto& [image_id, image] : reconstruction.images) {
+    const auto camera = reconstruction.cameras.find(image.camera_id);
+    if (camera == reconstruction.cameras.end()) continue;
+    ImageBuckets& buckets = hidden[image_id];
+    buckets.cell = std::max<double>(1.0, std::max(camera->second.width, camera->second.height) *
+                                             kOccluderNeighbourhood);
+    buckets.columns = static_cast<int>(camera->second.width / buckets.cell) + 1;
+    const std::set<point3D_t>& seen = observed[image_id];
+    for (const auto& [point_id, point] : reconstruction.points3D) {
+      if (point.track.size() < 2 || !box.contains(point.xyz) || seen.count(point_id)) continue;
+      Hidden entry;
+      if (!project(image, point.xyz, &entry.pixel, &entry.depth)) continue;
+      const int64_t key = static_cast<int64_t>(entry.pixel.y() / buckets.cell) * buckets.columns +
+                          static_cast<int64_t>(entry.pixel.x() / buckets.cell);
+      buckets.buckets[key].push_back(entry);
+    }
+  }
+  std::vector<Eigen::Vector3d> occluders;
+  for (const auto& [point_id, point] : reconstruction.points3D) {
+    if (point.track.size() < 2 || box.contains(point.xyz)) continue;
+    int hiding_views = 0;
+    for (const TrackElement& element : point.track) {
+      const auto image = reconstruction.images.find(element.image_id);
+      if (image == reconstruction.images.end()) continue;
+      Eigen::Vector2d pixel;
+      double depth = 0.0;
+      if (!project(image->second, point.xyz, &pixel, &depth)) continue;
+      const ImageBuckets& buckets = hidden[element.image_id];
+      const int column = static_cast<int>(pixel.x() / buckets.cell);
+      const int row = static_cast<int>(pixel.y() / buckets.cell);
+      int behind = 0;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          if (column + dx < 0 || column + dx >= buckets.columns) continue;
+          const auto bucket =
+              buckets.buckets.find(static_cast<int64_t>(row + dy) * buckets.columns + column + dx);
+          if (bucket == buckets.buckets.end()) continue;
+          for (const Hidden& other : bucket->second) {
+            behind += (other.pixel - pixel).norm() <= buckets.cell &&
+                      other.depth > depth * (1.0 + kOccluderDepthGap);
+          }
+        }
+      }
+      hiding_views += behind >= kOccludedPointsPerView;
+    }
+    if (hiding_views >= kOccluderViews) occluders.push_back(point.xyz);
+  }
+  return occluders;
 }
 
 }  // namespace raycarve

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -85,13 +86,30 @@ struct CaptureLayout {
   // The sparse points that most photos would frame around the focus: within the cameras' median
   // half field of view of it (at camera_distance), trimmed at 2% per axis, plus 10% margin. Empty
   // when fewer than 20 points lie there.
+  // Then grown to hold the occluders (FindOccluders) when there are at least kMinOccluderPoints.
   Eigen::AlignedBox3d focus_box;
   int focus_box_points = 0;
+  int occluder_points = 0;
   std::string Summary() const;
 };
 constexpr double kMaxObjectGapDegrees = 150.0;
 constexpr double kMinRingConeDegrees = 20.0;
 constexpr double kMinArcConeDegrees = 60.0;
+
+// Occluders: sparse points outside a box that hide points inside it from photos. A point hides
+// in a photo that observes it when at least kOccludedPointsPerView points of the box that the
+// photo does not observe (though they lie in its frame) project within kOccluderNeighbourhood of
+// the photo's longer side of it and lie more than kOccluderDepthGap farther; it is an occluder
+// when it hides so in at least kOccluderViews photos. (A point merely missed by the matcher in
+// one photo does not make its neighbours occluders: it takes several behind one point, in two
+// photos.)
+constexpr double kOccluderNeighbourhood = 1.0 / 40.0;
+constexpr double kOccluderDepthGap = 0.1;
+constexpr int kOccludedPointsPerView = 2;
+constexpr int kOccluderViews = 2;
+constexpr int kMinOccluderPoints = 10;
+std::vector<Eigen::Vector3d> FindOccluders(const Reconstruction& reconstruction,
+                                           const Eigen::AlignedBox3d& box);
 
 // Describes `reconstruction`'s cameras (at least 2 images; otherwise a default layout).
 CaptureLayout DescribeCapture(const Reconstruction& reconstruction);

@@ -20,29 +20,31 @@
 
 namespace raycarve {
 
+Bounds ParseBoxText(const std::string& text, const std::string& flag) {
+  std::vector<double> values;
+  std::stringstream stream(text);
+  stream.imbue(std::locale::classic());
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    char* end = nullptr;
+    const double value = std::strtod(item.c_str(), &end);
+    if (item.empty() || end != item.c_str() + item.size()) {
+      throw InputError(flag + ": '" + item + "' is not a number");
+    }
+    values.push_back(value);
+  }
+  if (values.size() != 6) {
+    throw InputError(flag + ": expected 6 comma-separated numbers, found " +
+                     std::to_string(values.size()));
+  }
+  return ExplicitBounds(Eigen::Vector3d(values[0], values[1], values[2]),
+                        Eigen::Vector3d(values[3], values[4], values[5]));
+}
+
 Bounds ResolveBounds(const Reconstruction& reconstruction,
                      const BoundsRequest& flags,
                      const std::string& source) {
-  if (!flags.bbox.empty()) {
-    std::vector<double> values;
-    std::stringstream stream(flags.bbox);
-    stream.imbue(std::locale::classic());
-    std::string item;
-    while (std::getline(stream, item, ',')) {
-      char* end = nullptr;
-      const double value = std::strtod(item.c_str(), &end);
-      if (item.empty() || end != item.c_str() + item.size()) {
-        throw InputError("--bbox: '" + item + "' is not a number");
-      }
-      values.push_back(value);
-    }
-    if (values.size() != 6) {
-      throw InputError("--bbox: expected 6 comma-separated numbers, found " +
-                       std::to_string(values.size()));
-    }
-    return ExplicitBounds(Eigen::Vector3d(values[0], values[1], values[2]),
-                          Eigen::Vector3d(values[3], values[4], values[5]));
-  }
+  if (!flags.bbox.empty()) return ParseBoxText(flags.bbox, "--bbox");
   std::string reason;
   if (!flags.options.IsValid(&reason)) throw InputError("bounds options: " + reason);
   return ComputeBounds(reconstruction, flags.options, source);
@@ -157,7 +159,12 @@ void ChooseCaptureBox(const BoundsRequest& request, LoadedProject* project) {
   project->bounds.box = box;
   project->bounds.around_focus = true;
   LOG(INFO) << "volume: the box around the cameras' focus (" << layout.focus_box_points
-            << " sparse points framed there; --capture " << request.capture << ")";
+            << " sparse points framed there"
+            << (layout.occluder_points >= kMinOccluderPoints
+                    ? ", grown to hold " + std::to_string(layout.occluder_points) +
+                          " in front of them that hide some of them from photos"
+                    : std::string())
+            << "; --capture " << request.capture << ")";
 }
 
 LoadedProject LoadProject(const ProjectRequest& request) {

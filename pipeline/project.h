@@ -56,6 +56,10 @@ std::vector<std::string> HoldOutImages(
     int every, Reconstruction* reconstruction,
     std::map<std::string, std::vector<Eigen::Vector3d>>* seen_points = nullptr);
 
+// The box "min_x,min_y,min_z,max_x,max_y,max_z" of `text`; throws InputError naming `flag`
+// when it is not six numbers or not a box (ExplicitBounds).
+Bounds ParseBoxText(const std::string& text, const std::string& flag);
+
 // The explicit box when request.bbox is given, else ComputeBounds; throws InputError on bad
 // options. `source` names the model in messages.
 Bounds ResolveBounds(const Reconstruction& reconstruction,

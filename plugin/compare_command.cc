@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -66,13 +67,15 @@ exporter::Alignment AlignModels(const std::string& input_model, const std::strin
 std::string ComparisonJson(const std::string& reference,
                            const std::string& input,
                            const exporter::CloudComparison& c,
-                           const exporter::Alignment* alignment) {
+                           const exporter::Alignment* alignment,
+                           const std::string& bbox) {
   JsonWriter json;
   json.BeginObject()
       .Key("reference").Value(reference)
       .Key("input").Value(input)
       .Key("num_reference_points").Value(static_cast<uint64_t>(c.num_reference))
       .Key("num_input_points").Value(static_cast<uint64_t>(c.num_reconstruction))
+      .Key("bbox").Value(bbox)
       .Key("threshold").Value(c.threshold)
       .Key("accuracy").Value(c.accuracy)
       .Key("completeness").Value(c.completeness)
@@ -102,7 +105,7 @@ std::string ComparisonJson(const std::string& reference,
 }
 
 int RunCompare(int argc, char** argv) {
-  std::string reference, input, output_path, input_model, reference_model;
+  std::string reference, input, output_path, input_model, reference_model, bbox;
   int mesh_samples = 500000;
   exporter::CompareOptions options;
   OptionParser parser(
@@ -128,7 +131,13 @@ int RunCompare(int argc, char** argv) {
                     "COLMAP model the input was made from (e.g. COLMAP SfM's sparse/0)");
   parser.AddDefault("reference_model", &reference_model,
                     "COLMAP model in the reference's frame (e.g. the given calibration)");
+  parser.AddDefault("bbox", &bbox,
+                    "compare only inside this box, min_x,min_y,min_z,max_x,max_y,max_z in the "
+                    "reference's frame (e.g. the volume a carve covered, report.json's bounds): "
+                    "both clouds are cut to it");
   if (!parser.Parse(argc, argv)) return 0;
+  const std::unique_ptr<Bounds> crop =
+      bbox.empty() ? nullptr : std::make_unique<Bounds>(ParseBoxText(bbox, "--bbox"));
   if (input_model.empty() != reference_model.empty()) {
     throw InputError("raycarve compare: give both --input_model and --reference_model, or neither");
   }
@@ -144,9 +153,27 @@ int RunCompare(int argc, char** argv) {
       point = alignment->transform(point.cast<double>()).cast<float>();
     }
   }
-  const exporter::CloudComparison comparison = exporter::CompareClouds(
-      exporter::ReadComparablePoints(reference, mesh_samples), input_points, options);
-  const std::string json = ComparisonJson(reference, input, comparison, alignment.get());
+  std::vector<Eigen::Vector3f> reference_points =
+      exporter::ReadComparablePoints(reference, mesh_samples);
+  if (crop) {
+    const auto outside = [&](const Eigen::Vector3f& point) {
+      return !crop->box.contains(point.cast<double>());
+    };
+    reference_points.erase(
+        std::remove_if(reference_points.begin(), reference_points.end(), outside),
+        reference_points.end());
+    input_points.erase(std::remove_if(input_points.begin(), input_points.end(), outside),
+                       input_points.end());
+    if (reference_points.empty() || input_points.empty()) {
+      throw InputError("raycarve compare: --bbox " + bbox + " holds " +
+                       std::to_string(reference_points.size()) + " reference and " +
+                       std::to_string(input_points.size()) +
+                       " input points; is it in the reference's frame?");
+    }
+  }
+  const exporter::CloudComparison comparison =
+      exporter::CompareClouds(reference_points, input_points, options);
+  const std::string json = ComparisonJson(reference, input, comparison, alignment.get(), bbox);
   std::cout << "compare " << input << " against " << reference << "\n";
   if (alignment) std::cout << "  aligned: " << alignment->Summary() << "\n";
   std::cout << "  " << comparison.Summary() << "\n" << json;

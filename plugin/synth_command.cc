@@ -38,9 +38,10 @@ int RunSynth(int argc, char** argv) {
                     "std. dev. of noise on the 2D observations (px)");
   std::string scene_kind = "simple";
   parser.AddDefault("scene", &scene_kind,
-                    "simple (sphere and box) or paper (teapot, sphere and cube; reads the "
-                    "teapot's patches from --teapot_path)",
-                    {"simple", "paper"});
+                    "simple (sphere and box), paper (teapot, sphere and cube; reads the "
+                    "teapot's patches from --teapot_path) or clutter (the simple scene amid "
+                    "five blocks of other textures, some between the cameras and the objects)",
+                    {"simple", "paper", "clutter"});
   parser.AddDefault("teapot_path", &options.teapot_path,
                     "the Utah teapot's Bezier patches (default: $RAYCARVE_DATA_DIR or "
                     "../shared/data, then teapot/teapot_bezier.txt)");

@@ -38,17 +38,19 @@ void IntersectSphere(const SceneGeometry& g, const Eigen::Vector3d& origin,
   }
 }
 
-void IntersectBox(const SceneGeometry& g, const Eigen::Vector3d& origin,
-                  const Eigen::Vector3d& direction, Hit* hit) {
+// The nearest entry of a ray into the axis-aligned box [lo, hi] ahead of *hit, as `surface`.
+void IntersectAlignedBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, Surface surface,
+                         const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                         Hit* hit) {
   double t_near = -kInfinity, t_far = kInfinity;
   int near_axis = 0;
   for (int axis = 0; axis < 3; ++axis) {
     if (direction[axis] == 0.0) {
-      if (origin[axis] < g.box_min[axis] || origin[axis] > g.box_max[axis]) return;
+      if (origin[axis] < lo[axis] || origin[axis] > hi[axis]) return;
       continue;
     }
-    double t0 = (g.box_min[axis] - origin[axis]) / direction[axis];
-    double t1 = (g.box_max[axis] - origin[axis]) / direction[axis];
+    double t0 = (lo[axis] - origin[axis]) / direction[axis];
+    double t1 = (hi[axis] - origin[axis]) / direction[axis];
     if (t0 > t1) std::swap(t0, t1);
     if (t0 > t_near) {
       t_near = t0;
@@ -58,10 +60,32 @@ void IntersectBox(const SceneGeometry& g, const Eigen::Vector3d& origin,
   }
   if (t_near > t_far || t_near <= 1e-9 || t_near >= hit->t) return;
   hit->t = t_near;
-  hit->surface = Surface::kBox;
+  hit->surface = surface;
   hit->point = origin + t_near * direction;
   hit->normal = Eigen::Vector3d::Zero();
   hit->normal[near_axis] = direction[near_axis] > 0.0 ? -1.0 : 1.0;
+}
+
+void IntersectBox(const SceneGeometry& g, const Eigen::Vector3d& origin,
+                  const Eigen::Vector3d& direction, Hit* hit) {
+  IntersectAlignedBox(g.box_min, g.box_max, Surface::kBox, origin, direction, hit);
+  for (const Eigen::AlignedBox3d& block : g.clutter) {
+    IntersectAlignedBox(block.min(), block.max(), Surface::kClutter, origin, direction, hit);
+  }
+}
+
+std::vector<Eigen::AlignedBox3d> ClutterBoxes() {
+  const auto block = [](double x, double y, double size_x, double size_y, double height) {
+    return Eigen::AlignedBox3d(Eigen::Vector3d(x - 0.5 * size_x, y - 0.5 * size_y, 0.0),
+                               Eigen::Vector3d(x + 0.5 * size_x, y + 0.5 * size_y, height));
+  };
+  return {
+      block(1.25, -1.2, 0.3, 0.3, 1.25),  // a post on the ground square's corner
+      block(-1.2, 1.15, 0.6, 0.45, 0.35),  // a low crate on the opposite corner
+      block(0.1, 2.25, 0.9, 0.35, 0.75),   // a bench in front of the arc's middle cameras
+      block(1.9, 1.5, 0.4, 0.4, 0.95),     // a column towards the arc's first cameras
+      block(-0.6, -2.3, 1.2, 0.4, 0.6),    // a chest behind the objects, seen from the arc
+  };
 }
 
 void IntersectGround(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Hit* hit) {
@@ -257,6 +281,18 @@ Eigen::Vector3d SurfaceColour(const Hit& hit, bool detail) {
       albedo = albedo.cwiseMax(0.0);
       break;
     }
+    case Surface::kClutter: {
+      // Blocks of mottled paint in big checks of 0.2: each place its own mix of three colours.
+      const Eigen::Vector3d& p = hit.point;
+      const int check = static_cast<int>(std::floor(p.x() / 0.2)) +
+                        static_cast<int>(std::floor(p.y() / 0.2)) +
+                        static_cast<int>(std::floor(p.z() / 0.2));
+      const Eigen::Vector3d mottle(ValueNoise(p, 0.35, 21), ValueNoise(p, 0.35, 22),
+                                   ValueNoise(p, 0.35, 23));
+      albedo = ((check & 1) ? Eigen::Vector3d(70, 40, 110) : Eigen::Vector3d(150, 120, 40)) +
+               110.0 * mottle;
+      break;
+    }
     case Surface::kNone:
       LOG(FATAL) << "no surface: use SkyColour";
   }
@@ -361,18 +397,60 @@ cv::Mat Render(const SceneGeometry& geometry, const Camera& camera, const Rigid3
   return photo;
 }
 
-// A uniformly distributed point on the scene's surfaces, by area.
+// The area of the axis-aligned box [lo, hi]'s six faces.
+double BoxArea(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const Eigen::Vector3d size = hi - lo;
+  return 2.0 * (size.x() * size.y() + size.y() * size.z() + size.x() * size.z());
+}
+
+// A point uniform over the faces of the axis-aligned box [lo, hi], as `surface`.
+Hit SampleBoxSurface(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, Surface surface,
+                     std::mt19937_64* random) {
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const Eigen::Vector3d size = hi - lo;
+  // A face picked in proportion to its area (faces normal to x, y, z), then a uniform point.
+  const double face_areas[3] = {size.y() * size.z(), size.x() * size.z(), size.x() * size.y()};
+  const double face_pick = uniform(*random) * (face_areas[0] + face_areas[1] + face_areas[2]);
+  const int axis = face_pick < face_areas[0]                   ? 0
+                   : face_pick < face_areas[0] + face_areas[1] ? 1
+                                                               : 2;
+  Hit hit;
+  hit.point = lo + size.cwiseProduct(
+                       Eigen::Vector3d(uniform(*random), uniform(*random), uniform(*random)));
+  const bool upper = uniform(*random) < 0.5;
+  hit.point[axis] = upper ? hi[axis] : lo[axis];
+  hit.normal = Eigen::Vector3d::Zero();
+  hit.normal[axis] = upper ? 1.0 : -1.0;
+  hit.surface = surface;
+  return hit;
+}
+
+// A uniformly distributed point on the scene's surfaces, by area. (A clutter block's bottom
+// face stands on the ground and is sampled too: no view sees it, so the visibility filters drop
+// it.)
 Hit SampleSurface(const SceneGeometry& g, std::mt19937_64* random) {
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const double sphere_area = 4.0 * M_PI * g.sphere_radius * g.sphere_radius;
-  const Eigen::Vector3d box_size = g.box_max - g.box_min;
-  const double box_area = 2.0 * (box_size.x() * box_size.y() + box_size.y() * box_size.z() +
-                                 box_size.x() * box_size.z());
+  const double box_area = BoxArea(g.box_min, g.box_max);
   const double ground_area = 4.0 * kGroundHalfSize * kGroundHalfSize;
   const double teapot_area = g.teapot_area_cdf.empty() ? 0.0 : g.teapot_area_cdf.back();
-  const double pick = uniform(*random) * (sphere_area + box_area + ground_area + teapot_area);
+  std::vector<double> clutter_cdf;
+  double clutter_area = 0.0;
+  for (const Eigen::AlignedBox3d& block : g.clutter) {
+    clutter_area += BoxArea(block.min(), block.max());
+    clutter_cdf.push_back(clutter_area);
+  }
+  const double pick =
+      uniform(*random) * (sphere_area + box_area + ground_area + teapot_area + clutter_area);
   Hit hit;
-  if (pick >= sphere_area + box_area + ground_area) {
+  if (pick >= sphere_area + box_area + ground_area + teapot_area) {
+    const double at = pick - (sphere_area + box_area + ground_area + teapot_area);
+    const size_t block = std::min<size_t>(
+        std::upper_bound(clutter_cdf.begin(), clutter_cdf.end(), at) - clutter_cdf.begin(),
+        g.clutter.size() - 1);
+    hit = SampleBoxSurface(g.clutter[block].min(), g.clutter[block].max(), Surface::kClutter,
+                           random);
+  } else if (pick >= sphere_area + box_area + ground_area) {
     const double at = pick - (sphere_area + box_area + ground_area);
     const int triangle = static_cast<int>(
         std::upper_bound(g.teapot_area_cdf.begin(), g.teapot_area_cdf.end(), at) -
@@ -389,21 +467,7 @@ Hit SampleSurface(const SceneGeometry& g, std::mt19937_64* random) {
     hit.normal = Eigen::Vector3d(s * std::cos(phi), s * std::sin(phi), z);
     hit.point = g.sphere_centre + g.sphere_radius * hit.normal;
   } else if (pick < sphere_area + box_area) {
-    // A face picked in proportion to its area (faces normal to x, y, z), then a uniform point.
-    const double face_areas[3] = {box_size.y() * box_size.z(),
-                                  box_size.x() * box_size.z(),
-                                  box_size.x() * box_size.y()};
-    const double face_pick = uniform(*random) * (face_areas[0] + face_areas[1] + face_areas[2]);
-    const int axis = face_pick < face_areas[0]                   ? 0
-                     : face_pick < face_areas[0] + face_areas[1] ? 1
-                                                                 : 2;
-    hit.point = g.box_min + box_size.cwiseProduct(Eigen::Vector3d(
-                                uniform(*random), uniform(*random), uniform(*random)));
-    const bool upper = uniform(*random) < 0.5;
-    hit.point[axis] = upper ? g.box_max[axis] : g.box_min[axis];
-    hit.normal = Eigen::Vector3d::Zero();
-    hit.normal[axis] = upper ? 1.0 : -1.0;
-    hit.surface = Surface::kBox;
+    hit = SampleBoxSurface(g.box_min, g.box_max, Surface::kBox, random);
   } else {
     hit.surface = Surface::kGround;
     hit.point = Eigen::Vector3d((2.0 * uniform(*random) - 1.0) * kGroundHalfSize,

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
 #include "calib/camera.h"
@@ -30,7 +31,12 @@ const Eigen::Vector3d kCameraTarget(0.0, 0.0, 0.35);
 // Where the light comes from (a unit direction): the surfaces' shading and the highlights.
 const Eigen::Vector3d kLight = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
 
-enum class Surface { kNone, kGround, kSphere, kBox, kTeapot };
+enum class Surface { kNone, kGround, kSphere, kBox, kTeapot, kClutter };
+
+// The clutter scene's blocks (SceneKind::kClutter), standing on z = 0 around the simple scene's
+// objects: two on the ground square's edge, three beyond it, between the cameras of an arc
+// (SceneKind::kArc looks from +y) and the objects or behind them.
+std::vector<Eigen::AlignedBox3d> ClutterBoxes();
 
 }  // namespace scene_tracing
 
@@ -43,6 +49,7 @@ struct SceneGeometry {
   Eigen::Vector3d box_max = scene_tracing::kBoxMax;
   std::unique_ptr<TriangleMesh> teapot;  // the paper's scene only
   std::vector<double> teapot_area_cdf;   // cumulative triangle areas, for sampling
+  std::vector<Eigen::AlignedBox3d> clutter;  // the clutter scene's blocks
   double top = scene_tracing::kSphereCentre.z() + scene_tracing::kSphereRadius;  // highest point of the objects
 };
 

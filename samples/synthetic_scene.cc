@@ -109,11 +109,19 @@ std::vector<double> ExampleCameraParams(CameraModelId model, int width, int heig
 }
 
 std::string SceneKindToString(SceneKind kind) {
-  return kind == SceneKind::kSimple ? "simple" : "paper";
+  switch (kind) {
+    case SceneKind::kSimple:
+      return "simple";
+    case SceneKind::kPaper:
+      return "paper";
+    case SceneKind::kClutter:
+      return "clutter";
+  }
+  return "simple";
 }
 
 bool SceneKindFromString(const std::string& text, SceneKind* kind) {
-  for (SceneKind candidate : {SceneKind::kSimple, SceneKind::kPaper}) {
+  for (SceneKind candidate : {SceneKind::kSimple, SceneKind::kPaper, SceneKind::kClutter}) {
     if (text == SceneKindToString(candidate)) {
       *kind = candidate;
       return true;
@@ -235,6 +243,13 @@ std::string DefaultTeapotPath() {
 std::shared_ptr<const SceneGeometry> MakeSceneGeometry(const SyntheticSceneOptions& options) {
   auto geometry = std::make_shared<SceneGeometry>();
   if (options.scene == SceneKind::kSimple) return geometry;
+  if (options.scene == SceneKind::kClutter) {
+    geometry->clutter = scene_tracing::ClutterBoxes();
+    for (const Eigen::AlignedBox3d& block : geometry->clutter) {
+      geometry->top = std::max(geometry->top, block.max().z());
+    }
+    return geometry;
+  }
   // The seed paper's scene: a textured teapot, a sphere and a cube on the checkered ground.
   geometry->sphere_centre = Eigen::Vector3d(-0.75, 0.65, 0.35);
   geometry->sphere_radius = 0.35;
@@ -285,44 +300,60 @@ void AddObservedPoint(const Eigen::Vector3d& xyz, const Eigen::Vector3d& colour,
   reconstruction->points3D.emplace(id, std::move(point3D));
 }
 
+// A point uniform by area over the room's floor outside the ground square and its wall
+// (Backdrop::kRoom); false when the draw fell on the ground square (the caller draws again or
+// skips it, which keeps the rest uniform).
+bool SampleRoomPoint(std::mt19937_64* random, Eigen::Vector3d* point) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double floor_area = M_PI * kRoomRadius * kRoomRadius;
+  const double wall_area = 2.0 * M_PI * kRoomRadius * kRoomHeight;
+  const double angle = 2.0 * M_PI * unit(*random);
+  if (unit(*random) * (floor_area + wall_area) < floor_area) {
+    const double radius = kRoomRadius * std::sqrt(unit(*random));
+    *point = Eigen::Vector3d(radius * std::cos(angle), radius * std::sin(angle), 0.0);
+    return !(std::abs(point->x()) < kGroundHalfSize && std::abs(point->y()) < kGroundHalfSize);
+  }
+  *point = Eigen::Vector3d(kRoomRadius * std::cos(angle), kRoomRadius * std::sin(angle),
+                           kRoomHeight * unit(*random));
+  return true;
+}
+
+// The views that see a point of the room (inside the frame, nothing of the scene in front), and
+// its pixel in each; stops once `enough` are found (0: all).
+std::vector<std::pair<image_t, Eigen::Vector2d>> RoomPointViews(
+    const Reconstruction& reconstruction, const SceneGeometry& geometry,
+    const Eigen::Vector3d& point, size_t enough = 0) {
+  std::vector<std::pair<image_t, Eigen::Vector2d>> observations;
+  for (const auto& [image_id, image] : reconstruction.images) {
+    const Camera& camera = reconstruction.cameras.at(image.camera_id);
+    const Eigen::Vector3d local = image.cam_from_world * point;
+    if (local.z() <= 0.0) continue;
+    const Eigen::Vector2d pixel = camera.ImgFromCam(local.hnormalized());
+    if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < camera.width &&
+          pixel.y() < camera.height)) {
+      continue;
+    }
+    const Eigen::Vector3d centre = image.ProjectionCenter();
+    const Eigen::Vector3d offset = point - centre;
+    if (Trace(geometry, centre, offset.normalized()).t < offset.norm()) continue;  // hidden
+    observations.emplace_back(image_id, pixel);
+    if (enough > 0 && observations.size() >= enough) break;
+  }
+  return observations;
+}
+
 // The room's sparse points (Backdrop::kRoom): as many tried as the scene's, uniform by area over
-// the floor outside the ground square and the wall, kept where two or more views see them
-// (inside the frame, nothing of the scene in front).
+// the floor outside the ground square and the wall, kept where two or more views see them.
 void AddRoomPoints(const SyntheticSceneOptions& options, const SceneGeometry& geometry,
                    std::mt19937_64* random, std::normal_distribution<double>* noise,
                    SyntheticScene* scene) {
   Reconstruction& reconstruction = scene->reconstruction;
-  const Camera& camera = reconstruction.cameras.begin()->second;
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const double floor_area = M_PI * kRoomRadius * kRoomRadius;
-  const double wall_area = 2.0 * M_PI * kRoomRadius * kRoomHeight;
   const int tries = static_cast<int>(std::lround(options.num_surface_samples * kRoomPointShare /
                                                  (1.0 - kRoomPointShare)));
   for (int sample = 0; sample < tries; ++sample) {
     Eigen::Vector3d point;
-    const double angle = 2.0 * M_PI * unit(*random);
-    if (unit(*random) * (floor_area + wall_area) < floor_area) {
-      const double radius = kRoomRadius * std::sqrt(unit(*random));
-      point = Eigen::Vector3d(radius * std::cos(angle), radius * std::sin(angle), 0.0);
-      if (std::abs(point.x()) < kGroundHalfSize && std::abs(point.y()) < kGroundHalfSize) continue;
-    } else {
-      point = Eigen::Vector3d(kRoomRadius * std::cos(angle), kRoomRadius * std::sin(angle),
-                              kRoomHeight * unit(*random));
-    }
-    std::vector<std::pair<image_t, Eigen::Vector2d>> observations;
-    for (const auto& [image_id, image] : reconstruction.images) {
-      const Eigen::Vector3d local = image.cam_from_world * point;
-      if (local.z() <= 0.0) continue;
-      const Eigen::Vector2d pixel = camera.ImgFromCam(local.hnormalized());
-      if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < camera.width &&
-            pixel.y() < camera.height)) {
-        continue;
-      }
-      const Eigen::Vector3d centre = image.ProjectionCenter();
-      const Eigen::Vector3d offset = point - centre;
-      if (Trace(geometry, centre, offset.normalized()).t < offset.norm()) continue;  // hidden
-      observations.emplace_back(image_id, pixel);
-    }
+    if (!SampleRoomPoint(random, &point)) continue;
+    const auto observations = RoomPointViews(reconstruction, geometry, point);
     if (observations.size() < 2) continue;
     AddObservedPoint(point, RoomColour(point), observations, options.pixel_noise, random, noise,
                      &reconstruction);
@@ -340,6 +371,7 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
   scene.object_box = Eigen::AlignedBox3d(Eigen::Vector3d(-kGroundHalfSize, -kGroundHalfSize, 0.0),
                                          Eigen::Vector3d(kGroundHalfSize, kGroundHalfSize,
                                                          geometry.top));
+  for (const Eigen::AlignedBox3d& block : geometry.clutter) scene.object_box.extend(block);
   Reconstruction& reconstruction = scene.reconstruction;
 
   // One camera shared by all views; the focal length frames the ground square from the ring.
@@ -394,6 +426,7 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
                      options.pixel_noise, &random, &noise, &reconstruction);
   }
   if (options.backdrop == Backdrop::kRoom) AddRoomPoints(options, geometry, &random, &noise, &scene);
+  scene.backdrop = options.backdrop;
   return scene;
 }
 
@@ -413,6 +446,23 @@ std::vector<Eigen::Vector3d> SampleTrueSurface(const SyntheticScene& scene,
       if (views >= min_views) break;
     }
     if (views >= min_views) points.push_back(surface.point);
+  }
+  return points;
+}
+
+std::vector<Eigen::Vector3d> SampleRoomSurface(const SyntheticScene& scene,
+                                               int count,
+                                               uint64_t seed,
+                                               int min_views) {
+  std::mt19937_64 random(seed);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < count; ++i) {
+    Eigen::Vector3d point;
+    if (!SampleRoomPoint(&random, &point)) continue;
+    if (RoomPointViews(scene.reconstruction, *scene.geometry, point, min_views).size() >=
+        static_cast<size_t>(min_views)) {
+      points.push_back(point);
+    }
   }
   return points;
 }
@@ -444,6 +494,13 @@ void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path)
     exporter::ColouredPoint coloured;
     coloured.xyz = point.cast<float>();
     truth.push_back(coloured);
+  }
+  if (scene.backdrop == Backdrop::kRoom) {
+    for (const Eigen::Vector3d& point : SampleRoomSurface(scene, kRoomTruthSamples, 8, 2)) {
+      exporter::ColouredPoint coloured;
+      coloured.xyz = point.cast<float>();
+      truth.push_back(coloured);
+    }
   }
   exporter::WritePointCloudPly(truth, (root / "truth.ply").string());
 }

@@ -20,9 +20,11 @@ namespace raycarve {
 // photos carry that model's distortion.
 //
 // World frame: z up, ground at z = 0, the scene inside [-1.5, 1.5]^2 x [0, 1.1]; units arbitrary.
-// Which objects: the simple scene (a sphere and a striped box), or the seed paper's scene (a
-// textured Utah teapot, a sphere and a cube), both on the checkered ground square.
-enum class SceneKind { kSimple, kPaper };
+// Which objects: the simple scene (a sphere and a striped box), the seed paper's scene (a
+// textured Utah teapot, a sphere and a cube), both on the checkered ground square, or the simple
+// scene amid clutter (kClutterBoxes: blocks of other textures standing around it, on the ground
+// square's edge and beyond, some between the cameras and the objects).
+enum class SceneKind { kSimple, kPaper, kClutter };
 std::string SceneKindToString(SceneKind kind);
 bool SceneKindFromString(const std::string& text, SceneKind* kind);
 
@@ -110,6 +112,7 @@ struct SyntheticScene {
   std::map<image_t, cv::Mat> masks;   // CV_8UC1, 255 where most of a pixel's rays hit the scene
   Eigen::AlignedBox3d object_box;     // smallest box holding the ground square and the objects
   std::shared_ptr<const SceneGeometry> geometry;  // what the photos show
+  Backdrop backdrop = Backdrop::kPatchwork;        // what the photos show around it
 };
 
 // The uniform backdrop's colour (RGB).
@@ -120,7 +123,7 @@ const Eigen::Vector3d kBackdropColour(12, 10, 14);
 std::vector<double> ExampleCameraParams(CameraModelId model, int width, int height, double focal);
 
 // Distance from a world point to the simple scene's true surface (sphere, box, ground square),
-// exact. (The paper's scene is measured against its truth.ply.)
+// exact. (The paper's and the clutter scene are measured against their truth.ply.)
 double TrueSurfaceDistance(const Eigen::Vector3d& point);
 
 // A dense sample of the true surface for measuring reconstructions: `count` candidate points
@@ -132,12 +135,23 @@ std::vector<Eigen::Vector3d> SampleTrueSurface(const SyntheticScene& scene,
                                                uint64_t seed,
                                                int min_views);
 
+// The room's floor (outside the ground square) and wall (Backdrop::kRoom) sampled likewise: they
+// are surfaces the photos show, which a scene's model keeps. Uniform over their area, at about a
+// seventh of the truth's density on the scene (kRoomTruthSamples over about 537 square units
+// against 200,000 over about 16), which is still far denser than a voxel at the thresholds used.
+constexpr int kRoomTruthSamples = 1000000;
+std::vector<Eigen::Vector3d> SampleRoomSurface(const SyntheticScene& scene,
+                                               int count,
+                                               uint64_t seed,
+                                               int min_views);
+
 // Generates the scene; the same options always give the same scene, bit for bit.
 SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options);
 
 // Writes a COLMAP project into `path`: images/<name>.png, masks/<name>.png (COLMAP's naming:
 // the photo's name plus .png), sparse/0/ (binary) and truth.ply (the ground truth:
-// SampleTrueSurface with 200,000 candidates, seen by 2 views). Throws InputError when a file
+// SampleTrueSurface with 200,000 candidates, seen by 2 views; with the room backdrop also
+// SampleRoomSurface with kRoomTruthSamples). Throws InputError when a file
 // cannot be written.
 void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path);
 

@@ -5,8 +5,9 @@
 # (--threshold 1000000), and report
 #   - the capture raycarve found (object / scene) and whether the box went round the focus;
 #   - the share of the surface on the volume box's walls (left out of the mesh);
-#   - the cloud against the scene's truth (truth.ply): precision, completeness and F-score at
-#     two voxels (raycarve compare);
+#   - the cloud against the scene's truth (truth.ply: the objects, the ground square, the clutter
+#     and the room's floor and wall) inside the volume carved: precision, completeness and F-score
+#     at two voxels (raycarve compare --bbox);
 #   - held-out photos: PSNR over the whole photo and inside the truth's silhouettes (the exact
 #     masks, kept apart from the project), and the share of their sparse points (triangulated from
 #     the other photos) the mesh draws at their depth and hides behind something nearer.
@@ -22,20 +23,25 @@ rm -rf "$out"
 mkdir -p "$out"
 rows="$out/rows.jsonl"
 : > "$rows"
-for scene in "room ring" "room arc" "room forward" "patchwork ring" "patchwork arc" "patchwork forward"; do
+for scene in "room ring" "room arc" "room forward" "patchwork ring" "patchwork arc" \
+             "patchwork forward" "room arc clutter" "patchwork ring clutter"; do
   set -- $scene
-  backdrop=$1 layout=$2 name="$1_$2"
+  backdrop=$1 layout=$2 kind=${3:-simple} name="$1_$2${3:+_$3}"
   dir="$out/$name"
-  $rc synth --output_path "$dir/scene" --backdrop "$backdrop" --layout "$layout" --views 12 \
-    --width 320 --height 240 > "$dir.synth.log" 2>&1
+  $rc synth --output_path "$dir/scene" --scene "$kind" --backdrop "$backdrop" --layout "$layout" \
+    --views 12 --width 320 --height 240 > "$dir.synth.log" 2>&1
   mv "$dir/scene/masks" "$dir/truth_masks"
   for run in defaults colour_off; do
     flags=""
     [ "$run" = colour_off ] && flags="--threshold 1000000"
     $rc carve --workspace_path "$dir/scene" --output_path "$dir/$run" $flags > "$dir.$run.carve.log" 2>&1
     voxel=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["statistics"]["voxel_size"])' "$dir/$run/report.json")
+    # Inside the volume carved: what lies beyond it (the room's far floor and wall) no carve of
+    # that box can hold.
+    box=$(python3 -c 'import json,sys; b=json.load(open(sys.argv[1]))["bounds"]; print(",".join(str(v) for v in b["min"] + b["max"]))' "$dir/$run/report.json")
     $rc compare --reference_path "$dir/scene/truth.ply" --input_path "$dir/$run/cloud.ply" \
-      --threshold "$(python3 -c "print(2 * $voxel)")" --output_path "$dir/$run/compare.json" > "$dir.$run.compare.log" 2>&1
+      --threshold "$(python3 -c "print(2 * $voxel)")" --bbox "$box" \
+      --output_path "$dir/$run/compare.json" > "$dir.$run.compare.log" 2>&1
     $rc holdout --workspace_path "$dir/scene" --output_path "$dir/$run" --every 4 $flags > "$dir.$run.holdout.log" 2>&1
     # The same model scored inside the truth's silhouettes (the exact masks, which the carve never
     # saw): what the photos show of the scene's objects and ground.

@@ -1,5 +1,6 @@
 #include "tests/test_support.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -105,6 +106,23 @@ double JsonNumber(const std::string& json, const std::string& key) {
   const size_t at = json.find("\"" + key + "\":");
   EXPECT_NE(at, std::string::npos) << key;
   return at == std::string::npos ? NAN : std::stod(json.substr(at + key.size() + 3));
+}
+
+std::string ReportBoxText(const std::string& report) {
+  const size_t bounds = report.find("\"bounds\":");
+  EXPECT_NE(bounds, std::string::npos);
+  if (bounds == std::string::npos) return "";
+  std::string text;
+  for (const std::string key : {"\"min\": [", "\"max\": ["}) {
+    const size_t open = report.find(key, bounds);
+    const size_t close = report.find(']', open);
+    EXPECT_NE(open, std::string::npos) << key;
+    if (open == std::string::npos || close == std::string::npos) return "";
+    std::string values = report.substr(open + key.size(), close - open - key.size());
+    values.erase(std::remove(values.begin(), values.end(), ' '), values.end());
+    text += (text.empty() ? "" : ",") + values;
+  }
+  return text;
 }
 
 std::map<std::string, std::string> FolderSnapshot(const std::string& folder) {

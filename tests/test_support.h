@@ -32,6 +32,9 @@ void ExpectUserError(const std::string& arguments, std::initializer_list<std::st
 
 // The number after "key": in a JSON text written by raycarve (fails the test when absent).
 double JsonNumber(const std::string& json, const std::string& key);
+// The carve's volume as raycarve compare's --bbox takes it, "min_x,...,max_z", from report.json's
+// "bounds" (its "min" and "max" arrays).
+std::string ReportBoxText(const std::string& report);
 
 // Every regular file under `folder` with its bytes.
 std::map<std::string, std::string> FolderSnapshot(const std::string& folder);

@@ -1,6 +1,8 @@
 #include "export/carve_export.h"
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -236,12 +238,35 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     geometry.max_edge_length = std::max(0.25 * grid.voxel_size(), options.edge_pixels * pixel);
   }
   ModelMesh model;
-  model.mesh = MeshSolidVoxels(result.volume, geometry, &model.geometry);
+  std::vector<Eigen::Vector3f> iso_surface;
+  model.mesh = MeshSolidVoxels(result.volume, geometry, &model.geometry, &iso_surface);
+  // The iso-surface's positions follow the vertices through the removals below by the smoothed
+  // position (which the removals copy bit for bit).
+  std::map<std::array<float, 3>, Eigen::Vector3f> iso_surface_at;
+  if (iso_surface.size() == model.mesh.vertices.size()) {
+    for (size_t v = 0; v < iso_surface.size(); ++v) {
+      const Eigen::Vector3f& p = model.mesh.vertices[v];
+      iso_surface_at.emplace(std::array<float, 3>{p.x(), p.y(), p.z()}, iso_surface[v]);
+    }
+  }
   model.small_components_removed =
       RemoveSmallComponents(options.min_component_vertices, &model.mesh);
   model.parts = RemoveUnneededParts(views, options.part_min_views, options.sparse_points,
                                     1.5 * grid.voxel_size(), options.num_threads, &model.mesh);
   if (model.mesh.empty()) return model;
+  // What UndoSelfIntersections returns vertices towards: the iso-surface before smoothing, which
+  // never folds through itself; else (splitting or decimation) the smoothed one.
+  std::vector<Eigen::Vector3f> unrefined = model.mesh.vertices;
+  if (!iso_surface_at.empty()) {
+    for (Eigen::Vector3f& p : unrefined) {
+      const auto found = iso_surface_at.find({p.x(), p.y(), p.z()});
+      if (found == iso_surface_at.end()) {
+        unrefined = model.mesh.vertices;
+        break;
+      }
+      p = found->second;
+    }
+  }
   MeshRefinementOptions refinement;
   refinement.passes = options.refine_passes;
   refinement.converged_offset = options.refine_converged_voxels * grid.voxel_size();
@@ -275,6 +300,9 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     fit.depth_tolerance = grid.voxel_size();
     fit.num_threads = options.num_threads;
     model.silhouettes = FitMeshToSilhouettes(views, fit, &model.mesh);
+  }
+  if (options.undo_self_intersections) {
+    model.self_intersections = UndoSelfIntersections(unrefined, &model.mesh);
   }
   // The walls are found on the final geometry and left out before colouring, so that the colour
   // figures describe the mesh written.

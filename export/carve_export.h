@@ -9,6 +9,7 @@
 #include "export/mesh_refinement.h"
 #include "export/mesh_silhouettes.h"
 #include "export/point_cloud_io.h"
+#include "export/mesh_self_intersection.h"
 #include "export/surface_mesh.h"
 
 namespace raycarve {
@@ -69,6 +70,10 @@ struct ModelMeshOptions {
   // corner. 24 is the iso-surface of a 2x2x2 block, the smallest speck the carve's default
   // --min_component_voxels 8 keeps; 0 keeps everything.
   int64_t min_component_vertices = 24;
+  // After refinement, smoothing and the silhouette fit, triangles that pass through each other
+  // are undone (UndoSelfIntersections: their vertices move back towards the iso-surface before
+  // refinement), so that the mesh bounds a solid. Off: the mesh as refined.
+  bool undo_self_intersections = true;
   // Then parts of the iso-surface that fewer than this many masked photos need go
   // (RemoveUnneededParts: the visual hull's phantoms, pieces every photo sees within the object's
   // silhouette); the largest part stays. 0 keeps every part. Two photos, as elsewhere: one photo's
@@ -98,6 +103,7 @@ struct ModelMesh {
   double final_smoothing_mean_move = 0.0;  // world units, over all vertices
   MeshPartsSummary parts;
   SilhouetteFitSummary silhouettes;
+  SelfIntersectionRepair self_intersections;
   MeshColouringSummary colouring;
   std::vector<std::vector<uint32_t>> seen_by;  // per vertex, the views (indices) that see it
   // Per vertex, 1 where it lies on the grid's wall: the part of the surface that separates solid

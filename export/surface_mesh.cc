@@ -1,4 +1,5 @@
 #include "export/surface_mesh.h"
+#include "export/mesh_self_intersection.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -224,7 +225,9 @@ vtkSmartPointer<vtkPolyData> Decimate(vtkSmartPointer<vtkPolyData> surface,
 
 TriangleMesh MeshSolidVoxels(const Volume& volume,
                              const SurfaceMeshOptions& options,
-                             SurfaceMeshSummary* summary) {
+                             SurfaceMeshSummary* summary,
+                             std::vector<Eigen::Vector3f>* iso_surface) {
+  if (iso_surface != nullptr) iso_surface->clear();
   const auto start = std::chrono::steady_clock::now();
   SurfaceMeshSummary local;
   SurfaceMeshSummary& result = summary != nullptr ? *summary : local;
@@ -245,6 +248,11 @@ TriangleMesh MeshSolidVoxels(const Volume& volume,
   contour->Update();
   vtkSmartPointer<vtkPolyData> surface = contour->GetOutput();
   result.iso_surface_triangles = surface->GetNumberOfPolys();
+  // Smoothing moves the points and keeps their order; splitting and decimation do not.
+  const bool same_points = options.max_edge_length <= 0.0 &&
+                           !(options.max_triangles > 0 &&
+                             surface->GetNumberOfPolys() > options.max_triangles);
+  if (iso_surface != nullptr && same_points) *iso_surface = FromPolyData(surface).vertices;
 
   if (options.smoothing_iterations > 0) {
     surface = WindowedSinc(surface, options.smoothing_iterations, options.smoothing_pass_band);
@@ -418,8 +426,24 @@ int64_t RemoveSmallComponents(int64_t min_vertices, TriangleMesh* mesh) {
   return removed;
 }
 
+std::string MeshTopology::Faults() const {
+  std::string text;
+  const auto add = [&text](int64_t count, const std::string& what) {
+    if (count == 0) return;
+    text += (text.empty() ? "" : ", ") + std::to_string(count) + " " + what;
+  };
+  add(boundary_edges, "boundary edges");
+  add(non_manifold_edges, "edges in 3+ triangles");
+  add(non_manifold_vertices, "vertices where sheets touch");
+  add(inconsistent_edges, "edges of flipped triangles");
+  add(degenerate_triangles, "degenerate triangles");
+  add(self_intersecting_pairs, "pairs of triangles through each other");
+  return text;
+}
+
 MeshTopology AnalyseTopology(const TriangleMesh& mesh) {
   MeshTopology topology;
+  topology.self_intersecting_pairs = static_cast<int64_t>(FindSelfIntersections(mesh).size());
   const int num_vertices = static_cast<int>(mesh.vertices.size());
   // Directed edges: key (min, max); count of uses and the balance of their directions.
   struct EdgeUse {

@@ -52,10 +52,13 @@ struct SurfaceMeshSummary {
 // the mesh is closed where the volume meets the grid's border), smoothed, split and decimated as
 // the options say, with outward vertex normals (the faces' unit normals averaged, as VTK's
 // vtkPolyDataNormals averages them; the winding is flying edges', which faces away from the solid
-// voxels). Colours are left empty. An empty volume gives an empty mesh.
+// voxels). Colours are left empty. An empty volume gives an empty mesh. `iso_surface`, when
+// given, gets each vertex's position before smoothing (the iso-surface, which never folds through
+// itself), index for index; empty when splitting or decimation changed the vertices.
 TriangleMesh MeshSolidVoxels(const Volume& volume,
                              const SurfaceMeshOptions& options,
-                             SurfaceMeshSummary* summary = nullptr);
+                             SurfaceMeshSummary* summary = nullptr,
+                             std::vector<Eigen::Vector3f>* iso_surface = nullptr);
 
 // How many threads the libraries' own parallel loops may use, process-wide: OpenCV's (resizing,
 // filtering) and VTK's (the iso-surface, smoothing), which otherwise take every core whatever
@@ -107,13 +110,20 @@ struct MeshTopology {
   int64_t inconsistent_edges = 0;  // shared by two triangles that run it the same way
   int64_t components = 0;          // connected through shared vertices
   int64_t degenerate_triangles = 0;  // repeating a vertex
-  // Every edge in exactly two triangles that run it in opposite directions, and every vertex one
-  // fan: a closed, oriented 2-manifold.
+  // Pairs of triangles that pass through each other (FindSelfIntersections): a mesh folded
+  // through itself encloses no volume, whatever its edges say.
+  int64_t self_intersecting_pairs = 0;
+  // Every edge in exactly two triangles that run it in opposite directions, every vertex one fan,
+  // and no triangle through another: a closed, oriented 2-manifold that bounds a solid.
   bool IsClosedManifold() const {
     return boundary_edges == 0 && non_manifold_edges == 0 && non_manifold_vertices == 0 &&
-           inconsistent_edges == 0 && degenerate_triangles == 0;
+           inconsistent_edges == 0 && degenerate_triangles == 0 && self_intersecting_pairs == 0;
   }
+  // What IsClosedManifold found wrong, e.g. "12 boundary edges, 3 pairs of triangles through
+  // each other"; empty when nothing.
+  std::string Faults() const;
 };
+// Counts the mesh's topology and its self-intersections.
 MeshTopology AnalyseTopology(const TriangleMesh& mesh);
 
 // Writes the mesh as binary little-endian PLY through PCL: vertex x y z nx ny nz red green blue

@@ -292,6 +292,9 @@ void CarvePipeline::MakeSurface() {
     LOG(INFO) << model_.refinement.Summary();
     LOG(INFO) << exporter::FinalSmoothingSummary(model_, request_.mesh);
     if (model_.silhouettes.passes > 0) LOG(INFO) << model_.silhouettes.Summary();
+    if (request_.mesh.undo_self_intersections) {
+      LOG(INFO) << "mesh self-intersections: " << model_.self_intersections.Summary();
+    }
     LOG(INFO) << model_.colouring.Summary();
   }
   run_.num_mesh_triangles = model_.mesh.triangles.size();
@@ -300,6 +303,7 @@ void CarvePipeline::MakeSurface() {
   run_.mesh_refinement = model_.refinement;
   run_.mesh_parts = model_.parts;
   run_.mesh_silhouettes = model_.silhouettes;
+  run_.mesh_self_intersections = model_.self_intersections;
   run_.mesh_final_smoothing_mean_move = model_.final_smoothing_mean_move;
   run_.mesh_small_components_removed = model_.small_components_removed;
   run_.mesh_grid_wall_vertices = model_.grid_wall_vertices;

@@ -61,6 +61,7 @@ struct CarveRun {
   exporter::MeshTopology mesh_topology;
   exporter::MeshColouringSummary mesh_colouring;  // the smooth mesh's (vertices 0 otherwise)
   exporter::MeshRefinementSummary mesh_refinement;
+  exporter::SelfIntersectionRepair mesh_self_intersections;
   exporter::MeshPartsSummary mesh_parts;
   exporter::SilhouetteFitSummary mesh_silhouettes;
   double mesh_final_smoothing_mean_move = 0.0;  // world units

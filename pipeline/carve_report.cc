@@ -148,7 +148,8 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
       .Key("camera_distance").Value(layout.camera_distance)
       .Key("focus_in_front").Value(layout.focus_in_front)
       .Key("cameras").Value(layout.cameras)
-      .Key("focus_box_points").Value(layout.focus_box_points);
+      .Key("focus_box_points").Value(layout.focus_box_points)
+      .Key("occluder_points").Value(layout.occluder_points);
   if (!layout.focus_box.isEmpty()) {
     json.Key("focus_box_min").Value(JsonArray(layout.focus_box.min()))
         .Key("focus_box_max").Value(JsonArray(layout.focus_box.max()));
@@ -293,6 +294,13 @@ void WriteMesh(const CarveRequest& request, const CarveRun& run, JsonWriter& jso
     const exporter::MeshColouringSummary& c = run.mesh_colouring;
     json.Key("mesh").BeginObject()
         .Key("closed_manifold").Value(t.IsClosedManifold())
+        .Key("faults").Value(t.Faults())
+        .Key("self_intersecting_pairs").Value(static_cast<int64_t>(t.self_intersecting_pairs))
+        .Key("undo_self_intersections").Value(request.mesh.undo_self_intersections)
+        .Key("self_intersecting_pairs_undone")
+        .Value(run.mesh_self_intersections.pairs_before - run.mesh_self_intersections.pairs_after)
+        .Key("self_intersection_vertices_moved_back")
+        .Value(run.mesh_self_intersections.vertices_moved_back)
         .Key("components").Value(static_cast<int64_t>(t.components))
         .Key("small_components_removed").Value(run.mesh_small_components_removed)
         .Key("grid_wall_vertices").Value(run.mesh_grid_wall_vertices)

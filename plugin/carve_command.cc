@@ -64,7 +64,8 @@ std::string MaskSummary(const std::vector<PhotoMaskInfo>& photos) {
 std::string MeshShape(const CarveRun& run) {
   const exporter::MeshTopology& t = run.mesh_topology;
   if (t.IsClosedManifold()) return "closed and 2-manifold";
-  if (run.mesh_wall_triangles_removed > 0 && t.non_manifold_edges == 0) {
+  if (run.mesh_wall_triangles_removed > 0 && t.non_manifold_edges == 0 &&
+      t.self_intersecting_pairs == 0) {
     // Where two removed stretches of wall meet at a corner, two sheets of surface touch at a
     // vertex: said, not hidden.
     return "open where the box cuts the scene" +
@@ -74,7 +75,7 @@ std::string MeshShape(const CarveRun& run) {
                       " where two sheets touch)"
                 : std::string());
   }
-  return "NOT closed 2-manifold (see report.json)";
+  return "NOT a closed 2-manifold: " + t.Faults();
 }
 
 void PrintSummary(const CarveRequest& request, const CarveRun& run) {

@@ -177,6 +177,10 @@ void AddMeshFlags(OptionParser* parser, CarveRequest* request) {
                      "cuts the scene, e.g. a table or the ground running on beyond it, or a "
                      "backdrop seen through it); the mesh is open there. 0: keep it, the mesh "
                      "closed by the box");
+  parser->AddDefault("mesh_undo_self_intersections", &request->mesh.undo_self_intersections,
+                     "smooth mesh: where refinement and smoothing made triangles pass through "
+                     "each other, move their vertices back towards the surface before "
+                     "refinement, so that the mesh bounds a solid; 0: the mesh as refined");
 }
 
 void AddThreadFlags(OptionParser* parser, CarveRequest* request) {

@@ -1,0 +1,49 @@
+#pragma once
+// Whether a mesh folds through itself, and undoing the moves that made it fold. CGAL stays
+// inside the .cc file.
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "export/surface_mesh.h"
+
+namespace raycarve {
+namespace exporter {
+
+// The pairs of triangles (indices, first < second) that intersect anywhere but in what they
+// share: two triangles with no common vertex that touch at all; two with one common vertex that
+// meet elsewhere too (an edge of one through the other). Two with a common edge are not tested
+// (they meet only along it unless they lie folded flat onto each other). Candidates come from
+// CGAL's box intersection of the triangles' bounding boxes, tests from CGAL's exact predicates.
+// Triangles with a repeated vertex are left out (AnalyseTopology counts them). Sorted. With
+// `check` (one flag per triangle), only the pairs with a flagged triangle.
+std::vector<std::pair<int, int>> FindSelfIntersections(const TriangleMesh& mesh,
+                                                       const std::vector<uint8_t>* check = nullptr);
+
+// How UndoSelfIntersections went.
+struct SelfIntersectionRepair {
+  int64_t pairs_before = 0;        // FindSelfIntersections on the mesh given
+  int64_t pairs_after = 0;         // ... on the mesh returned
+  int64_t vertices_moved_back = 0;  // distinct vertices moved towards their safe position
+  int rounds = 0;
+  double seconds = 0.0;
+  std::string Summary() const;
+};
+
+// Undoes the moves that made `mesh` fold through itself: while triangles intersect, the vertices
+// of every intersecting triangle and their neighbours move back towards their positions in
+// `safe` (the same vertices and triangles at an earlier stage, without self-intersections, such
+// as the iso-surface before it was smoothed and refined), halfway in the first three rounds and
+// then all the way, for at most 30 rounds.
+// Vertices of triangles that do not intersect stay where they are. When `safe` itself
+// intersects, what it shares with the mesh cannot be undone: pairs_after says so. Normals are
+// recomputed for the vertices moved.
+SelfIntersectionRepair UndoSelfIntersections(const std::vector<Eigen::Vector3f>& safe,
+                                             TriangleMesh* mesh);
+
+}  // namespace exporter
+}  // namespace raycarve

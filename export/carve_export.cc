@@ -238,6 +238,9 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     geometry.max_edge_length = std::max(0.25 * grid.voxel_size(), options.edge_pixels * pixel);
   }
   ModelMesh model;
+  const auto tell = [&options](const std::string& line) {
+    if (options.progress) options.progress(line);
+  };
   std::vector<Eigen::Vector3f> iso_surface;
   model.mesh = MeshSolidVoxels(result.volume, geometry, &model.geometry, &iso_surface);
   // The iso-surface's positions follow the vertices through the removals below by the smoothed
@@ -251,8 +254,10 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   }
   model.small_components_removed =
       RemoveSmallComponents(options.min_component_vertices, &model.mesh);
+  tell(model.geometry.Summary());
   model.parts = RemoveUnneededParts(views, options.part_min_views, options.sparse_points,
                                     1.5 * grid.voxel_size(), options.num_threads, &model.mesh);
+  if (model.parts.removed > 0 || model.parts.anchored > 0) tell(model.parts.Summary());
   if (model.mesh.empty()) return model;
   // What UndoSelfIntersections returns vertices towards: the iso-surface before smoothing, which
   // never folds through itself; else (splitting or decimation) the smoothed one.
@@ -277,7 +282,11 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   refinement.min_views = std::max(2, options.min_views);
   refinement.num_threads = options.num_threads;
   if (refinement.passes > 0) {
+    tell("mesh refinement: at most " + std::to_string(refinement.passes) + " passes over " +
+         std::to_string(model.mesh.vertices.size()) + " vertices, from " +
+         std::to_string(views.size()) + " photos ...");
     model.refinement = RefineMeshFromPhotos(views, refinement, &model.mesh);
+    tell(model.refinement.Summary());
     if (options.final_smoothing_iterations > 0) {
       // Smoothed where the photos leave the position open, kept where they pin it.
       TriangleMesh smooth = model.mesh;
@@ -291,6 +300,7 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
       }
       model.final_smoothing_mean_move = moved / static_cast<double>(model.mesh.vertices.size());
       ComputeVertexNormals(&model.mesh);
+      tell(FinalSmoothingSummary(model, options));
     }
   }
   if (options.silhouette_passes > 0) {
@@ -300,9 +310,11 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     fit.depth_tolerance = grid.voxel_size();
     fit.num_threads = options.num_threads;
     model.silhouettes = FitMeshToSilhouettes(views, fit, &model.mesh);
+    if (model.silhouettes.passes > 0) tell(model.silhouettes.Summary());
   }
   if (options.undo_self_intersections) {
     model.self_intersections = UndoSelfIntersections(unrefined, &model.mesh);
+    tell("mesh self-intersections: " + model.self_intersections.Summary());
   }
   // The walls are found on the final geometry and left out before colouring, so that the colour
   // figures describe the mesh written.
@@ -315,6 +327,7 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   colouring.depth_tolerance = grid.voxel_size();
   colouring.num_threads = options.num_threads;
   model.colouring = ColourMeshFromPhotos(views, colouring, &model.mesh, &model.seen_by);
+  tell(model.colouring.Summary());
   return model;
 }
 

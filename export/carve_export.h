@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -93,6 +94,9 @@ struct ModelMeshOptions {
   bool remove_grid_walls = true;
   // Threads for refining and colouring (0 or less: every core); the mesh does not depend on it.
   int num_threads = 0;
+  // Told a line as each step starts or ends (what it did), so that a long mesh stage shows its
+  // progress; empty: nothing told.
+  std::function<void(const std::string&)> progress;
   bool IsValid(std::string* reason) const;
 };
 struct ModelMesh {

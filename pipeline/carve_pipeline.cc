@@ -285,18 +285,10 @@ void CarvePipeline::MakeSurface() {
   const Clock::time_point start = Clock::now();
   exporter::ModelMeshOptions options = request_.mesh;
   for (const SurfacePoint& point : surface_points_) options.sparse_points.push_back(point.xyz);
+  // Each step's line as it ends: the mesh stage can take longer than the carve.
+  options.progress = [](const std::string& line) { LOG(INFO) << line; };
+  LOG(INFO) << "meshing the surface of the solid voxels ...";
   model_ = exporter::MeshCarvedModel(*run_.result, carved_, options);
-  LOG(INFO) << model_.geometry.Summary();
-  if (model_.parts.removed > 0 || model_.parts.anchored > 0) LOG(INFO) << model_.parts.Summary();
-  if (!model_.mesh.empty()) {
-    LOG(INFO) << model_.refinement.Summary();
-    LOG(INFO) << exporter::FinalSmoothingSummary(model_, request_.mesh);
-    if (model_.silhouettes.passes > 0) LOG(INFO) << model_.silhouettes.Summary();
-    if (request_.mesh.undo_self_intersections) {
-      LOG(INFO) << "mesh self-intersections: " << model_.self_intersections.Summary();
-    }
-    LOG(INFO) << model_.colouring.Summary();
-  }
   run_.num_mesh_triangles = model_.mesh.triangles.size();
   run_.num_mesh_vertices = model_.mesh.vertices.size();
   run_.mesh_colouring = model_.colouring;

@@ -328,6 +328,11 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   colouring.num_threads = options.num_threads;
   model.colouring = ColourMeshFromPhotos(views, colouring, &model.mesh, &model.seen_by);
   tell(model.colouring.Summary());
+  if (options.texture && !model.mesh.empty()) {
+    model.texture =
+        TextureMeshFromPhotos(views, model.seen_by, options.texture_options, &model.mesh);
+    tell(model.texture.Summary());
+  }
   return model;
 }
 

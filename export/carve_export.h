@@ -11,6 +11,7 @@
 #include "export/mesh_silhouettes.h"
 #include "export/point_cloud_io.h"
 #include "export/mesh_self_intersection.h"
+#include "export/mesh_texture.h"
 #include "export/surface_mesh.h"
 
 namespace raycarve {
@@ -94,6 +95,11 @@ struct ModelMeshOptions {
   bool remove_grid_walls = true;
   // Threads for refining and colouring (0 or less: every core); the mesh does not depend on it.
   int num_threads = 0;
+  // After colouring, a texture atlas from the photos (TextureMeshFromPhotos): each triangle
+  // coloured from the photo that sees it best, at the photo's resolution. false: vertex colours
+  // only.
+  bool texture = true;
+  MeshTextureOptions texture_options;
   // Told a line as each step starts or ends (what it did), so that a long mesh stage shows its
   // progress; empty: nothing told.
   std::function<void(const std::string&)> progress;
@@ -109,6 +115,7 @@ struct ModelMesh {
   SilhouetteFitSummary silhouettes;
   SelfIntersectionRepair self_intersections;
   MeshColouringSummary colouring;
+  MeshTextureSummary texture;
   std::vector<std::vector<uint32_t>> seen_by;  // per vertex, the views (indices) that see it
   // Per vertex, 1 where it lies on the grid's wall: the part of the surface that separates solid
   // voxels from the space outside the grid (which the mesh treats as empty so that it closes).

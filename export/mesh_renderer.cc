@@ -6,6 +6,8 @@
 
 #include <glog/logging.h>
 
+#include "export/mesh_colouring.h"
+
 namespace raycarve {
 namespace exporter {
 
@@ -85,6 +87,7 @@ void Rasterise(const TriangleMesh& mesh, const CalibratedView& view, bool front_
   if (image != nullptr) *image = cv::Mat(view.height, view.width, CV_8UC3, cv::Scalar::all(0));
   if (silhouette != nullptr) *silhouette = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
   const bool coloured = image != nullptr && mesh.colours.size() == mesh.vertices.size();
+  const bool textured = image != nullptr && mesh.textured();
   ForEachCoveredPixel(mesh, view, front_faces_only,
                       [&](size_t triangle, int row, int col, double a0, double a1, double a2) {
     const double inverse_z = a0 + a1 + a2;
@@ -95,6 +98,24 @@ void Rasterise(const TriangleMesh& mesh, const CalibratedView& view, bool front_
     if (silhouette != nullptr) silhouette->at<uint8_t>(row, col) = 255;
     if (image == nullptr) return;
     cv::Vec3b& colour = image->at<cv::Vec3b>(row, col);
+    if (textured) {
+      const double p0 = a0 / inverse_z, p1 = a1 / inverse_z, p2 = a2 / inverse_z;
+      const Eigen::Vector2f* uv = &mesh.corner_uvs[3 * triangle];
+      const Eigen::Vector2d at = (p0 * uv[0].cast<double>() + p1 * uv[1].cast<double>() +
+                                  p2 * uv[2].cast<double>())
+                                     .cwiseProduct(Eigen::Vector2d(mesh.texture.cols,
+                                                                   mesh.texture.rows));
+      // Inside the atlas's pixel centres (a corner's coordinate can sit on a chart's edge).
+      const Eigen::Vector2d clamped(std::clamp(at.x(), 0.5, mesh.texture.cols - 0.5),
+                                    std::clamp(at.y(), 0.5, mesh.texture.rows - 0.5));
+      Eigen::Vector3f sample;
+      if (SampleBilinear(mesh.texture, clamped, &sample)) {
+        for (int k = 0; k < 3; ++k) {
+          colour[k] = static_cast<uint8_t>(std::clamp(std::lround(sample[k]), 0L, 255L));
+        }
+        return;
+      }
+    }
     if (!coloured) {
       colour = cv::Vec3b(128, 128, 128);
       return;

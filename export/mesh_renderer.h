@@ -13,7 +13,8 @@ namespace exporter {
 // Draws a triangle mesh into one view's pinhole camera (K, cam_from_world, size; its pixels are
 // not used) with a depth buffer: a pixel is covered when its centre (COLMAP convention) lies in
 // a triangle's projection, takes the depth of the nearest such triangle along the optical axis,
-// and the perspective-correct blend of its vertices' colours (grey 128 where the mesh has none).
+// and the perspective-correct blend of its vertices' colours (grey 128 where the mesh has none),
+// or, for a textured mesh, the texture bilinearly sampled at the blend of its corners' coordinates.
 // Triangles with a vertex at or behind the camera plane are skipped. Both sides are drawn, so a
 // mesh's inside never shows through a hole, unless `front_faces_only`: then triangles whose
 // winding (counter-clockwise seen from outside, as MeshSolidVoxels makes them) faces away from

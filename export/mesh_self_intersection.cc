@@ -36,12 +36,13 @@ bool Intersect(const TriangleMesh& mesh, int a, int b) {
       }
     }
   }
+  // Neighbours across an edge are most of the candidates: answered before any geometry.
+  if (shared >= 2) return false;
   const auto point = [&](int vertex) { return ToPoint(mesh.vertices[vertex]); };
   const Triangle triangle_a(point(ta[0]), point(ta[1]), point(ta[2]));
   const Triangle triangle_b(point(tb[0]), point(tb[1]), point(tb[2]));
   if (triangle_a.is_degenerate() || triangle_b.is_degenerate()) return false;
   if (shared == 0) return CGAL::do_intersect(triangle_a, triangle_b);
-  if (shared >= 2) return false;
   // One common vertex: they meet elsewhere when the edge opposite it in one triangle crosses
   // the other (any other intersection of two triangles includes such a crossing).
   const Segment opposite_a(point(ta[(shared_in_a + 1) % 3]), point(ta[(shared_in_a + 2) % 3]));
@@ -88,7 +89,45 @@ std::vector<std::pair<int, int>> FindSelfIntersections(const TriangleMesh& mesh,
   if (check == nullptr) {
     CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), test);
   } else if (!checked.empty()) {
-    CGAL::box_intersection_d(checked.begin(), checked.end(), boxes.begin(), boxes.end(), test);
+    // Only the boxes near a checked one can meet it: those touching a cell of a coarse grid
+    // (kNearCells a side over the mesh's box) that a checked box touches. When few triangles are
+    // checked this leaves most of the mesh out of the search.
+    constexpr int kNearCells = 64;
+    CGAL::Bbox_3 whole;
+    for (const Box& box : boxes) whole += box.bbox();
+    const double low[3] = {whole.xmin(), whole.ymin(), whole.zmin()};
+    double cell[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      cell[axis] = std::max((whole.max(axis) - whole.min(axis)) / kNearCells, 1e-30);
+    }
+    const auto cell_range = [&](const Box& box, int axis, int* from, int* to) {
+      *from = std::clamp(static_cast<int>((box.min_coord(axis) - low[axis]) / cell[axis]), 0, kNearCells - 1);
+      *to = std::clamp(static_cast<int>((box.max_coord(axis) - low[axis]) / cell[axis]), 0, kNearCells - 1);
+    };
+    std::vector<uint8_t> marked(kNearCells * kNearCells * kNearCells, 0);
+    int from[3], to[3];
+    for (const Box& box : checked) {
+      for (int axis = 0; axis < 3; ++axis) cell_range(box, axis, &from[axis], &to[axis]);
+      for (int z = from[2]; z <= to[2]; ++z) {
+        for (int y = from[1]; y <= to[1]; ++y) {
+          for (int x = from[0]; x <= to[0]; ++x) marked[(z * kNearCells + y) * kNearCells + x] = 1;
+        }
+      }
+    }
+    std::vector<Box> near;
+    for (const Box& box : boxes) {
+      for (int axis = 0; axis < 3; ++axis) cell_range(box, axis, &from[axis], &to[axis]);
+      bool touches = false;
+      for (int z = from[2]; z <= to[2] && !touches; ++z) {
+        for (int y = from[1]; y <= to[1] && !touches; ++y) {
+          for (int x = from[0]; x <= to[0] && !touches; ++x) {
+            touches = marked[(z * kNearCells + y) * kNearCells + x];
+          }
+        }
+      }
+      if (touches) near.push_back(box);
+    }
+    CGAL::box_intersection_d(checked.begin(), checked.end(), near.begin(), near.end(), test);
   }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());

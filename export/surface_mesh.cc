@@ -441,9 +441,11 @@ std::string MeshTopology::Faults() const {
   return text;
 }
 
-MeshTopology AnalyseTopology(const TriangleMesh& mesh) {
+MeshTopology AnalyseTopology(const TriangleMesh& mesh, int64_t known_self_intersections) {
   MeshTopology topology;
-  topology.self_intersecting_pairs = static_cast<int64_t>(FindSelfIntersections(mesh).size());
+  topology.self_intersecting_pairs =
+      known_self_intersections >= 0 ? known_self_intersections
+                                    : static_cast<int64_t>(FindSelfIntersections(mesh).size());
   const int num_vertices = static_cast<int>(mesh.vertices.size());
   // Directed edges: key (min, max); count of uses and the balance of their directions.
   struct EdgeUse {

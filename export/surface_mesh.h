@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
 
 #include "carve/volume.h"
 
@@ -18,8 +19,16 @@ struct TriangleMesh {
   std::vector<Eigen::Vector3f> normals;                  // unit, outward; one per vertex
   std::vector<Eigen::Matrix<uint8_t, 3, 1>> colours;     // RGB per vertex; empty until coloured
   std::vector<Eigen::Vector3i> triangles;                // counter-clockwise seen from outside
+  // A texture (TextureMeshFromPhotos), or none: per triangle its three corners' coordinates in
+  // `texture` (u right, v down, both 0-1 over the whole image, as glTF has them; pixel centres at
+  // (i + 0.5) / size), and the atlas (CV_8UC3, RGB). Steps that change the triangles drop them.
+  std::vector<Eigen::Vector2f> corner_uvs;
+  cv::Mat texture;
 
   bool empty() const { return triangles.empty(); }
+  bool textured() const {
+    return !texture.empty() && corner_uvs.size() == 3 * triangles.size();
+  }
 };
 
 // How the carved volume becomes a smooth surface.
@@ -123,8 +132,10 @@ struct MeshTopology {
   // each other"; empty when nothing.
   std::string Faults() const;
 };
-// Counts the mesh's topology and its self-intersections.
-MeshTopology AnalyseTopology(const TriangleMesh& mesh);
+// Counts the mesh's topology and its self-intersections (FindSelfIntersections), unless
+// `known_self_intersections` (>= 0) gives their count: e.g. 0 after UndoSelfIntersections left
+// none and only triangles were removed since, which cannot make new ones.
+MeshTopology AnalyseTopology(const TriangleMesh& mesh, int64_t known_self_intersections = -1);
 
 // Writes the mesh as binary little-endian PLY through PCL: vertex x y z nx ny nz red green blue
 // (grey 128 where `colours` is empty), face vertex_indices. An empty mesh gives a valid PLY with

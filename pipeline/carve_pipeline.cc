@@ -212,8 +212,9 @@ void CarvePipeline::PlanOutputs() {
   // The output folder doubles as a COLMAP dense workspace, whose meshers read the sparse model
   // from sparse/: written there unless an input is or holds that folder, or it holds files that
   // no earlier carve wrote.
-  for (const char* name : {"cloud.ply", "cloud.ply.vis", "mesh.ply", "fused.ply", "fused.ply.vis",
-                           "sparse", "report.json", "convergence.csv"}) {
+  for (const char* name : {"cloud.ply", "cloud.ply.vis", "mesh.ply", "mesh.glb", "mesh.obj",
+                           "mesh.mtl", "mesh_texture.png", "fused.ply", "fused.ply.vis", "sparse",
+                           "report.json", "convergence.csv"}) {
     CheckNoLinkInside(run_.output_path, name);
   }
   const fs::path sparse_folder = fs::weakly_canonical(out / "sparse");
@@ -296,6 +297,7 @@ void CarvePipeline::MakeSurface() {
   run_.mesh_parts = model_.parts;
   run_.mesh_silhouettes = model_.silhouettes;
   run_.mesh_self_intersections = model_.self_intersections;
+  run_.mesh_texture = model_.texture;
   run_.mesh_final_smoothing_mean_move = model_.final_smoothing_mean_move;
   run_.mesh_small_components_removed = model_.small_components_removed;
   run_.mesh_grid_wall_vertices = model_.grid_wall_vertices;
@@ -319,8 +321,17 @@ void CarvePipeline::SampleCloud() {
     // mesh's own failure is thrown by get() in WriteOutputs.)
     const fs::path out(staged_->path());
     auto mesh_file = [this, out] {
-      run_.mesh_topology = exporter::AnalyseTopology(model_.mesh);
+      // The undo left no pair, and since then only triangles were removed (the box's walls):
+      // no new pair can have appeared, and the search (about half a second on 100k triangles)
+      // need not run again.
+      const bool none_left = request_.mesh.undo_self_intersections &&
+                             model_.self_intersections.pairs_after == 0;
+      run_.mesh_topology = exporter::AnalyseTopology(model_.mesh, none_left ? 0 : -1);
       exporter::WriteMeshPly(model_.mesh, (out / "mesh.ply").string());
+      // The formats other programs load: glTF binary (Blender, web viewers, game engines) and,
+      // textured, OBJ with its material and atlas.
+      exporter::WriteGlb(model_.mesh, (out / "mesh.glb").string());
+      if (model_.mesh.textured()) exporter::WriteTexturedObj(model_.mesh, (out / "mesh.obj").string());
     };
     if (ResolveNumThreads(request_.options.num_threads) > 1) {
       mesh_written_ = std::async(std::launch::async, mesh_file);

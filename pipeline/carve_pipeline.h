@@ -62,6 +62,7 @@ struct CarveRun {
   exporter::MeshColouringSummary mesh_colouring;  // the smooth mesh's (vertices 0 otherwise)
   exporter::MeshRefinementSummary mesh_refinement;
   exporter::SelfIntersectionRepair mesh_self_intersections;
+  exporter::MeshTextureSummary mesh_texture;
   exporter::MeshPartsSummary mesh_parts;
   exporter::SilhouetteFitSummary mesh_silhouettes;
   double mesh_final_smoothing_mean_move = 0.0;  // world units

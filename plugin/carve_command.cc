@@ -139,7 +139,7 @@ void PrintSummary(const CarveRequest& request, const CarveRun& run) {
       "  masks           %s\n"
       "%s"
       "  outputs         %s/cloud.ply (%zu points, seen by %d+ photos), mesh.ply (%zu triangles),\n"
-      "                  report.json, convergence.csv\n"
+      "                  %sreport.json, convergence.csv\n"
       "  open with       meshlab %s/mesh.ply   (or CloudCompare, Open3D, colmap gui)\n",
       run.model_path.c_str(), s.dimensions.x(), s.dimensions.y(), s.dimensions.z(), s.voxel_size,
       static_cast<long long>(s.num_voxels), static_cast<long long>(s.carved),
@@ -158,7 +158,12 @@ void PrintSummary(const CarveRequest& request, const CarveRun& run) {
       silhouette_line.c_str(), run.output_path.c_str(),
       run.num_cloud_points,
       request.mesh_kind == "smooth" ? request.cloud_min_views : request.options.min_views,
-      run.num_mesh_triangles, run.output_path.c_str());
+      run.num_mesh_triangles,
+      request.mesh_kind != "smooth" ? ""
+      : run.mesh_texture.atlas_width > 0
+          ? "mesh.glb, mesh.obj (+ mesh.mtl, mesh_texture.png: textured from the photos),\n                  "
+          : "mesh.glb, ",
+      run.output_path.c_str());
 }
 
 // What to do next when the capture has no masks and the box cuts much of its surroundings: the

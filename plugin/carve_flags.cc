@@ -181,6 +181,11 @@ void AddMeshFlags(OptionParser* parser, CarveRequest* request) {
                      "smooth mesh: where refinement and smoothing made triangles pass through "
                      "each other, move their vertices back towards the surface before "
                      "refinement, so that the mesh bounds a solid; 0: the mesh as refined");
+  parser->AddDefault("mesh_texture", &request->mesh.texture,
+                     "smooth mesh: a texture atlas from the photos (each triangle from the photo "
+                     "that sees it best, at the photo's resolution), written as mesh.obj + "
+                     "mesh.mtl + mesh_texture.png and inside mesh.glb, and drawn by holdout; 0: "
+                     "vertex colours only (mesh.ply always has them)");
 }
 
 void AddThreadFlags(OptionParser* parser, CarveRequest* request) {

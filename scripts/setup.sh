@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake pkg-config libeigen3-dev libopencv-dev libceres-dev libpcl-dev
-          libvtk9-dev libgoogle-glog-dev libgflags-dev libjpeg-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev colmap)
+          libvtk9-dev libgoogle-glog-dev libgflags-dev libjpeg-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libtinygltf-dev colmap)
 missing=()
 for package in "${packages[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then

@@ -149,6 +149,17 @@ TEST(CarveExport, TheSmoothMeshIsClosedAndNearerTheTruthAndItsPhotoColoursBeatVo
     EXPECT_TRUE(model.on_grid_wall[edge.first] && model.on_grid_wall[edge.second]);
   }
   EXPECT_GT(boundary, 0);
+  // Refinement folded the surface through itself; the undo left no pair, which a full search of
+  // the mesh as written confirms (the pipeline takes the undo's count for it).
+  EXPECT_GT(model.self_intersections.pairs_before, 0);
+  EXPECT_EQ(model.self_intersections.pairs_after, 0);
+  EXPECT_EQ(topology.self_intersecting_pairs, 0);
+  // Textured from the photos: most triangles from a photo, every corner inside the atlas.
+  ASSERT_TRUE(model.mesh.textured());
+  EXPECT_GT(model.texture.textured, model.texture.triangles / 2);
+  for (const Eigen::Vector2f& uv : model.mesh.corner_uvs) {
+    ASSERT_TRUE(uv.x() >= 0.0f && uv.x() <= 1.0f && uv.y() >= 0.0f && uv.y() <= 1.0f);
+  }
   ModelMeshOptions with_walls;
   with_walls.remove_grid_walls = false;
   EXPECT_TRUE(AnalyseTopology(MeshCarvedModel(result, views, with_walls).mesh).IsClosedManifold());

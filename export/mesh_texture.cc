@@ -1,0 +1,698 @@
+#include "export/mesh_texture.h"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+
+#include <glog/logging.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <tiny_gltf.h>
+
+#include "calib/atomic_file.h"
+#include "calib/input_error.h"
+#include "export/mesh_colouring.h"
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+// A triangle's photo: the view and the pixels its corners project to there.
+struct Candidate {
+  int view = -1;
+  double area = 0.0;  // projected area in pixels
+};
+
+// The views that see all three corners (seen_by lists are sorted), with the triangle in the
+// frame and facing the camera, and the area it covers in each.
+std::vector<Candidate> CandidatesOf(const std::vector<CalibratedView>& views,
+                                    const std::vector<std::vector<uint32_t>>& seen_by,
+                                    const TriangleMesh& mesh, const Eigen::Vector3i& triangle) {
+  std::vector<uint32_t> common = seen_by[triangle[0]];
+  for (int corner = 1; corner < 3; ++corner) {
+    std::vector<uint32_t> both;
+    const std::vector<uint32_t>& other = seen_by[triangle[corner]];
+    std::set_intersection(common.begin(), common.end(), other.begin(), other.end(),
+                          std::back_inserter(both));
+    common.swap(both);
+  }
+  std::vector<Candidate> candidates;
+  for (const uint32_t v : common) {
+    const CalibratedView& view = views[v];
+    Eigen::Vector2d pixel[3];
+    bool inside = true;
+    for (int corner = 0; corner < 3 && inside; ++corner) {
+      pixel[corner] = view.Project(mesh.vertices[triangle[corner]].cast<double>());
+      inside = pixel[corner].x() >= 1.0 && pixel[corner].y() >= 1.0 &&
+               pixel[corner].x() <= view.width - 1.0 && pixel[corner].y() <= view.height - 1.0;
+    }
+    if (!inside) continue;
+    const Eigen::Vector2d ab = pixel[1] - pixel[0], ac = pixel[2] - pixel[0];
+    // Facing the camera: clockwise on the screen (see RenderMesh).
+    const double signed_area = 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
+    if (!(signed_area < 0.0)) continue;
+    candidates.push_back({static_cast<int>(v), -signed_area});
+  }
+  return candidates;
+}
+
+// Per triangle, the triangles sharing an edge with it.
+std::vector<std::vector<int>> EdgeNeighbours(const TriangleMesh& mesh) {
+  std::unordered_map<uint64_t, std::vector<int>> by_edge;
+  by_edge.reserve(mesh.triangles.size() * 2);
+  for (int t = 0; t < static_cast<int>(mesh.triangles.size()); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
+      by_edge[(static_cast<uint64_t>(std::min(a, b)) << 32) | static_cast<uint32_t>(std::max(a, b))]
+          .push_back(t);
+    }
+  }
+  std::vector<std::vector<int>> neighbours(mesh.triangles.size());
+  for (const auto& [edge, triangles] : by_edge) {
+    for (const int t : triangles) {
+      for (const int u : triangles) {
+        if (u != t) neighbours[t].push_back(u);
+      }
+    }
+  }
+  return neighbours;
+}
+
+// A piece of one photo holding a connected set of triangles that take that photo.
+struct Chart {
+  int view = -1;  // -1: the flat cells of triangles no photo sees whole
+  std::vector<int> triangles;
+  cv::Rect source;  // in the photo, padding included
+  cv::Mat patch;    // what goes into the atlas (scaled, levelled)
+  cv::Point at;     // its top-left corner in the atlas
+};
+
+// Shelf packing, tallest first: the charts' positions in an atlas `width` wide; returns the
+// height used.
+int Pack(int width, std::vector<Chart>* charts) {
+  std::vector<size_t> order(charts->size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return (*charts)[a].patch.rows > (*charts)[b].patch.rows;
+  });
+  int x = 0, y = 0, shelf = 0;
+  for (const size_t i : order) {
+    Chart& chart = (*charts)[i];
+    if (x + chart.patch.cols > width) {
+      x = 0;
+      y += shelf;
+      shelf = 0;
+    }
+    chart.at = cv::Point(x, y);
+    x += chart.patch.cols;
+    shelf = std::max(shelf, chart.patch.rows);
+  }
+  return y + shelf;
+}
+
+// Pixels a side of the cell of a triangle no photo sees whole: its corners' colours at three of
+// the cell's texel centres, (0.5, 0.5), (kFlatCell - 0.5, 0.5) and (0.5, kFlatCell - 0.5),
+// blended in between as the vertex colours are.
+constexpr int kFlatCell = 4;
+
+// Each texel of the chart's triangles (in `patch`, the chart's piece of its own photo) becomes the
+// mean of what the triangle's candidate photos see at its point, weighted by the area the
+// triangle covers in each; samples far from the first mean (beyond twice the samples' spread
+// and at least kBlendOutlier) are left out of the second. The point is the texel's barycentric
+// blend of the corners (affine over the triangle: its projection is, to within a fraction of a
+// pixel at a triangle's size). Texels outside the triangles keep the photo's pixels, so that
+// sampling at a chart's edge blends with what the photo shows there.
+constexpr double kBlendOutlier = 30.0;
+void BlendViews(const std::vector<CalibratedView>& views, const TriangleMesh& mesh,
+                const std::vector<std::vector<Candidate>>& candidates, const Chart& chart,
+                const std::vector<std::array<Eigen::Vector2d, 3>>& corner_pixels, cv::Mat* patch) {
+  std::vector<Eigen::Vector3f> samples;
+  std::vector<double> weights;
+  for (const int t : chart.triangles) {
+    const Eigen::Vector2d offset(chart.source.x, chart.source.y);
+    const Eigen::Vector2d a = corner_pixels[t][0] - offset, b = corner_pixels[t][1] - offset,
+                          c = corner_pixels[t][2] - offset;
+    const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+    if (!(std::abs(area) > 1e-12)) continue;
+    const Eigen::Vector3d corner[3] = {mesh.vertices[mesh.triangles[t][0]].cast<double>(),
+                                       mesh.vertices[mesh.triangles[t][1]].cast<double>(),
+                                       mesh.vertices[mesh.triangles[t][2]].cast<double>()};
+    const int col_min = std::max(0, static_cast<int>(std::floor(std::min({a.x(), b.x(), c.x()}))));
+    const int col_max = std::min(patch->cols - 1, static_cast<int>(std::ceil(std::max({a.x(), b.x(), c.x()}))));
+    const int row_min = std::max(0, static_cast<int>(std::floor(std::min({a.y(), b.y(), c.y()}))));
+    const int row_max = std::min(patch->rows - 1, static_cast<int>(std::ceil(std::max({a.y(), b.y(), c.y()}))));
+    for (int row = row_min; row <= row_max; ++row) {
+      for (int col = col_min; col <= col_max; ++col) {
+        const Eigen::Vector2d p(col + 0.5, row + 0.5);
+        const double w0 = ((b.x() - p.x()) * (c.y() - p.y()) - (b.y() - p.y()) * (c.x() - p.x())) / area;
+        const double w1 = ((c.x() - p.x()) * (a.y() - p.y()) - (c.y() - p.y()) * (a.x() - p.x())) / area;
+        const double w2 = 1.0 - w0 - w1;
+        // A texel whose centre is within half a texel of the triangle: its edge texels too.
+        const double margin = 0.5 * std::sqrt(2.0) * 2.0 / std::sqrt(std::abs(area));
+        if (w0 < -margin || w1 < -margin || w2 < -margin) continue;
+        const Eigen::Vector3d point = w0 * corner[0] + w1 * corner[1] + w2 * corner[2];
+        samples.clear();
+        weights.clear();
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        double total = 0.0;
+        for (const Candidate& candidate : candidates[t]) {
+          Eigen::Vector3f colour;
+          if (!SamplePhoto(views[candidate.view], views[candidate.view].Project(point), &colour)) continue;
+          samples.push_back(colour);
+          weights.push_back(candidate.area);
+          sum += candidate.area * colour.cast<double>();
+          total += candidate.area;
+        }
+        if (!(total > 0.0)) continue;
+        const Eigen::Vector3d mean = sum / total;
+        double spread = 0.0;
+        for (size_t i = 0; i < samples.size(); ++i) {
+          spread += weights[i] * (samples[i].cast<double>() - mean).squaredNorm();
+        }
+        const double limit = std::max(kBlendOutlier, 2.0 * std::sqrt(spread / total));
+        Eigen::Vector3d kept = Eigen::Vector3d::Zero();
+        double kept_weight = 0.0;
+        for (size_t i = 0; i < samples.size(); ++i) {
+          if ((samples[i].cast<double>() - mean).norm() > limit) continue;
+          kept += weights[i] * samples[i].cast<double>();
+          kept_weight += weights[i];
+        }
+        const Eigen::Vector3d colour = kept_weight > 0.0 ? Eigen::Vector3d(kept / kept_weight) : mean;
+        cv::Vec3b& texel = patch->at<cv::Vec3b>(row, col);
+        for (int k = 0; k < 3; ++k) {
+          texel[k] = static_cast<uint8_t>(std::clamp(std::lround(colour[k]), 0L, 255L));
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+bool MeshTextureOptions::IsValid(std::string* reason) const {
+  if (!(neighbour_share > 0.0 && neighbour_share <= 1.0)) {
+    *reason = "neighbour_share must be in (0, 1]";
+    return false;
+  }
+  if (relabel_passes < 0 || padding < 1 || padding > 16) {
+    *reason = "relabel_passes must be >= 0 and padding in [1, 16]";
+    return false;
+  }
+  if (max_atlas_side < 64 || max_atlas_side > 16384) {
+    *reason = "max_atlas_side must be in [64, 16384]";
+    return false;
+  }
+  return true;
+}
+
+std::string MeshTextureSummary::Summary() const {
+  std::ostringstream text;
+  text.precision(3);
+  text << "mesh texture: " << textured << " of " << triangles << " triangles from the photos in "
+       << charts << " charts (" << relabelled << " took their neighbours' photo), the rest from their vertices' colours; atlas "
+       << atlas_width << " x " << atlas_height;
+  if (scale < 1.0) text << " at " << scale << " of the photos' resolution";
+  text << ", in " << seconds << " s";
+  return text.str();
+}
+
+MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& views,
+                                         const std::vector<std::vector<uint32_t>>& seen_by,
+                                         const MeshTextureOptions& options, TriangleMesh* mesh) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string reason;
+  CHECK(options.IsValid(&reason)) << reason;
+  CHECK_EQ(seen_by.size(), mesh->vertices.size());
+  CHECK_EQ(mesh->colours.size(), mesh->vertices.size());
+  MeshTextureSummary summary;
+  const int num_triangles = static_cast<int>(mesh->triangles.size());
+  summary.triangles = num_triangles;
+  mesh->corner_uvs.clear();
+  mesh->texture.release();
+  if (num_triangles == 0) return summary;
+
+  // Each triangle's photo: the one where it covers the most pixels, then its neighbours' where
+  // that one is nearly as good.
+  std::vector<std::vector<Candidate>> candidates(num_triangles);
+  std::vector<int> label(num_triangles, -1);
+  for (int t = 0; t < num_triangles; ++t) {
+    candidates[t] = CandidatesOf(views, seen_by, *mesh, mesh->triangles[t]);
+    double best = 0.0;
+    for (const Candidate& c : candidates[t]) {
+      if (c.area > best) {
+        best = c.area;
+        label[t] = c.view;
+      }
+    }
+  }
+  const std::vector<std::vector<int>> neighbours = EdgeNeighbours(*mesh);
+  for (int pass = 0; pass < options.relabel_passes; ++pass) {
+    std::vector<int> next = label;
+    for (int t = 0; t < num_triangles; ++t) {
+      if (label[t] < 0) continue;
+      std::map<int, int> votes;
+      for (const int u : neighbours[t]) {
+        if (label[u] >= 0 && label[u] != label[t]) ++votes[label[u]];
+      }
+      int own_votes = 0;
+      for (const int u : neighbours[t]) own_votes += label[u] == label[t];
+      double best = 0.0;
+      for (const Candidate& c : candidates[t]) best = std::max(best, c.area);
+      for (const auto& [view, count] : votes) {
+        if (count <= own_votes || count < 2) continue;
+        for (const Candidate& c : candidates[t]) {
+          if (c.view == view && c.area >= options.neighbour_share * best) next[t] = view;
+        }
+      }
+    }
+    label.swap(next);
+  }
+
+  // Charts: edge-connected triangles with one photo.
+  std::vector<int> chart_of(num_triangles, -1);
+  std::vector<Chart> charts;
+  Chart flat;
+  for (int t = 0; t < num_triangles; ++t) {
+    if (label[t] < 0) {
+      flat.triangles.push_back(t);
+      continue;
+    }
+    if (chart_of[t] >= 0) continue;
+    Chart chart;
+    chart.view = label[t];
+    std::vector<int> stack = {t};
+    chart_of[t] = static_cast<int>(charts.size());
+    while (!stack.empty()) {
+      const int u = stack.back();
+      stack.pop_back();
+      chart.triangles.push_back(u);
+      for (const int w : neighbours[u]) {
+        if (chart_of[w] < 0 && label[w] == chart.view) {
+          chart_of[w] = chart_of[t];
+          stack.push_back(w);
+        }
+      }
+    }
+    charts.push_back(std::move(chart));
+  }
+  summary.charts = static_cast<int64_t>(charts.size());
+  summary.textured = num_triangles - static_cast<int64_t>(flat.triangles.size());
+  for (int t = 0; t < num_triangles; ++t) {
+    if (label[t] < 0) continue;
+    double best = 0.0;
+    int best_view = -1;
+    for (const Candidate& c : candidates[t]) {
+      if (c.area > best) {
+        best = c.area;
+        best_view = c.view;
+      }
+    }
+    summary.relabelled += label[t] != best_view;
+  }
+
+  // Each chart's piece of its photo, levelled to the vertices' colours.
+  std::vector<std::array<Eigen::Vector2d, 3>> corner_pixels(num_triangles);
+  for (Chart& chart : charts) {
+    const CalibratedView& view = views[chart.view];
+    Eigen::Vector2d low(1e300, 1e300), high(-1e300, -1e300);
+    Eigen::Vector3d vertex_sum = Eigen::Vector3d::Zero(), photo_sum = Eigen::Vector3d::Zero();
+    for (const int t : chart.triangles) {
+      for (int corner = 0; corner < 3; ++corner) {
+        const int vertex = mesh->triangles[t][corner];
+        const Eigen::Vector2d pixel = view.Project(mesh->vertices[vertex].cast<double>());
+        corner_pixels[t][corner] = pixel;
+        low = low.cwiseMin(pixel);
+        high = high.cwiseMax(pixel);
+        Eigen::Vector3f colour;
+        if (SampleBilinear(view.image, pixel, &colour)) {
+          photo_sum += colour.cast<double>();
+          vertex_sum += mesh->colours[vertex].cast<double>();
+        }
+      }
+    }
+    const int x0 = std::max(0, static_cast<int>(std::floor(low.x())) - options.padding);
+    const int y0 = std::max(0, static_cast<int>(std::floor(low.y())) - options.padding);
+    const int x1 = std::min(view.width, static_cast<int>(std::ceil(high.x())) + options.padding);
+    const int y1 = std::min(view.height, static_cast<int>(std::ceil(high.y())) + options.padding);
+    chart.source = cv::Rect(x0, y0, std::max(1, x1 - x0), std::max(1, y1 - y0));
+    chart.patch = view.image(chart.source).clone();
+    if (options.blend_views) {
+      BlendViews(views, *mesh, candidates, chart, corner_pixels, &chart.patch);
+    } else if (options.level_colours && photo_sum.minCoeff() > 0.0) {
+      cv::Mat levelled;
+      chart.patch.convertTo(levelled, CV_32FC3);
+      cv::Scalar gain;
+      for (int k = 0; k < 3; ++k) gain[k] = std::clamp(vertex_sum[k] / photo_sum[k], 1.0 / 1.4, 1.4);
+      cv::multiply(levelled, gain, levelled);
+      levelled.convertTo(chart.patch, CV_8UC3);  // saturating
+    }
+  }
+  // The cells of the triangles no photo sees whole, in a square block.
+  const int flat_count = static_cast<int>(flat.triangles.size());
+  const int flat_side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(flat_count))));
+  if (flat_count > 0) {
+    flat.patch = cv::Mat(flat_side * kFlatCell, flat_side * kFlatCell, CV_8UC3, cv::Scalar::all(128));
+    const double span = kFlatCell - 1.0;
+    for (int i = 0; i < flat_count; ++i) {
+      const Eigen::Vector3i& triangle = mesh->triangles[flat.triangles[i]];
+      const int x0 = (i % flat_side) * kFlatCell, y0 = (i / flat_side) * kFlatCell;
+      for (int y = 0; y < kFlatCell; ++y) {
+        for (int x = 0; x < kFlatCell; ++x) {
+          // Barycentric weights of the texel centre, clamped onto the triangle.
+          double w1 = x / span, w2 = y / span;
+          if (w1 + w2 > 1.0) {
+            const double sum = w1 + w2;
+            w1 /= sum;
+            w2 /= sum;
+          }
+          const double w0 = 1.0 - w1 - w2;
+          cv::Vec3b& texel = flat.patch.at<cv::Vec3b>(y0 + y, x0 + x);
+          for (int k = 0; k < 3; ++k) {
+            const double value = w0 * mesh->colours[triangle[0]][k] +
+                                 w1 * mesh->colours[triangle[1]][k] +
+                                 w2 * mesh->colours[triangle[2]][k];
+            texel[k] = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+          }
+        }
+      }
+    }
+  }
+
+  // Packing: an atlas about as wide as tall; scaled down until it fits the longest side allowed.
+  double area = 0.0;
+  for (const Chart& chart : charts) area += static_cast<double>(chart.patch.total());
+  std::vector<cv::Mat> originals;
+  for (const Chart& chart : charts) originals.push_back(chart.patch);
+  double scale = 1.0;
+  int width = 0, height = 0;
+  for (int attempt = 0; attempt < 40; ++attempt) {
+    width = 64;
+    while (width < options.max_atlas_side &&
+           static_cast<double>(width) * width < 1.2 * (area * scale * scale + flat.patch.total())) {
+      width *= 2;
+    }
+    for (size_t i = 0; i < charts.size(); ++i) {
+      if (scale < 1.0) {
+        const cv::Size size(std::max(1, static_cast<int>(std::lround(originals[i].cols * scale))),
+                            std::max(1, static_cast<int>(std::lround(originals[i].rows * scale))));
+        cv::resize(originals[i], charts[i].patch, size, 0, 0, cv::INTER_AREA);
+      }
+    }
+    // No narrower than the widest chart.
+    for (const Chart& chart : charts) width = std::max(width, chart.patch.cols);
+    width = std::max(width, flat.patch.cols);
+    charts.push_back(flat);
+    height = Pack(width, &charts);
+    flat = charts.back();
+    charts.pop_back();
+    if (height <= options.max_atlas_side && width <= options.max_atlas_side) break;
+    scale *= 0.9;
+  }
+  summary.scale = scale;
+  summary.atlas_width = width;
+  summary.atlas_height = height;
+  mesh->texture = cv::Mat(height, width, CV_8UC3, cv::Scalar::all(128));
+  mesh->corner_uvs.assign(3 * static_cast<size_t>(num_triangles), Eigen::Vector2f::Zero());
+  for (size_t i = 0; i < charts.size(); ++i) {
+    const Chart& chart = charts[i];
+    const double sx = static_cast<double>(chart.patch.cols) / chart.source.width;
+    const double sy = static_cast<double>(chart.patch.rows) / chart.source.height;
+    chart.patch.copyTo(mesh->texture(cv::Rect(chart.at, chart.patch.size())));
+    for (const int t : chart.triangles) {
+      for (int corner = 0; corner < 3; ++corner) {
+        const Eigen::Vector2d& pixel = corner_pixels[t][corner];
+        mesh->corner_uvs[3 * t + corner] =
+            Eigen::Vector2f((chart.at.x + (pixel.x() - chart.source.x) * sx) / width,
+                            (chart.at.y + (pixel.y() - chart.source.y) * sy) / height);
+      }
+    }
+  }
+  if (flat_count > 0) {
+    flat.patch.copyTo(mesh->texture(cv::Rect(flat.at, flat.patch.size())));
+    for (int i = 0; i < flat_count; ++i) {
+      const float x0 = static_cast<float>(flat.at.x + (i % flat_side) * kFlatCell) + 0.5f;
+      const float y0 = static_cast<float>(flat.at.y + (i / flat_side) * kFlatCell) + 0.5f;
+      const float span = kFlatCell - 1.0f;
+      const Eigen::Vector2f corners[3] = {{x0, y0}, {x0 + span, y0}, {x0, y0 + span}};
+      for (int corner = 0; corner < 3; ++corner) {
+        mesh->corner_uvs[3 * flat.triangles[i] + corner] =
+            corners[corner].cwiseQuotient(Eigen::Vector2f(width, height));
+      }
+    }
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+namespace {
+
+// The mesh's corners as vertices of their own where one vertex has several texture coordinates:
+// per output vertex, its mesh vertex and its coordinates; per triangle corner, its output vertex.
+struct SplitVertices {
+  std::vector<int> vertex;
+  std::vector<Eigen::Vector2f> uv;
+  std::vector<int> corner;
+};
+
+SplitVertices SplitByTextureCoordinates(const TriangleMesh& mesh) {
+  SplitVertices split;
+  struct Key {
+    int vertex;
+    float u, v;
+    bool operator==(const Key& o) const { return vertex == o.vertex && u == o.u && v == o.v; }
+  };
+  struct KeyHash {
+    size_t operator()(const Key& k) const {
+      uint32_t u, v;
+      std::memcpy(&u, &k.u, 4);
+      std::memcpy(&v, &k.v, 4);
+      return std::hash<uint64_t>()((static_cast<uint64_t>(k.vertex) << 32) ^ (u * 2654435761u) ^ v);
+    }
+  };
+  std::unordered_map<Key, int, KeyHash> index;
+  index.reserve(mesh.corner_uvs.size());
+  split.corner.reserve(mesh.corner_uvs.size());
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2f& uv = mesh.corner_uvs[3 * t + k];
+      const Key key{mesh.triangles[t][k], uv.x(), uv.y()};
+      const auto [found, added] = index.emplace(key, static_cast<int>(split.vertex.size()));
+      if (added) {
+        split.vertex.push_back(key.vertex);
+        split.uv.push_back(uv);
+      }
+      split.corner.push_back(found->second);
+    }
+  }
+  return split;
+}
+
+std::vector<uint8_t> EncodePng(const cv::Mat& rgb, const std::string& path) {
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  std::vector<uint8_t> bytes;
+  if (!cv::imencode(".png", bgr, bytes)) throw InputError(path + ": cannot encode the texture");
+  return bytes;
+}
+
+void WriteBytes(const std::string& path, const std::string& what, const char* data, size_t size) {
+  const std::string temporary = TemporaryPathFor(path);
+  errno = 0;
+  std::ofstream file(temporary, std::ios::binary);
+  file.write(data, static_cast<std::streamsize>(size));
+  file.close();
+  if (!file) ThrowWriteFailure(temporary, what, errno);
+  RenameIntoPlace(temporary, path);
+}
+
+}  // namespace
+
+void WriteTexturedObj(const TriangleMesh& mesh, const std::string& obj_path) {
+  CHECK(mesh.textured());
+  const std::filesystem::path obj(obj_path);
+  const std::string stem = obj.stem().string();
+  const std::filesystem::path folder = obj.parent_path();
+  const std::string mtl_name = stem + ".mtl", png_name = stem + "_texture.png";
+  const std::vector<uint8_t> png = EncodePng(mesh.texture, (folder / png_name).string());
+  WriteBytes((folder / png_name).string(), "the texture", reinterpret_cast<const char*>(png.data()),
+             png.size());
+  const std::string mtl = "# raycarve: the texture atlas from the photos\nnewmtl raycarve\n"
+                          "Ka 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\nmap_Kd " + png_name + "\n";
+  WriteBytes((folder / mtl_name).string(), "the material", mtl.data(), mtl.size());
+  const SplitVertices split = SplitByTextureCoordinates(mesh);
+  std::ostringstream text;
+  text.imbue(std::locale::classic());
+  text.precision(9);
+  text << "# raycarve: textured mesh, " << mesh.vertices.size() << " vertices, "
+       << mesh.triangles.size() << " triangles\nmtllib " << mtl_name << "\n";
+  for (const Eigen::Vector3f& v : mesh.vertices) text << "v " << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
+  const bool normals = mesh.normals.size() == mesh.vertices.size();
+  if (normals) {
+    for (const Eigen::Vector3f& n : mesh.normals) text << "vn " << n.x() << ' ' << n.y() << ' ' << n.z() << '\n';
+  }
+  // OBJ's v runs up from the image's bottom.
+  for (const Eigen::Vector2f& uv : split.uv) text << "vt " << uv.x() << ' ' << 1.0f - uv.y() << '\n';
+  text << "usemtl raycarve\n";
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    text << 'f';
+    for (int k = 0; k < 3; ++k) {
+      const int v = mesh.triangles[t][k] + 1, vt = split.corner[3 * t + k] + 1;
+      text << ' ' << v << '/' << vt;
+      if (normals) text << '/' << v;
+    }
+    text << '\n';
+  }
+  const std::string bytes = text.str();
+  WriteBytes(obj_path, "the mesh", bytes.data(), bytes.size());
+}
+
+void WriteGlb(const TriangleMesh& mesh, const std::string& path) {
+  const bool textured = mesh.textured();
+  SplitVertices split;
+  if (textured) {
+    split = SplitByTextureCoordinates(mesh);
+  } else {
+    split.vertex.resize(mesh.vertices.size());
+    std::iota(split.vertex.begin(), split.vertex.end(), 0);
+    for (const Eigen::Vector3i& t : mesh.triangles) {
+      for (int k = 0; k < 3; ++k) split.corner.push_back(t[k]);
+    }
+  }
+  const size_t n = split.vertex.size();
+  const bool normals = mesh.normals.size() == mesh.vertices.size();
+  const bool colours = !textured && mesh.colours.size() == mesh.vertices.size();
+  tinygltf::Model model;
+  tinygltf::Buffer buffer;
+  auto append = [&buffer](const void* data, size_t bytes) {
+    const size_t offset = buffer.data.size();
+    buffer.data.resize(offset + bytes);
+    std::memcpy(buffer.data.data() + offset, data, bytes);
+    while (buffer.data.size() % 4 != 0) buffer.data.push_back(0);
+    return offset;
+  };
+  auto add_view = [&](size_t offset, size_t bytes, int target) {
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = offset;
+    view.byteLength = bytes;
+    view.target = target;
+    model.bufferViews.push_back(view);
+    return static_cast<int>(model.bufferViews.size() - 1);
+  };
+  auto add_accessor = [&](int view, int component, int type, size_t count, bool normalized) {
+    tinygltf::Accessor accessor;
+    accessor.bufferView = view;
+    accessor.componentType = component;
+    accessor.type = type;
+    accessor.count = count;
+    accessor.normalized = normalized;
+    model.accessors.push_back(accessor);
+    return static_cast<int>(model.accessors.size() - 1);
+  };
+  std::vector<float> positions, normal_values, uvs;
+  std::vector<uint8_t> colour_values;
+  Eigen::Vector3f low = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+  Eigen::Vector3f high = -low;
+  for (const int v : split.vertex) {
+    const Eigen::Vector3f& p = mesh.vertices[v];
+    positions.insert(positions.end(), {p.x(), p.y(), p.z()});
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+    if (normals) normal_values.insert(normal_values.end(), {mesh.normals[v].x(), mesh.normals[v].y(), mesh.normals[v].z()});
+    if (colours) {
+      colour_values.insert(colour_values.end(), {mesh.colours[v][0], mesh.colours[v][1], mesh.colours[v][2], 255});
+    }
+  }
+  for (const Eigen::Vector2f& uv : split.uv) uvs.insert(uvs.end(), {uv.x(), uv.y()});
+  std::vector<uint32_t> indices(split.corner.begin(), split.corner.end());
+  tinygltf::Primitive primitive;
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+  const int position_accessor = add_accessor(
+      add_view(append(positions.data(), positions.size() * 4), positions.size() * 4,
+               TINYGLTF_TARGET_ARRAY_BUFFER),
+      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, false);
+  if (n > 0) {
+    model.accessors[position_accessor].minValues = {low.x(), low.y(), low.z()};
+    model.accessors[position_accessor].maxValues = {high.x(), high.y(), high.z()};
+  }
+  primitive.attributes["POSITION"] = position_accessor;
+  if (normals) {
+    primitive.attributes["NORMAL"] = add_accessor(
+        add_view(append(normal_values.data(), normal_values.size() * 4), normal_values.size() * 4,
+                 TINYGLTF_TARGET_ARRAY_BUFFER),
+        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, false);
+  }
+  if (colours) {
+    primitive.attributes["COLOR_0"] = add_accessor(
+        add_view(append(colour_values.data(), colour_values.size()), colour_values.size(),
+                 TINYGLTF_TARGET_ARRAY_BUFFER),
+        TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_VEC4, n, true);
+  }
+  if (textured) {
+    primitive.attributes["TEXCOORD_0"] = add_accessor(
+        add_view(append(uvs.data(), uvs.size() * 4), uvs.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, n, false);
+  }
+  primitive.indices = add_accessor(
+      add_view(append(indices.data(), indices.size() * 4), indices.size() * 4,
+               TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size(), false);
+  tinygltf::Material material;
+  material.name = "raycarve";
+  material.pbrMetallicRoughness.metallicFactor = 0.0;
+  material.pbrMetallicRoughness.roughnessFactor = 1.0;
+  if (textured) {
+    const std::vector<uint8_t> png = EncodePng(mesh.texture, path);
+    tinygltf::Image image;
+    image.mimeType = "image/png";
+    image.bufferView = add_view(append(png.data(), png.size()), png.size(), 0);
+    model.images.push_back(image);
+    tinygltf::Sampler sampler;
+    sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+    sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+    model.samplers.push_back(sampler);
+    tinygltf::Texture texture;
+    texture.source = 0;
+    texture.sampler = 0;
+    model.textures.push_back(texture);
+    material.pbrMetallicRoughness.baseColorTexture.index = 0;
+  }
+  model.materials.push_back(material);
+  primitive.material = 0;
+  tinygltf::Mesh gltf_mesh;
+  gltf_mesh.name = "raycarve";
+  gltf_mesh.primitives.push_back(primitive);
+  model.meshes.push_back(gltf_mesh);
+  tinygltf::Node node;
+  node.mesh = 0;
+  model.nodes.push_back(node);
+  tinygltf::Scene scene;
+  scene.nodes.push_back(0);
+  model.scenes.push_back(scene);
+  model.defaultScene = 0;
+  model.asset.version = "2.0";
+  model.asset.generator = "raycarve";
+  model.buffers.push_back(std::move(buffer));
+  const std::string temporary = TemporaryPathFor(path);
+  tinygltf::TinyGLTF writer;
+  errno = 0;
+  if (!writer.WriteGltfSceneToFile(&model, temporary, /*embedImages=*/false, /*embedBuffers=*/true,
+                                   /*prettyPrint=*/false, /*writeBinary=*/true)) {
+    ThrowWriteFailure(temporary, "the glTF mesh", errno);
+  }
+  RenameIntoPlace(temporary, path);
+}
+
+}  // namespace exporter
+}  // namespace raycarve

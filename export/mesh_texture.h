@@ -1,0 +1,71 @@
+#pragma once
+// A texture atlas for a mesh from the photos: each triangle takes its colours from the photo that
+// sees it best, neighbours share photos where they can, and the pieces of photo are packed into
+// one image. Then the textured mesh's files: OBJ + MTL + PNG, and glTF 2.0 binary (GLB).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "calib/calibrated_view.h"
+#include "export/surface_mesh.h"
+
+namespace raycarve {
+namespace exporter {
+
+struct MeshTextureOptions {
+  // A triangle takes the photo its neighbours take when that photo sees all its corners with at
+  // least this share of its best photo's projected area; this many passes. Fewer, larger charts
+  // mean fewer seams.
+  double neighbour_share = 0.5;
+  int relabel_passes = 3;
+  // Photo pixels kept around each chart, so that sampling at its edge stays inside it.
+  int padding = 2;
+  // The atlas's longer side at most; the charts are scaled down when they would not fit.
+  int max_atlas_side = 8192;
+  // Each chart's colours scaled (per channel, within [1/1.4, 1.4]) so that its photo's colours at
+  // the chart's vertices match the vertices' colours, which all the photos that see them agreed
+  // on: the photos' exposures differ and the seams between charts would show it.
+  bool level_colours = true;
+  // Each texel the mean of every candidate photo's colour at its point (weighted by the area the
+  // triangle covers in each, outliers left out) rather than its chart's photo alone: the
+  // photos' view-dependent light and the geometry's error average out as in the vertex colours,
+  // at the photos' resolution. Levelling is then not needed.
+  bool blend_views = true;
+  bool IsValid(std::string* reason) const;
+};
+
+struct MeshTextureSummary {
+  int64_t triangles = 0;
+  int64_t textured = 0;  // from the photos; the rest take their vertices' colours
+  int64_t charts = 0;
+  int64_t relabelled = 0;  // triangles that took their neighbours' photo
+  int atlas_width = 0;
+  int atlas_height = 0;
+  double scale = 1.0;  // photo pixels to atlas pixels (1 unless the atlas had to shrink)
+  double seconds = 0.0;
+  std::string Summary() const;
+};
+
+// Sets mesh->corner_uvs and mesh->texture. `seen_by` gives per vertex the views (indices into
+// `views`) that see it (ColourMeshFromPhotos); a triangle's candidate photos see all three of its
+// corners, inside the photo and facing the camera, and it takes the one where it covers the most
+// pixels (resolution and obliqueness in one figure). Triangles no photo sees whole take their
+// vertices' colours (mesh->colours), blended over a small cell each. Needs mesh->colours.
+MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& views,
+                                         const std::vector<std::vector<uint32_t>>& seen_by,
+                                         const MeshTextureOptions& options, TriangleMesh* mesh);
+
+// Writes `<stem>.obj`, `<stem>.mtl` and `<stem>_texture.png` beside each other (`obj_path` ends
+// in .obj): positions, normals, the corners' texture coordinates, one material whose diffuse map
+// is the atlas. Each file under a temporary name and renamed; throws InputError naming the file
+// on failure. The mesh must be textured.
+void WriteTexturedObj(const TriangleMesh& mesh, const std::string& obj_path);
+
+// Writes the mesh as glTF 2.0 binary: positions, normals, and the texture (PNG, embedded) with
+// its coordinates when the mesh is textured, else the vertex colours (COLOR_0). Temporary name
+// and rename; throws InputError naming the file on failure.
+void WriteGlb(const TriangleMesh& mesh, const std::string& path);
+
+}  // namespace exporter
+}  // namespace raycarve

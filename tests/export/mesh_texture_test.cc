@@ -1,0 +1,177 @@
+// The texture atlas against answers known by construction: a patterned photo of a flat
+// rectangle that the textured mesh must draw back, a triangle no photo sees whole that must keep
+// its vertices' colours, and the OBJ and glTF files read back.
+#include "export/mesh_texture.h"
+
+#include <cmath>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <tiny_gltf.h>
+
+#include "export/mesh_renderer.h"
+#include "tests/test_support.h"
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+// An 80x60 pinhole view at the origin looking down +z (x right, y down), f = 100, whose photo is
+// a pattern that differs at every pixel: a 4-pixel check over two gradients.
+CalibratedView PatternView() {
+  CalibratedView view;
+  view.width = 80;
+  view.height = 60;
+  view.K << 100, 0, 40, 0, 100, 30, 0, 0, 1;
+  view.cam_from_world.rotation = Eigen::Quaterniond::Identity();
+  view.cam_from_world.translation = Eigen::Vector3d::Zero();
+  view.centre = Eigen::Vector3d::Zero();
+  view.P = view.K * view.cam_from_world.ToMatrix();
+  view.image = cv::Mat(view.height, view.width, CV_8UC3);
+  for (int row = 0; row < view.height; ++row) {
+    for (int col = 0; col < view.width; ++col) {
+      const bool check = ((col / 4) + (row / 4)) % 2 == 0;
+      view.image.at<cv::Vec3b>(row, col) =
+          cv::Vec3b(static_cast<uint8_t>(3 * col), static_cast<uint8_t>(4 * row), check ? 220 : 30);
+    }
+  }
+  view.valid = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(255));
+  return view;
+}
+
+// The rectangle over pixels 10..70 across and 10..50 down at depth 4, as a grid of 6 x 4 quads
+// of two triangles each, wound to face the camera; grey vertex colours.
+TriangleMesh Rectangle(const CalibratedView& view) {
+  TriangleMesh mesh;
+  for (int j = 0; j <= 4; ++j) {
+    for (int i = 0; i <= 6; ++i) {
+      const double x = 10 + 10 * i, y = 10 + 10 * j, z = 4.0;
+      mesh.vertices.emplace_back(static_cast<float>((x - view.K(0, 2)) / view.K(0, 0) * z),
+                                 static_cast<float>((y - view.K(1, 2)) / view.K(1, 1) * z),
+                                 static_cast<float>(z));
+    }
+  }
+  for (int j = 0; j < 4; ++j) {
+    for (int i = 0; i < 6; ++i) {
+      const int a = j * 7 + i, b = a + 1, c = a + 8, d = a + 7;
+      mesh.triangles.emplace_back(a, c, b);  // counter-clockwise on the screen: facing the camera
+      mesh.triangles.emplace_back(a, d, c);
+    }
+  }
+  mesh.colours.assign(mesh.vertices.size(), Eigen::Matrix<uint8_t, 3, 1>(128, 128, 128));
+  ComputeVertexNormals(&mesh);
+  return mesh;
+}
+
+TEST(TextureMeshFromPhotos, TheTexturedMeshDrawsThePhotoBack) {
+  const std::vector<CalibratedView> views = {PatternView()};
+  TriangleMesh mesh = Rectangle(views[0]);
+  const std::vector<std::vector<uint32_t>> seen_by(mesh.vertices.size(), {0});
+  const MeshTextureSummary summary = TextureMeshFromPhotos(views, seen_by, {}, &mesh);
+  ASSERT_TRUE(mesh.textured());
+  EXPECT_EQ(summary.triangles, 48);
+  EXPECT_EQ(summary.textured, 48);
+  EXPECT_EQ(summary.charts, 1);  // one photo, one connected piece
+  EXPECT_DOUBLE_EQ(summary.scale, 1.0);
+  for (const Eigen::Vector2f& uv : mesh.corner_uvs) {
+    EXPECT_TRUE(uv.x() >= 0.0f && uv.x() <= 1.0f && uv.y() >= 0.0f && uv.y() <= 1.0f);
+  }
+  const Rendering rendering = RenderMesh(mesh, views[0]);
+  double error = 0.0;
+  int pixels = 0;
+  for (int row = 10; row < 50; ++row) {
+    for (int col = 10; col < 70; ++col) {
+      ASSERT_NE(rendering.silhouette.at<uint8_t>(row, col), 0);
+      const cv::Vec3b drawn = rendering.image.at<cv::Vec3b>(row, col);
+      const cv::Vec3b photo = views[0].image.at<cv::Vec3b>(row, col);
+      for (int k = 0; k < 3; ++k) error += std::abs(drawn[k] - photo[k]);
+      ++pixels;
+    }
+  }
+  // Drawn back at the photo's own pixels: the same colours to within rounding.
+  EXPECT_LT(error / (3.0 * pixels), 1.0);
+  // Without the texture the grey vertex colours are all that is drawn.
+  TriangleMesh plain = mesh;
+  plain.texture.release();
+  EXPECT_EQ(RenderMesh(plain, views[0]).image.at<cv::Vec3b>(30, 40), cv::Vec3b(128, 128, 128));
+}
+
+TEST(TextureMeshFromPhotos, ATriangleNoPhotoSeesWholeKeepsItsVertexColours) {
+  const std::vector<CalibratedView> views = {PatternView()};
+  TriangleMesh mesh = Rectangle(views[0]);
+  std::vector<std::vector<uint32_t>> seen_by(mesh.vertices.size(), {0});
+  // The first quad's far corner unseen: the six triangles around it have no photo.
+  seen_by[8].clear();
+  mesh.colours[0] = {200, 0, 0};
+  mesh.colours[1] = {0, 200, 0};
+  mesh.colours[8] = {0, 0, 200};
+  const MeshTextureSummary summary = TextureMeshFromPhotos(views, seen_by, {}, &mesh);
+  EXPECT_EQ(summary.textured, 48 - 6);
+  const Rendering rendering = RenderMesh(mesh, views[0]);
+  // Triangle (0, 8, 1): corners at pixels (10, 10), (20, 20), (20, 10); near its centroid the
+  // three colours blend about equally, as the vertex colours would draw them.
+  const cv::Vec3b centre = rendering.image.at<cv::Vec3b>(13, 16);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(centre[k], 200.0 / 3.0, 25.0) << k;
+}
+
+TEST(WriteTexturedObj, TheFilesReadBack) {
+  const std::vector<CalibratedView> views = {PatternView()};
+  TriangleMesh mesh = Rectangle(views[0]);
+  TextureMeshFromPhotos(views, std::vector<std::vector<uint32_t>>(mesh.vertices.size(), {0}), {},
+                        &mesh);
+  const std::string folder = testing::MakeTemporaryDirectory("mesh_texture");
+  WriteTexturedObj(mesh, folder + "/mesh.obj");
+  std::ifstream obj(folder + "/mesh.obj");
+  int v = 0, vt = 0, vn = 0, f = 0;
+  bool mtllib = false, usemtl = false;
+  for (std::string line; std::getline(obj, line);) {
+    v += line.rfind("v ", 0) == 0;
+    vt += line.rfind("vt ", 0) == 0;
+    vn += line.rfind("vn ", 0) == 0;
+    f += line.rfind("f ", 0) == 0;
+    mtllib |= line == "mtllib mesh.mtl";
+    usemtl |= line == "usemtl raycarve";
+  }
+  EXPECT_EQ(v, 35);
+  EXPECT_EQ(vn, 35);
+  EXPECT_EQ(vt, 35);  // one chart: each vertex one texture coordinate
+  EXPECT_EQ(f, 48);
+  EXPECT_TRUE(mtllib && usemtl);
+  EXPECT_NE(testing::ReadFileBytes(folder + "/mesh.mtl").find("map_Kd mesh_texture.png"),
+            std::string::npos);
+  const cv::Mat png = cv::imread(folder + "/mesh_texture.png", cv::IMREAD_COLOR);
+  EXPECT_EQ(png.size(), mesh.texture.size());
+
+  WriteGlb(mesh, folder + "/mesh.glb");
+  EXPECT_EQ(testing::ReadFileBytes(folder + "/mesh.glb").substr(0, 4), "glTF");
+  tinygltf::TinyGLTF loader;
+  // The embedded PNG is checked above; the loader need not decode it.
+  loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int,
+                           const unsigned char*, int, void*) { return true; },
+                        nullptr);
+  tinygltf::Model model;
+  std::string error, warning;
+  ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &error, &warning, folder + "/mesh.glb")) << error;
+  ASSERT_EQ(model.meshes.size(), 1u);
+  const tinygltf::Primitive& primitive = model.meshes[0].primitives[0];
+  ASSERT_TRUE(primitive.attributes.count("TEXCOORD_0"));
+  EXPECT_EQ(model.accessors[primitive.attributes.at("POSITION")].count, 35u);
+  EXPECT_EQ(model.accessors[primitive.indices].count, 3u * 48u);
+  EXPECT_EQ(model.images.size(), 1u);
+  EXPECT_EQ(model.images[0].mimeType, "image/png");
+
+  // Untextured, the vertex colours go in instead.
+  TriangleMesh plain = Rectangle(views[0]);
+  WriteGlb(plain, folder + "/plain.glb");
+  tinygltf::Model plain_model;
+  ASSERT_TRUE(loader.LoadBinaryFromFile(&plain_model, &error, &warning, folder + "/plain.glb"))
+      << error;
+  EXPECT_TRUE(plain_model.meshes[0].primitives[0].attributes.count("COLOR_0"));
+  EXPECT_TRUE(plain_model.images.empty());
+}
+
+}  // namespace
+}  // namespace exporter
+}  // namespace raycarve

@@ -5,7 +5,6 @@
 #include <sstream>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/box_intersection_d.h>
 #include <CGAL/intersections.h>
 
 namespace raycarve {
@@ -16,7 +15,6 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using Segment = Kernel::Segment_3;
 using Triangle = Kernel::Triangle_3;
-using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int>;
 
 Point ToPoint(const Eigen::Vector3f& p) { return Point(p.x(), p.y(), p.z()); }
 
@@ -54,80 +52,93 @@ bool Intersect(const TriangleMesh& mesh, int a, int b) {
 
 namespace {
 
-// The triangle's bounding box, false for a degenerate or non-finite triangle.
-bool TriangleBox(const TriangleMesh& mesh, int t, Box* box) {
-  const Eigen::Vector3i& triangle = mesh.triangles[t];
-  if (Degenerate(triangle)) return false;
-  const Eigen::Vector3f& p0 = mesh.vertices[triangle[0]];
-  const Eigen::Vector3f& p1 = mesh.vertices[triangle[1]];
-  const Eigen::Vector3f& p2 = mesh.vertices[triangle[2]];
-  if (!p0.allFinite() || !p1.allFinite() || !p2.allFinite()) return false;
-  const Eigen::Vector3f low = p0.cwiseMin(p1).cwiseMin(p2);
-  const Eigen::Vector3f high = p0.cwiseMax(p1).cwiseMax(p2);
-  *box = Box(CGAL::Bbox_3(low.x(), low.y(), low.z(), high.x(), high.y(), high.z()), t);
-  return true;
+// A triangle's bounding box.
+struct TriangleBox {
+  Eigen::Vector3f low, high;
+  int triangle;
+};
+
+bool Overlap(const TriangleBox& a, const TriangleBox& b) {
+  return (a.low.array() <= b.high.array()).all() && (b.low.array() <= a.high.array()).all();
 }
 
 }  // namespace
 
 std::vector<std::pair<int, int>> FindSelfIntersections(const TriangleMesh& mesh,
                                                        const std::vector<uint8_t>* check) {
-  std::vector<Box> boxes, checked;
+  std::vector<TriangleBox> boxes;
   boxes.reserve(mesh.triangles.size());
+  std::vector<float> extents;
   for (int t = 0; t < static_cast<int>(mesh.triangles.size()); ++t) {
-    Box box;
-    if (!TriangleBox(mesh, t, &box)) continue;
+    const Eigen::Vector3i& triangle = mesh.triangles[t];
+    if (Degenerate(triangle)) continue;
+    const Eigen::Vector3f& p0 = mesh.vertices[triangle[0]];
+    const Eigen::Vector3f& p1 = mesh.vertices[triangle[1]];
+    const Eigen::Vector3f& p2 = mesh.vertices[triangle[2]];
+    if (!p0.allFinite() || !p1.allFinite() || !p2.allFinite()) continue;
+    TriangleBox box{p0.cwiseMin(p1).cwiseMin(p2), p0.cwiseMax(p1).cwiseMax(p2), t};
     boxes.push_back(box);
-    if (check != nullptr && (*check)[t]) checked.push_back(box);
+    extents.push_back((box.high - box.low).maxCoeff());
   }
   std::vector<std::pair<int, int>> pairs;
-  const auto test = [&](const Box& a, const Box& b) {
-    if (a.info() != b.info() && Intersect(mesh, a.info(), b.info())) {
-      pairs.emplace_back(std::min(a.info(), b.info()), std::max(a.info(), b.info()));
-    }
+  if (boxes.size() < 2) return pairs;
+  // Candidates share a cell of a uniform grid whose cells are twice the 90th percentile of the
+  // triangles' extents (a triangle then touches at most 8 cells, mostly 1), grown until the grid
+  // has at most about a cell per triangle.
+  std::nth_element(extents.begin(), extents.begin() + extents.size() * 9 / 10, extents.end());
+  Eigen::Vector3f low = boxes[0].low, high = boxes[0].high;
+  for (const TriangleBox& box : boxes) {
+    low = low.cwiseMin(box.low);
+    high = high.cwiseMax(box.high);
+  }
+  double cell = std::max<double>(2.0 * extents[extents.size() * 9 / 10],
+                                 1e-6 * std::max(1e-30f, (high - low).maxCoeff()));
+  const auto cells_along = [&](int axis) {
+    return static_cast<int64_t>((high[axis] - low[axis]) / cell) + 1;
   };
-  if (check == nullptr) {
-    CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), test);
-  } else if (!checked.empty()) {
-    // Only the boxes near a checked one can meet it: those touching a cell of a coarse grid
-    // (kNearCells a side over the mesh's box) that a checked box touches. When few triangles are
-    // checked this leaves most of the mesh out of the search.
-    constexpr int kNearCells = 64;
-    CGAL::Bbox_3 whole;
-    for (const Box& box : boxes) whole += box.bbox();
-    const double low[3] = {whole.xmin(), whole.ymin(), whole.zmin()};
-    double cell[3];
-    for (int axis = 0; axis < 3; ++axis) {
-      cell[axis] = std::max((whole.max(axis) - whole.min(axis)) / kNearCells, 1e-30);
-    }
-    const auto cell_range = [&](const Box& box, int axis, int* from, int* to) {
-      *from = std::clamp(static_cast<int>((box.min_coord(axis) - low[axis]) / cell[axis]), 0, kNearCells - 1);
-      *to = std::clamp(static_cast<int>((box.max_coord(axis) - low[axis]) / cell[axis]), 0, kNearCells - 1);
-    };
-    std::vector<uint8_t> marked(kNearCells * kNearCells * kNearCells, 0);
-    int from[3], to[3];
-    for (const Box& box : checked) {
-      for (int axis = 0; axis < 3; ++axis) cell_range(box, axis, &from[axis], &to[axis]);
-      for (int z = from[2]; z <= to[2]; ++z) {
-        for (int y = from[1]; y <= to[1]; ++y) {
-          for (int x = from[0]; x <= to[0]; ++x) marked[(z * kNearCells + y) * kNearCells + x] = 1;
+  while (cells_along(0) * cells_along(1) * cells_along(2) > 4 * static_cast<int64_t>(boxes.size())) {
+    cell *= 1.5;
+  }
+  const int64_t nx = cells_along(0), ny = cells_along(1);
+  const auto cell_of = [&](float value, int axis) {
+    return static_cast<int64_t>((value - low[axis]) / cell);
+  };
+  // (cell, box) for every cell each box touches, grouped by cell.
+  std::vector<std::pair<int64_t, int>> entries;
+  entries.reserve(boxes.size() * 2);
+  for (int i = 0; i < static_cast<int>(boxes.size()); ++i) {
+    const TriangleBox& box = boxes[i];
+    for (int64_t z = cell_of(box.low.z(), 2); z <= cell_of(box.high.z(), 2); ++z) {
+      for (int64_t y = cell_of(box.low.y(), 1); y <= cell_of(box.high.y(), 1); ++y) {
+        for (int64_t x = cell_of(box.low.x(), 0); x <= cell_of(box.high.x(), 0); ++x) {
+          entries.emplace_back((z * ny + y) * nx + x, i);
         }
       }
     }
-    std::vector<Box> near;
-    for (const Box& box : boxes) {
-      for (int axis = 0; axis < 3; ++axis) cell_range(box, axis, &from[axis], &to[axis]);
-      bool touches = false;
-      for (int z = from[2]; z <= to[2] && !touches; ++z) {
-        for (int y = from[1]; y <= to[1] && !touches; ++y) {
-          for (int x = from[0]; x <= to[0] && !touches; ++x) {
-            touches = marked[(z * kNearCells + y) * kNearCells + x];
-          }
+  }
+  std::sort(entries.begin(), entries.end());
+  for (size_t begin = 0; begin < entries.size();) {
+    size_t end = begin;
+    while (end < entries.size() && entries[end].first == entries[begin].first) ++end;
+    const int64_t here = entries[begin].first;
+    for (size_t i = begin; i < end; ++i) {
+      const TriangleBox& a = boxes[entries[i].second];
+      for (size_t j = i + 1; j < end; ++j) {
+        const TriangleBox& b = boxes[entries[j].second];
+        if (check != nullptr && !(*check)[a.triangle] && !(*check)[b.triangle]) continue;
+        if (!Overlap(a, b)) continue;
+        // Tested once: in the first cell the two boxes share.
+        const Eigen::Vector3f shared = a.low.cwiseMax(b.low);
+        if ((cell_of(shared.z(), 2) * ny + cell_of(shared.y(), 1)) * nx + cell_of(shared.x(), 0) !=
+            here) {
+          continue;
+        }
+        if (Intersect(mesh, a.triangle, b.triangle)) {
+          pairs.emplace_back(std::min(a.triangle, b.triangle), std::max(a.triangle, b.triangle));
         }
       }
-      if (touches) near.push_back(box);
     }
-    CGAL::box_intersection_d(checked.begin(), checked.end(), near.begin(), near.end(), test);
+    begin = end;
   }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());

@@ -571,11 +571,26 @@ void WriteGlb(const TriangleMesh& mesh, const std::string& path) {
   const bool normals = mesh.normals.size() == mesh.vertices.size();
   const bool colours = !textured && mesh.colours.size() == mesh.vertices.size();
   tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "raycarve";
+  if (mesh.triangles.empty()) {
+    // glTF has no empty accessors: an empty carve gives a scene with nothing in it.
+    model.scenes.emplace_back();
+    model.defaultScene = 0;
+    const std::string temporary = TemporaryPathFor(path);
+    tinygltf::TinyGLTF writer;
+    errno = 0;
+    if (!writer.WriteGltfSceneToFile(&model, temporary, false, true, false, true)) {
+      ThrowWriteFailure(temporary, "the glTF mesh", errno);
+    }
+    RenameIntoPlace(temporary, path);
+    return;
+  }
   tinygltf::Buffer buffer;
   auto append = [&buffer](const void* data, size_t bytes) {
     const size_t offset = buffer.data.size();
     buffer.data.resize(offset + bytes);
-    std::memcpy(buffer.data.data() + offset, data, bytes);
+    if (bytes > 0) std::memcpy(buffer.data.data() + offset, data, bytes);
     while (buffer.data.size() % 4 != 0) buffer.data.push_back(0);
     return offset;
   };

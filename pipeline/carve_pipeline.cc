@@ -7,10 +7,12 @@
 #include <sstream>
 
 #include <glog/logging.h>
+#include <opencv2/imgproc.hpp>
 
 #include "calib/input_error.h"
 #include "calib/model_writer.h"
 #include "pipeline/carve_report.h"
+#include "export/preview.h"
 #include "pipeline/output_files.h"
 
 namespace raycarve {
@@ -213,8 +215,8 @@ void CarvePipeline::PlanOutputs() {
   // from sparse/: written there unless an input is or holds that folder, or it holds files that
   // no earlier carve wrote.
   for (const char* name : {"cloud.ply", "cloud.ply.vis", "mesh.ply", "mesh.glb", "mesh.obj",
-                           "mesh.mtl", "mesh_texture.png", "fused.ply", "fused.ply.vis", "sparse",
-                           "report.json", "convergence.csv"}) {
+                           "mesh.mtl", "mesh_texture.png", "preview.png", "fused.ply",
+                           "fused.ply.vis", "sparse", "report.json", "convergence.csv"}) {
     CheckNoLinkInside(run_.output_path, name);
   }
   const fs::path sparse_folder = fs::weakly_canonical(out / "sparse");
@@ -332,6 +334,12 @@ void CarvePipeline::SampleCloud() {
       // textured, OBJ with its material and atlas.
       exporter::WriteGlb(model_.mesh, (out / "mesh.glb").string());
       if (model_.mesh.textured()) exporter::WriteTexturedObj(model_.mesh, (out / "mesh.obj").string());
+      // Something to look at: the mesh from three of the photos' cameras, beside the photos.
+      cv::Mat preview = exporter::PreviewImage(model_.mesh, carved_);
+      if (!preview.empty()) {
+        cv::cvtColor(preview, preview, cv::COLOR_RGB2BGR);
+        WriteImageAtomically((out / "preview.png").string(), preview);
+      }
     };
     if (ResolveNumThreads(request_.options.num_threads) > 1) {
       mesh_written_ = std::async(std::launch::async, mesh_file);

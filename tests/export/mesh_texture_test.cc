@@ -12,6 +12,7 @@
 #include <tiny_gltf.h>
 
 #include "export/mesh_renderer.h"
+#include "export/preview.h"
 #include "tests/test_support.h"
 
 namespace raycarve {
@@ -170,6 +171,21 @@ TEST(WriteTexturedObj, TheFilesReadBack) {
       << error;
   EXPECT_TRUE(plain_model.meshes[0].primitives[0].attributes.count("COLOR_0"));
   EXPECT_TRUE(plain_model.images.empty());
+}
+
+TEST(PreviewImage, PhotoBesideTheMeshFromItsCamera) {
+  const std::vector<CalibratedView> views = {PatternView(), PatternView()};
+  TriangleMesh mesh = Rectangle(views[0]);
+  const cv::Mat preview = PreviewImage(mesh, views, 3, 1600);
+  // Two views: two rows (the first and the last), photo | render, full size.
+  ASSERT_EQ(preview.size(), cv::Size(160, 120));
+  EXPECT_EQ(cv::norm(preview(cv::Rect(0, 0, 80, 60)), views[0].image, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(preview(cv::Rect(80, 0, 80, 60)), RenderMesh(mesh, views[0]).image,
+                     cv::NORM_INF),
+            0.0);
+  // Narrower than two photos: each row scaled down to fit.
+  EXPECT_EQ(PreviewImage(mesh, views, 1, 80).size(), cv::Size(80, 30));
+  EXPECT_TRUE(PreviewImage(mesh, {}, 3, 1600).empty());
 }
 
 }  // namespace

@@ -89,10 +89,19 @@ TEST_F(CarveCommands, CarveWritesCloudMeshReportAndCurve) {
       << output;
   EXPECT_NE(output.find("carving a 40x"), std::string::npos) << output;
   EXPECT_NE(output.find("open with"), std::string::npos) << output;
-  for (const char* file : {"cloud.ply", "mesh.ply", "report.json", "convergence.csv"}) {
+  for (const char* file : {"cloud.ply", "mesh.ply", "mesh.glb", "mesh.obj", "mesh.mtl",
+                           "mesh_texture.png", "preview.png", "report.json", "convergence.csv"}) {
     EXPECT_TRUE(fs::is_regular_file(out + "/" + file)) << file;
   }
+  // The preview: three rows of photo | mesh, each pair at the undistorted photos' size (the
+  // project's 96x72, or as near as undistortion leaves it).
+  const cv::Mat preview = cv::imread(out + "/preview.png", cv::IMREAD_COLOR);
+  ASSERT_FALSE(preview.empty());
+  EXPECT_EQ(preview.rows % 3, 0);
+  EXPECT_NEAR(preview.cols / 2.0, 96.0, 8.0);
+  EXPECT_NEAR(preview.rows / 3.0, 72.0, 8.0);
   const std::string report = testing::ReadFileBytes(out + "/report.json");
+  EXPECT_GT(JsonNumber(report, "textured_triangles"), 0);
   const double carved = JsonNumber(report, "carved");
   EXPECT_GT(carved, 0);
   EXPECT_EQ(carved + JsonNumber(report, "final_solid"), JsonNumber(report, "num_voxels"));

@@ -129,6 +129,7 @@ void CarvePipeline::LoadViews() {
   run_.output_path = project_.output_path;
   run_.bounds = project_.bounds;
   run_.layout = project_.layout;
+  run_.plane = project_.plane;
   run_.num_views = static_cast<int>(carved_.size());
   run_.num_missing_images = static_cast<int>(project_.view_summary.missing.size());
   run_.masks_from_files = project_.view_summary.masks_from_files;

@@ -11,6 +11,7 @@
 
 #include "calib/atomic_file.h"
 #include "carve/carver.h"
+#include "export/supporting_plane.h"
 #include "carve/mask_agreement.h"
 #include "export/carve_export.h"
 #include "export/point_cloud_compare.h"
@@ -42,6 +43,7 @@ struct CarveRun {
   std::string output_path;
   Bounds bounds;
   CaptureLayout layout;
+  exporter::SupportingPlane plane;  // the plane the subject stands on (reported only)
   int num_views = 0;  // the views carved
   int num_missing_images = 0;
   int masks_from_files = 0;

@@ -154,6 +154,17 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
     json.Key("focus_box_min").Value(JsonArray(layout.focus_box.min()))
         .Key("focus_box_max").Value(JsonArray(layout.focus_box.max()));
   }
+  const exporter::SupportingPlane& plane = run.plane;
+  json.Key("supporting_plane").BeginObject()
+      .Key("found").Value(plane.found)
+      .Key("normal").Value(JsonArray(plane.normal))
+      .Key("offset").Value(plane.offset)
+      .Key("tolerance").Value(plane.tolerance)
+      .Key("points").Value(plane.points)
+      .Key("on_plane_share").Value(plane.on_plane_share)
+      .Key("below_share").Value(plane.below_share)
+      .Key("cameras_above_share").Value(plane.cameras_above_share)
+      .EndObject();
   json.EndObject();
   json.Key("statistics").BeginObject()
       .Key("visibility").Value(s.visibility)

@@ -225,6 +225,18 @@ LoadedProject LoadProject(const ProjectRequest& request) {
     }
   }
   ChooseCaptureBox(request.bounds, &project);
+  {
+    std::vector<Eigen::Vector3d> points, cameras;
+    for (const auto& [id, point] : project.reconstruction.points3D) {
+      if (point.track.size() >= 2 && project.bounds.box.contains(point.xyz)) points.push_back(point.xyz);
+    }
+    for (const auto& [id, image] : project.reconstruction.images) {
+      cameras.push_back(image.ProjectionCenter());
+    }
+    project.plane = exporter::FitSupportingPlane(
+        points, cameras, kPlaneTolerance * project.bounds.box.sizes().maxCoeff());
+    LOG(INFO) << "support: " << project.plane.Summary();
+  }
   project.surface_points =
       SurfacePointsOf(project.reconstruction, project.views, project.bounds.box);
   return project;

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "calib/bounds.h"
+#include "export/supporting_plane.h"
 #include "calib/calibrated_view.h"
 #include "calib/colour_calibration.h"
 #include "calib/reconstruction.h"
@@ -19,6 +20,8 @@
 namespace raycarve {
 
 // The pipeline's first stage: a COLMAP project's paths, model, bounds and calibrated views.
+constexpr double kPlaneTolerance = 0.01;
+
 struct LoadedProject {
   std::string model_path;
   std::string image_path;
@@ -26,6 +29,9 @@ struct LoadedProject {
   Reconstruction reconstruction;
   Bounds bounds;
   CaptureLayout layout;  // how the cameras stand (DescribeCapture), after any hold-out
+  // The plane the subject stands on, from the sparse points in the volume (FitSupportingPlane,
+  // tolerance kPlaneTolerance of the volume's largest extent): reported, not used to carve.
+  exporter::SupportingPlane plane;
   std::vector<CalibratedView> views;
   ViewReaderSummary view_summary;
   ColourCalibration colour;  // estimated unless off (points_used 0 otherwise); see its `applied`

@@ -152,7 +152,8 @@ void PrintSummary(const CarveRequest& request, const CarveRun& run) {
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,
       sparse_line.c_str(),
       (run.layout.Summary() +
-       (run.bounds.around_focus ? "\n                  the volume: the box around their focus" : ""))
+       (run.bounds.around_focus ? "\n                  the volume: the box around their focus" : "") +
+       "\n                  " + run.plane.Summary())
           .c_str(),
       mask_line.c_str(),
       silhouette_line.c_str(), run.output_path.c_str(),

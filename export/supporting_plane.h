@@ -1,0 +1,41 @@
+#pragma once
+// The plane an object stands on (a table, the ground), from the sparse points. PCL stays inside
+// the .cc file.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace raycarve {
+namespace exporter {
+
+struct SupportingPlane {
+  bool found = false;
+  // The plane n . x + offset = 0, n a unit vector pointing to the side most cameras are on.
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  double offset = 0.0;
+  double tolerance = 0.0;      // world units: a point within it is on the plane
+  int points = 0;              // points tried
+  double on_plane_share = 0.0;  // of them, within `tolerance` of the plane
+  double below_share = 0.0;     // beyond `tolerance` on the side away from the cameras
+  double cameras_above_share = 0.0;
+  std::string Summary() const;
+};
+
+// A support needs at least this share of the points on it, at most this share below it, and
+// this share of the cameras above it.
+constexpr double kMinSupportShare = 0.2;
+constexpr double kMaxBelowShare = 0.1;
+constexpr double kMinCamerasAbove = 0.8;
+
+// The plane holding the most of `points` within `tolerance` (RANSAC with PCL's plane model, a
+// fixed seed, refined by least squares on its inliers), oriented towards the majority of
+// `cameras` (their centres), and whether it is a support: kMinSupportShare of the points on it,
+// at most kMaxBelowShare of them below it, and kMinCamerasAbove of the cameras above. Fewer than
+// 20 points: not found.
+SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
+                                   const std::vector<Eigen::Vector3d>& cameras, double tolerance);
+
+}  // namespace exporter
+}  // namespace raycarve

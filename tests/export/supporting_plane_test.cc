@@ -1,0 +1,72 @@
+// The supporting plane against scenes whose answer is known: an object on a tilted table seen
+// from above, a ball with no table, and a table seen from below.
+#include "export/supporting_plane.h"
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+namespace raycarve {
+namespace exporter {
+namespace {
+
+// 500 points on the plane through `origin` with unit normal `n` (a disc of radius 2), 300 on a
+// ball of radius 0.5 resting on it; cameras on a ring 3 above it.
+struct Scene {
+  std::vector<Eigen::Vector3d> points, cameras;
+};
+Scene TableScene(const Eigen::Vector3d& origin, const Eigen::Vector3d& n, bool with_table) {
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  Scene scene;
+  for (int i = 0; with_table && i < 500; ++i) {
+    const double r = 2.0 * std::sqrt(unit(random)), a = 2.0 * M_PI * unit(random);
+    scene.points.push_back(origin + r * std::cos(a) * u + r * std::sin(a) * v);
+  }
+  for (int i = 0; i < 300; ++i) {
+    const double z = 2.0 * unit(random) - 1.0, a = 2.0 * M_PI * unit(random);
+    const double s = std::sqrt(1.0 - z * z);
+    scene.points.push_back(origin + 0.5 * n + 0.5 * (s * std::cos(a) * u + s * std::sin(a) * v + z * n));
+  }
+  for (int i = 0; i < 12; ++i) {
+    const double a = 2.0 * M_PI * i / 12.0;
+    scene.cameras.push_back(origin + 3.0 * n + 4.0 * (std::cos(a) * u + std::sin(a) * v));
+  }
+  return scene;
+}
+
+TEST(FitSupportingPlane, FindsTheTableUnderAnObjectOrientedTowardsTheCameras) {
+  const Eigen::Vector3d n = Eigen::Vector3d(0.2, -0.1, 1.0).normalized();
+  const Eigen::Vector3d origin(1.0, 2.0, -0.5);
+  const Scene scene = TableScene(origin, n, true);
+  const SupportingPlane plane = FitSupportingPlane(scene.points, scene.cameras, 0.01);
+  ASSERT_TRUE(plane.found) << plane.Summary();
+  EXPECT_GT(plane.normal.dot(n), 0.9999);
+  EXPECT_NEAR(plane.normal.dot(origin) + plane.offset, 0.0, 1e-3);
+  // The table's 500 of 800 points, and a few of the ball's where it rests on the table.
+  EXPECT_NEAR(plane.on_plane_share, 500.0 / 800.0, 0.02);
+  EXPECT_EQ(plane.below_share, 0.0);
+  EXPECT_EQ(plane.cameras_above_share, 1.0);
+  EXPECT_NE(plane.Summary().find("a supporting plane"), std::string::npos);
+}
+
+TEST(FitSupportingPlane, ABallAloneOrATableSeenFromBelowIsNoSupport) {
+  const Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
+  const Scene ball = TableScene(Eigen::Vector3d::Zero(), n, false);
+  EXPECT_FALSE(FitSupportingPlane(ball.points, ball.cameras, 0.01).found);
+  // Cameras under the table: the plane's normal turns to them, and the ball lies below it.
+  Scene under = TableScene(Eigen::Vector3d::Zero(), n, true);
+  for (Eigen::Vector3d& camera : under.cameras) camera.z() = -camera.z();
+  const SupportingPlane plane = FitSupportingPlane(under.points, under.cameras, 0.01);
+  EXPECT_LT(plane.normal.z(), -0.999);
+  EXPECT_GT(plane.below_share, 0.3);
+  EXPECT_FALSE(plane.found);
+  EXPECT_FALSE(FitSupportingPlane({}, under.cameras, 0.01).found);
+}
+
+}  // namespace
+}  // namespace exporter
+}  // namespace raycarve

@@ -199,14 +199,9 @@ Quality MeasureQuality(const raycarve::CarveResult& result,
   return quality;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  raycarve::SyntheticSceneOptions scene_options;
-  scene_options.num_views = 14;
-  scene_options.width = 800;
-  scene_options.height = 600;
-  scene_options.num_surface_samples = 0;
+// What the benchmark runs: the scene, and every combination of the lists.
+struct BenchmarkPlan {
+  raycarve::SyntheticSceneOptions scene;
   std::vector<int> resolutions = {128, 256};
   std::vector<raycarve::VisLookup> lookups = {raycarve::VisLookup::kFootprint,
                                               raycarve::VisLookup::kRayLists};
@@ -220,181 +215,253 @@ int main(int argc, char** argv) {
   std::vector<int> batch_sizes = {raycarve::CarveOptions().batch_voxels};
   int repeats = 1;
   bool core_check = true;
-  if (raycarve::ResolveNumThreads(-1) > 1) thread_counts.push_back(raycarve::ResolveNumThreads(-1));
+
+  BenchmarkPlan() {
+    scene.num_views = 14;
+    scene.width = 800;
+    scene.height = 600;
+    scene.num_surface_samples = 0;
+    if (raycarve::ResolveNumThreads(-1) > 1) thread_counts.push_back(raycarve::ResolveNumThreads(-1));
+  }
+};
+
+// Reads the flags into *plan; false, with a line on stderr, for a flag it does not know or a
+// value it cannot take.
+bool ParsePlan(int argc, char** argv, BenchmarkPlan* plan) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
-    if (flag == "--views") scene_options.num_views = std::stoi(value);
-    else if (flag == "--width") scene_options.width = std::stoi(value);
-    else if (flag == "--height") scene_options.height = std::stoi(value);
-    else if (flag == "--threshold") threshold = std::stod(value);
-    else if (flag == "--repeats") repeats = std::max(1, std::stoi(value));
-    else if (flag == "--incremental_statistics") incremental_statistics = std::stoi(value) != 0;
-    else if (flag == "--core_check") core_check = std::stoi(value) != 0;
+    if (flag == "--views") plan->scene.num_views = std::stoi(value);
+    else if (flag == "--width") plan->scene.width = std::stoi(value);
+    else if (flag == "--height") plan->scene.height = std::stoi(value);
+    else if (flag == "--threshold") plan->threshold = std::stod(value);
+    else if (flag == "--repeats") plan->repeats = std::max(1, std::stoi(value));
+    else if (flag == "--incremental_statistics") plan->incremental_statistics = std::stoi(value) != 0;
+    else if (flag == "--core_check") plan->core_check = std::stoi(value) != 0;
     else if (flag == "--vis_lookup") {
       raycarve::VisLookup lookup;
       if (value != "both" && !raycarve::VisLookupFromString(value, &lookup)) {
         std::fprintf(stderr, "--vis_lookup: footprint, ray_lists or both\n");
-        return 1;
+        return false;
       }
-      if (value != "both") lookups = {lookup};
-    }
-    else if (flag == "--resolutions" || flag == "--threads" || flag == "--lod_levels" ||
-             flag == "--batch_voxels") {
-      std::vector<int>& numbers =
-          flag == "--threads" ? thread_counts
-                              : (flag == "--lod_levels" ? level_counts
-                                                        : (flag == "--batch_voxels" ? batch_sizes
-                                                                                    : resolutions));
+      if (value != "both") plan->lookups = {lookup};
+    } else if (flag == "--resolutions" || flag == "--threads" || flag == "--lod_levels" ||
+               flag == "--batch_voxels") {
+      std::vector<int>& numbers = flag == "--threads"        ? plan->thread_counts
+                                  : flag == "--lod_levels"   ? plan->level_counts
+                                  : flag == "--batch_voxels" ? plan->batch_sizes
+                                                             : plan->resolutions;
       numbers.clear();
       std::stringstream list(value);
       std::string item;
       while (std::getline(list, item, ',')) numbers.push_back(std::stoi(item));
     } else {
       std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
-      return 1;
+      return false;
     }
   }
   std::string reason;
-  if (!scene_options.IsValid(&reason)) {
+  if (!plan->scene.IsValid(&reason)) {
     std::fprintf(stderr, "%s\n", reason.c_str());
-    return 1;
+    return false;
   }
-  std::fprintf(stderr, "rendering %d views of %dx%d...\n", scene_options.num_views,
-               scene_options.width, scene_options.height);
-  const raycarve::SyntheticScene scene = raycarve::GenerateSyntheticScene(scene_options);
-  std::vector<raycarve::CalibratedView> views;
-  for (const auto& [image_id, image] : scene.reconstruction.images) {
-    views.push_back(raycarve::MakeCalibratedView(
-        scene.reconstruction.cameras.at(image.camera_id), image, scene.photos.at(image_id), image.name));
-  }
+  return true;
+}
 
-  const std::vector<Eigen::Vector3d> truth = raycarve::SampleTrueSurface(scene, 20000, 5, 2);
+// One combination of the plan's lists.
+struct Configuration {
+  int resolution = 0;
+  int levels = 1;
+  raycarve::VisLookup lookup = raycarve::VisLookup::kFootprint;
+  int batch = 0;
+  int repeat = 0;
+  int threads = 1;
+};
+
+// What the runs share: the photos as views, the scene's box, the truth, the pointer chase.
+struct Inputs {
+  std::vector<raycarve::CalibratedView> views;
+  Eigen::AlignedBox3d box;
+  std::vector<Eigen::Vector3d> truth;
+  std::vector<uint64_t> chase;
+};
+
+// The rows' JSON and the convergence seconds per (resolution, levels, lookup, batch, threads)
+// over the repeats, in the order first run.
+using Key = std::tuple<int, int, std::string, int, int>;
+struct Results {
+  std::ostringstream json;
+  bool first = true;
+  std::map<Key, std::vector<double>> convergence;
+  std::vector<Key> key_order;
+};
+
+void PrintHeader() {
   std::printf("%-10s %-10s %-5s %-7s %-6s %-14s %8s %10s %8s %10s %10s %10s %12s %12s %9s %12s   %s   %s\n",
               "resolution", "vis", "batch", "threads", "levels", "grid", "set-up s", "converge s",
               "colour s", "parallel s", "memory MiB", "peak RSS", "carved", "evaluated",
               "precision", "completeness", "work s / wait s per thread",
               "ns per load per core, round trip");
-  const std::vector<uint64_t> chase =
-      core_check ? MakeChase(size_t{8} << 20) : std::vector<uint64_t>();
-  std::ostringstream json;
-  json << "[";
-  bool first = true;
-  // Convergence seconds per (resolution, levels, lookup, batch, threads), over the repeats.
-  using Key = std::tuple<int, int, std::string, int, int>;
-  std::map<Key, std::vector<double>> convergence;
-  std::vector<Key> key_order;
-  for (size_t k = 0; k < resolutions.size(); ++k) {
-   for (const int levels : level_counts) {
-   for (const raycarve::VisLookup lookup : lookups) {
-   for (const int batch : batch_sizes) {
-   for (int repeat = 0; repeat < repeats; ++repeat) {
-   for (const int threads : thread_counts) {
-    if (lookup == raycarve::VisLookup::kRayLists && threads != thread_counts.front()) continue;
-    raycarve::CarveOptions options;
-    options.resolution = resolutions[k];
-    options.threshold = threshold;
-    options.vis_lookup = lookup;
-    options.incremental_statistics = incremental_statistics;
-    options.num_threads = lookup == raycarve::VisLookup::kRayLists ? 1 : threads;
-    options.lod_levels = levels;
-    options.batch_voxels = batch;
-    const std::string vis = raycarve::VisLookupToString(lookup);
-    if (!raycarve::CheckCarveFits(views, scene.object_box, options, &reason)) {
-      std::fprintf(stderr, "resolution %d: %s\n", resolutions[k], reason.c_str());
-      return 1;
-    }
-    const std::vector<double> latencies =
-        core_check ? CoreLatencies(chase, 1 << 20) : std::vector<double>();
-    const double round_trip = core_check ? CoreRoundTrip() : -1.0;
-    const raycarve::CarveResult result = raycarve::CarveVolume(views, scene.object_box, options);
-    const raycarve::CarveStatistics& s = result.statistics;
-    char grid[32];
-    std::snprintf(grid, sizeof(grid), "%dx%dx%d", s.dimensions.x(), s.dimensions.y(), s.dimensions.z());
-    const double memory = s.peak_memory_bytes / (1024.0 * 1024.0);
-    const Quality quality = MeasureQuality(result, truth);
-    std::string threads_text, threads_json;
-    for (size_t t = 0; t < s.thread_work_seconds.size(); ++t) {
-      const double work = s.thread_work_seconds[t], wait = s.parallel_seconds - work;
-      char entry[64];
-      std::snprintf(entry, sizeof(entry), "%s%.2f/%.2f", t == 0 ? "" : " ", work, wait);
-      threads_text += entry;
-      std::snprintf(entry, sizeof(entry), "%s{\"work_seconds\": %.4f, \"wait_seconds\": %.4f}",
-                    t == 0 ? "" : ", ", work, wait);
-      threads_json += entry;
-    }
-    std::string latency_text, latency_json;
-    for (size_t c = 0; c < latencies.size(); ++c) {
-      char entry[32];
-      std::snprintf(entry, sizeof(entry), "%s%.0f", c == 0 ? "" : "/", latencies[c]);
-      latency_text += entry;
-      std::snprintf(entry, sizeof(entry), "%s%.1f", c == 0 ? "" : ", ", latencies[c]);
-      latency_json += entry;
-    }
-    if (round_trip > 0.0) {
-      char entry[32];
-      std::snprintf(entry, sizeof(entry), ", trip %.0f", round_trip);
-      latency_text += entry;
-    }
-    std::printf("%-10d %-10s %-5d %-7d %-6d %-14s %8.2f %10.2f %8.2f %10.2f %10.1f %10.1f %12lld %12lld %8.1f%% %11.1f%%   %s   %s\n",
-                resolutions[k], vis.c_str(), batch, s.threads, static_cast<int>(s.levels.size()),
-                grid, s.setup_seconds, s.carve_seconds, s.colour_seconds, s.parallel_seconds,
-                memory, PeakResidentMiB(), static_cast<long long>(s.carved),
-                static_cast<long long>(s.evaluated), 100.0 * quality.precision,
-                100.0 * quality.completeness, threads_text.c_str(), latency_text.c_str());
-    std::fflush(stdout);
-    const Key key{resolutions[k], static_cast<int>(s.levels.size()), vis, batch, s.threads};
-    if (convergence.count(key) == 0) key_order.push_back(key);
-    convergence[key].push_back(s.carve_seconds);
-    json << (first ? "" : ",") << "\n  {\"resolution\": " << resolutions[k]
-         << ", \"repeat\": " << repeat
-         << ", \"vis_lookup\": \"" << vis << "\", \"batch_voxels\": " << batch
-         << ", \"threads_asked\": " << options.num_threads << ", \"threads\": " << s.threads
-         << ", \"lod_levels\": " << s.levels.size()
-         << ", \"lod_automatic\": " << (levels == raycarve::kAutomaticLevels ? "true" : "false")
-         << ", \"grid\": \"" << grid
-         << "\", \"views\": " << views.size() << ", \"width\": " << scene_options.width
-         << ", \"height\": " << scene_options.height << ", \"setup_seconds\": " << s.setup_seconds
-         << ", \"convergence_seconds\": " << s.carve_seconds
-         << ", \"colour_seconds\": " << s.colour_seconds
-         << ", \"parallel_seconds\": " << s.parallel_seconds
-         << ", \"parallel_runs\": " << s.parallel_runs << ", \"inline_runs\": " << s.inline_runs
-         << ", \"per_thread\": [" << threads_json << "]"
-         << ", \"core_latency_ns\": [" << latency_json << "]"
-         << ", \"core_round_trip_ns\": " << round_trip
-         << ", \"memory_mib\": " << memory
-         << ", \"peak_rss_mib\": " << PeakResidentMiB() << ", \"carved\": " << s.carved
-         << ", \"evaluated\": " << s.evaluated << ", \"precision\": " << quality.precision
-         << ", \"completeness\": " << quality.completeness << "}";
-    first = false;
-   }
-   }
-   }
-   }
-   }
+}
+
+// Each thread's work and wait seconds, for the table and for JSON.
+void FormatThreads(const raycarve::CarveStatistics& s, std::string* text, std::string* json) {
+  for (size_t t = 0; t < s.thread_work_seconds.size(); ++t) {
+    const double work = s.thread_work_seconds[t], wait = s.parallel_seconds - work;
+    char entry[64];
+    std::snprintf(entry, sizeof(entry), "%s%.2f/%.2f", t == 0 ? "" : " ", work, wait);
+    *text += entry;
+    std::snprintf(entry, sizeof(entry), "%s{\"work_seconds\": %.4f, \"wait_seconds\": %.4f}",
+                  t == 0 ? "" : ", ", work, wait);
+    *json += entry;
   }
-  if (repeats > 1) {
-    auto median = [](std::vector<double> values) {
-      std::sort(values.begin(), values.end());
-      const size_t n = values.size();
-      return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// The cores' load latencies and round trip, for the table and for JSON.
+void FormatLatencies(const std::vector<double>& latencies, double round_trip, std::string* text,
+                     std::string* json) {
+  for (size_t c = 0; c < latencies.size(); ++c) {
+    char entry[32];
+    std::snprintf(entry, sizeof(entry), "%s%.0f", c == 0 ? "" : "/", latencies[c]);
+    *text += entry;
+    std::snprintf(entry, sizeof(entry), "%s%.1f", c == 0 ? "" : ", ", latencies[c]);
+    *json += entry;
+  }
+  if (round_trip > 0.0) {
+    char entry[32];
+    std::snprintf(entry, sizeof(entry), ", trip %.0f", round_trip);
+    *text += entry;
+  }
+}
+
+// Carves one configuration, prints its row and adds it to *results; false (with a line on
+// stderr) when the carve would not fit in memory.
+bool RunConfiguration(const BenchmarkPlan& plan, const Inputs& inputs, const Configuration& c,
+                      Results* results) {
+  raycarve::CarveOptions options;
+  options.resolution = c.resolution;
+  options.threshold = plan.threshold;
+  options.vis_lookup = c.lookup;
+  options.incremental_statistics = plan.incremental_statistics;
+  options.num_threads = c.lookup == raycarve::VisLookup::kRayLists ? 1 : c.threads;
+  options.lod_levels = c.levels;
+  options.batch_voxels = c.batch;
+  const std::string vis = raycarve::VisLookupToString(c.lookup);
+  std::string reason;
+  if (!raycarve::CheckCarveFits(inputs.views, inputs.box, options, &reason)) {
+    std::fprintf(stderr, "resolution %d: %s\n", c.resolution, reason.c_str());
+    return false;
+  }
+  const std::vector<double> latencies =
+      plan.core_check ? CoreLatencies(inputs.chase, 1 << 20) : std::vector<double>();
+  const double round_trip = plan.core_check ? CoreRoundTrip() : -1.0;
+  const raycarve::CarveResult result = raycarve::CarveVolume(inputs.views, inputs.box, options);
+  const raycarve::CarveStatistics& s = result.statistics;
+  char grid[32];
+  std::snprintf(grid, sizeof(grid), "%dx%dx%d", s.dimensions.x(), s.dimensions.y(), s.dimensions.z());
+  const double memory = s.peak_memory_bytes / (1024.0 * 1024.0);
+  const Quality quality = MeasureQuality(result, inputs.truth);
+  std::string threads_text, threads_json, latency_text, latency_json;
+  FormatThreads(s, &threads_text, &threads_json);
+  FormatLatencies(latencies, round_trip, &latency_text, &latency_json);
+  std::printf("%-10d %-10s %-5d %-7d %-6d %-14s %8.2f %10.2f %8.2f %10.2f %10.1f %10.1f %12lld %12lld %8.1f%% %11.1f%%   %s   %s\n",
+              c.resolution, vis.c_str(), c.batch, s.threads, static_cast<int>(s.levels.size()),
+              grid, s.setup_seconds, s.carve_seconds, s.colour_seconds, s.parallel_seconds,
+              memory, PeakResidentMiB(), static_cast<long long>(s.carved),
+              static_cast<long long>(s.evaluated), 100.0 * quality.precision,
+              100.0 * quality.completeness, threads_text.c_str(), latency_text.c_str());
+  std::fflush(stdout);
+  const Key key{c.resolution, static_cast<int>(s.levels.size()), vis, c.batch, s.threads};
+  if (results->convergence.count(key) == 0) results->key_order.push_back(key);
+  results->convergence[key].push_back(s.carve_seconds);
+  results->json << (results->first ? "" : ",") << "\n  {\"resolution\": " << c.resolution
+       << ", \"repeat\": " << c.repeat
+       << ", \"vis_lookup\": \"" << vis << "\", \"batch_voxels\": " << c.batch
+       << ", \"threads_asked\": " << options.num_threads << ", \"threads\": " << s.threads
+       << ", \"lod_levels\": " << s.levels.size()
+       << ", \"lod_automatic\": " << (c.levels == raycarve::kAutomaticLevels ? "true" : "false")
+       << ", \"grid\": \"" << grid
+       << "\", \"views\": " << inputs.views.size() << ", \"width\": " << plan.scene.width
+       << ", \"height\": " << plan.scene.height << ", \"setup_seconds\": " << s.setup_seconds
+       << ", \"convergence_seconds\": " << s.carve_seconds
+       << ", \"colour_seconds\": " << s.colour_seconds
+       << ", \"parallel_seconds\": " << s.parallel_seconds
+       << ", \"parallel_runs\": " << s.parallel_runs << ", \"inline_runs\": " << s.inline_runs
+       << ", \"per_thread\": [" << threads_json << "]"
+       << ", \"core_latency_ns\": [" << latency_json << "]"
+       << ", \"core_round_trip_ns\": " << round_trip
+       << ", \"memory_mib\": " << memory
+       << ", \"peak_rss_mib\": " << PeakResidentMiB() << ", \"carved\": " << s.carved
+       << ", \"evaluated\": " << s.evaluated << ", \"precision\": " << quality.precision
+       << ", \"completeness\": " << quality.completeness << "}";
+  results->first = false;
+  return true;
+}
+
+// With repeats: the median convergence per configuration and its speed-up over the first thread
+// count run for it.
+void PrintMedians(int repeats, const Results& results) {
+  auto median = [](std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    const size_t n = values.size();
+    return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+  };
+  std::printf("\nmedian of %d runs\n%-10s %-6s %-10s %-5s %-7s %10s %9s\n", repeats, "resolution",
+              "levels", "vis", "batch", "threads", "converge s", "speed-up");
+  for (const Key& key : results.key_order) {
+    // The first thread count run for this configuration (key itself, if no other).
+    const auto same_configuration = [&key](const Key& other) {
+      return std::get<0>(other) == std::get<0>(key) && std::get<1>(other) == std::get<1>(key) &&
+             std::get<2>(other) == std::get<2>(key) && std::get<3>(other) == std::get<3>(key);
     };
-    std::printf("\nmedian of %d runs\n%-10s %-6s %-10s %-5s %-7s %10s %9s\n", repeats, "resolution",
-                "levels", "vis", "batch", "threads", "converge s", "speed-up");
-    for (const Key& key : key_order) {
-      // The first thread count run for this configuration (key itself, if no other).
-      const auto same_configuration = [&key](const Key& other) {
-        return std::get<0>(other) == std::get<0>(key) && std::get<1>(other) == std::get<1>(key) &&
-               std::get<2>(other) == std::get<2>(key) && std::get<3>(other) == std::get<3>(key);
-      };
-      const Key& first_threads =
-          *std::find_if(key_order.begin(), key_order.end(), same_configuration);
-      const double seconds = median(convergence[key]);
-      std::printf("%-10d %-6d %-10s %-5d %-7d %10.2f %8.2fx\n", std::get<0>(key), std::get<1>(key),
-                  std::get<2>(key).c_str(), std::get<3>(key), std::get<4>(key), seconds,
-                  median(convergence[first_threads]) / seconds);
+    const Key& first_threads =
+        *std::find_if(results.key_order.begin(), results.key_order.end(), same_configuration);
+    const double seconds = median(results.convergence.at(key));
+    std::printf("%-10d %-6d %-10s %-5d %-7d %10.2f %8.2fx\n", std::get<0>(key), std::get<1>(key),
+                std::get<2>(key).c_str(), std::get<3>(key), std::get<4>(key), seconds,
+                median(results.convergence.at(first_threads)) / seconds);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  BenchmarkPlan plan;
+  if (!ParsePlan(argc, argv, &plan)) return 1;
+  std::fprintf(stderr, "rendering %d views of %dx%d...\n", plan.scene.num_views, plan.scene.width,
+               plan.scene.height);
+  const raycarve::SyntheticScene scene = raycarve::GenerateSyntheticScene(plan.scene);
+  Inputs inputs;
+  for (const auto& [image_id, image] : scene.reconstruction.images) {
+    inputs.views.push_back(raycarve::MakeCalibratedView(
+        scene.reconstruction.cameras.at(image.camera_id), image, scene.photos.at(image_id), image.name));
+  }
+  inputs.box = scene.object_box;
+  inputs.truth = raycarve::SampleTrueSurface(scene, 20000, 5, 2);
+  PrintHeader();
+  if (plan.core_check) inputs.chase = MakeChase(size_t{8} << 20);
+  Results results;
+  results.json << "[";
+  Configuration c;
+  for (const int resolution : plan.resolutions) {
+    for (const int levels : plan.level_counts) {
+      for (const raycarve::VisLookup lookup : plan.lookups) {
+        for (const int batch : plan.batch_sizes) {
+          for (int repeat = 0; repeat < plan.repeats; ++repeat) {
+            for (const int threads : plan.thread_counts) {
+              // Ray lists run on one thread: once per repeat.
+              if (lookup == raycarve::VisLookup::kRayLists && threads != plan.thread_counts.front()) {
+                continue;
+              }
+              c = Configuration{resolution, levels, lookup, batch, repeat, threads};
+              if (!RunConfiguration(plan, inputs, c, &results)) return 1;
+            }
+          }
+        }
+      }
     }
   }
-  json << "\n]\n";
-  std::printf("\n%s", json.str().c_str());
+  if (plan.repeats > 1) PrintMedians(plan.repeats, results);
+  results.json << "\n]\n";
+  std::printf("\n%s", results.json.str().c_str());
   return 0;
 }

@@ -373,6 +373,18 @@ void WriteRunIdentity(JsonWriter& json) {
       .Key("commit").Value(BuildCommit())
       .Key("command_line").Value(RunCommandLine())
       .Key("start_time").Value(RunStartTime());
+  // The units of the figures that follow, by the kind of field (docs/report.md).
+  json.Key("units").BeginObject()
+      .Key("lengths").Value("the model's world units (COLMAP's frame)")
+      .Key("fields_named_voxels").Value("voxels of the finest grid")
+      .Key("fields_named_px").Value("photo pixels after --max_image_size")
+      .Key("angles").Value("degrees")
+      .Key("times").Value("seconds (wall)")
+      .Key("memory").Value("bytes, or MiB where the field says mib")
+      .Key("colours_and_thresholds").Value("RGB 0-255")
+      .Key("shares").Value("fractions 0-1")
+      .Key("psnr").Value("dB over 8-bit RGB")
+      .EndObject();
 }
 
 double ProcessPeakMiB() {

@@ -102,6 +102,8 @@ TEST_F(CarveCommands, CarveWritesCloudMeshReportAndCurve) {
   EXPECT_NEAR(preview.rows / 3.0, 72.0, 8.0);
   const std::string report = testing::ReadFileBytes(out + "/report.json");
   EXPECT_GT(JsonNumber(report, "textured_triangles"), 0);
+  EXPECT_NE(report.find("\"lengths\": \"the model's world units (COLMAP's frame)\""),
+            std::string::npos);
   const double carved = JsonNumber(report, "carved");
   EXPECT_GT(carved, 0);
   EXPECT_EQ(carved + JsonNumber(report, "final_solid"), JsonNumber(report, "num_voxels"));

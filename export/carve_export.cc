@@ -329,8 +329,9 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   model.colouring = ColourMeshFromPhotos(views, colouring, &model.mesh, &model.seen_by);
   tell(model.colouring.Summary());
   if (options.texture && !model.mesh.empty()) {
-    model.texture =
-        TextureMeshFromPhotos(views, model.seen_by, options.texture_options, &model.mesh);
+    MeshTextureOptions texture = options.texture_options;
+    texture.num_threads = options.num_threads;
+    model.texture = TextureMeshFromPhotos(views, model.seen_by, texture, &model.mesh);
     tell(model.texture.Summary());
   }
   return model;

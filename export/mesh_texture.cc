@@ -21,6 +21,8 @@
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "export/mesh_colouring.h"
+#include "export/parallel_ranges.h"
+#include "carve/view_workers.h"
 
 namespace raycarve {
 namespace exporter {
@@ -320,8 +322,9 @@ MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& view
   }
 
   // Each chart's piece of its photo, levelled to the vertices' colours.
+  // Charts are independent (each triangle in one): any thread count gives the same atlas.
   std::vector<std::array<Eigen::Vector2d, 3>> corner_pixels(num_triangles);
-  for (Chart& chart : charts) {
+  const auto make_patch = [&](Chart& chart) {
     const CalibratedView& view = views[chart.view];
     Eigen::Vector2d low(1e300, 1e300), high(-1e300, -1e300);
     Eigen::Vector3d vertex_sum = Eigen::Vector3d::Zero(), photo_sum = Eigen::Vector3d::Zero();
@@ -355,7 +358,11 @@ MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& view
       cv::multiply(levelled, gain, levelled);
       levelled.convertTo(chart.patch, CV_8UC3);  // saturating
     }
-  }
+  };
+  ParallelRanges(charts.size(), ResolveNumThreads(options.num_threads), 16,
+                 [&](size_t begin, size_t end) {
+                   for (size_t i = begin; i < end; ++i) make_patch(charts[i]);
+                 });
   // The cells of the triangles no photo sees whole, in a square block.
   const int flat_count = static_cast<int>(flat.triangles.size());
   const int flat_side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(flat_count))));

@@ -32,6 +32,8 @@ struct MeshTextureOptions {
   // photos' view-dependent light and the geometry's error average out as in the vertex colours,
   // at the photos' resolution. Levelling is then not needed.
   bool blend_views = true;
+  // Threads making the charts' pieces (< 1: one per core); the atlas does not depend on it.
+  int num_threads = 1;
   bool IsValid(std::string* reason) const;
 };
 

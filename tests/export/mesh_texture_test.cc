@@ -99,6 +99,30 @@ TEST(TextureMeshFromPhotos, TheTexturedMeshDrawsThePhotoBack) {
   EXPECT_EQ(RenderMesh(plain, views[0]).image.at<cv::Vec3b>(30, 40), cv::Vec3b(128, 128, 128));
 }
 
+TEST(TextureMeshFromPhotos, TheAtlasIsTheSameOnAnyNumberOfThreads) {
+  // Two photos, each seeing one half of the rectangle: several charts.
+  std::vector<CalibratedView> views = {PatternView(), PatternView()};
+  cv::flip(views[1].image, views[1].image, 1);
+  TriangleMesh mesh = Rectangle(views[0]);
+  std::vector<std::vector<uint32_t>> seen_by(mesh.vertices.size());
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const int column = static_cast<int>(v % 7);
+    if (column <= 3) seen_by[v].push_back(0);
+    if (column >= 3) seen_by[v].push_back(1);
+  }
+  TriangleMesh one = mesh, two = mesh;
+  MeshTextureOptions options;
+  options.num_threads = 1;
+  const MeshTextureSummary first = TextureMeshFromPhotos(views, seen_by, options, &one);
+  options.num_threads = 2;
+  TextureMeshFromPhotos(views, seen_by, options, &two);
+  EXPECT_GE(first.charts, 2);
+  EXPECT_EQ(first.textured, 48);
+  ASSERT_EQ(one.texture.size(), two.texture.size());
+  EXPECT_EQ(cv::norm(one.texture, two.texture, cv::NORM_INF), 0.0);
+  EXPECT_EQ(one.corner_uvs, two.corner_uvs);
+}
+
 TEST(TextureMeshFromPhotos, ATriangleNoPhotoSeesWholeKeepsItsVertexColours) {
   const std::vector<CalibratedView> views = {PatternView()};
   TriangleMesh mesh = Rectangle(views[0]);

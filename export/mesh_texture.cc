@@ -2,24 +2,15 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <map>
 #include <numeric>
 #include <sstream>
-#include <unordered_map>
 
 #include <glog/logging.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <tiny_gltf.h>
 
-#include "calib/atomic_file.h"
-#include "calib/input_error.h"
 #include "export/mesh_colouring.h"
 #include "export/parallel_ranges.h"
 #include "carve/view_workers.h"
@@ -324,6 +315,8 @@ MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& view
   // Each chart's piece of its photo, levelled to the vertices' colours.
   // Charts are independent (each triangle in one): any thread count gives the same atlas.
   std::vector<std::array<Eigen::Vector2d, 3>> corner_pixels(num_triangles);
+  // Levelling (single photos only): the sums of the photo's and the vertices' colours.
+  const bool level = !options.blend_views && options.level_colours;
   const auto make_patch = [&](Chart& chart) {
     const CalibratedView& view = views[chart.view];
     Eigen::Vector2d low(1e300, 1e300), high(-1e300, -1e300);
@@ -336,7 +329,7 @@ MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& view
         low = low.cwiseMin(pixel);
         high = high.cwiseMax(pixel);
         Eigen::Vector3f colour;
-        if (SampleBilinear(view.image, pixel, &colour)) {
+        if (level && SampleBilinear(view.image, pixel, &colour)) {
           photo_sum += colour.cast<double>();
           vertex_sum += mesh->colours[vertex].cast<double>();
         }
@@ -350,7 +343,7 @@ MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& view
     chart.patch = view.image(chart.source).clone();
     if (options.blend_views) {
       BlendViews(views, *mesh, candidates, chart, corner_pixels, &chart.patch);
-    } else if (options.level_colours && photo_sum.minCoeff() > 0.0) {
+    } else if (level && photo_sum.minCoeff() > 0.0) {
       cv::Mat levelled;
       chart.patch.convertTo(levelled, CV_32FC3);
       cv::Scalar gain;
@@ -458,262 +451,6 @@ MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& view
   }
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
-}
-
-namespace {
-
-// The mesh's corners as vertices of their own where one vertex has several texture coordinates:
-// per output vertex, its mesh vertex and its coordinates; per triangle corner, its output vertex.
-struct SplitVertices {
-  std::vector<int> vertex;
-  std::vector<Eigen::Vector2f> uv;
-  std::vector<int> corner;
-};
-
-SplitVertices SplitByTextureCoordinates(const TriangleMesh& mesh) {
-  SplitVertices split;
-  struct Key {
-    int vertex;
-    float u, v;
-    bool operator==(const Key& o) const { return vertex == o.vertex && u == o.u && v == o.v; }
-  };
-  struct KeyHash {
-    size_t operator()(const Key& k) const {
-      uint32_t u, v;
-      std::memcpy(&u, &k.u, 4);
-      std::memcpy(&v, &k.v, 4);
-      return std::hash<uint64_t>()((static_cast<uint64_t>(k.vertex) << 32) ^ (u * 2654435761u) ^ v);
-    }
-  };
-  std::unordered_map<Key, int, KeyHash> index;
-  index.reserve(mesh.corner_uvs.size());
-  split.corner.reserve(mesh.corner_uvs.size());
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector2f& uv = mesh.corner_uvs[3 * t + k];
-      const Key key{mesh.triangles[t][k], uv.x(), uv.y()};
-      const auto [found, added] = index.emplace(key, static_cast<int>(split.vertex.size()));
-      if (added) {
-        split.vertex.push_back(key.vertex);
-        split.uv.push_back(uv);
-      }
-      split.corner.push_back(found->second);
-    }
-  }
-  return split;
-}
-
-std::vector<uint8_t> EncodePng(const cv::Mat& rgb, const std::string& path) {
-  cv::Mat bgr;
-  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-  std::vector<uint8_t> bytes;
-  if (!cv::imencode(".png", bgr, bytes)) throw InputError(path + ": cannot encode the texture");
-  return bytes;
-}
-
-void WriteBytes(const std::string& path, const std::string& what, const char* data, size_t size) {
-  const std::string temporary = TemporaryPathFor(path);
-  errno = 0;
-  std::ofstream file(temporary, std::ios::binary);
-  file.write(data, static_cast<std::streamsize>(size));
-  file.close();
-  if (!file) ThrowWriteFailure(temporary, what, errno);
-  RenameIntoPlace(temporary, path);
-}
-
-}  // namespace
-
-void WriteTexturedObj(const TriangleMesh& mesh, const std::string& obj_path) {
-  CHECK(mesh.textured());
-  const std::filesystem::path obj(obj_path);
-  const std::string stem = obj.stem().string();
-  const std::filesystem::path folder = obj.parent_path();
-  const std::string mtl_name = stem + ".mtl", png_name = stem + "_texture.png";
-  const std::vector<uint8_t> png = EncodePng(mesh.texture, (folder / png_name).string());
-  WriteBytes((folder / png_name).string(), "the texture", reinterpret_cast<const char*>(png.data()),
-             png.size());
-  const std::string mtl = "# raycarve: the texture atlas from the photos\nnewmtl raycarve\n"
-                          "Ka 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\nmap_Kd " + png_name + "\n";
-  WriteBytes((folder / mtl_name).string(), "the material", mtl.data(), mtl.size());
-  const SplitVertices split = SplitByTextureCoordinates(mesh);
-  std::ostringstream text;
-  text.imbue(std::locale::classic());
-  text.precision(9);
-  text << "# raycarve: textured mesh, " << mesh.vertices.size() << " vertices, "
-       << mesh.triangles.size() << " triangles\nmtllib " << mtl_name << "\n";
-  for (const Eigen::Vector3f& v : mesh.vertices) text << "v " << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
-  const bool normals = mesh.normals.size() == mesh.vertices.size();
-  if (normals) {
-    for (const Eigen::Vector3f& n : mesh.normals) text << "vn " << n.x() << ' ' << n.y() << ' ' << n.z() << '\n';
-  }
-  // OBJ's v runs up from the image's bottom.
-  for (const Eigen::Vector2f& uv : split.uv) text << "vt " << uv.x() << ' ' << 1.0f - uv.y() << '\n';
-  text << "usemtl raycarve\n";
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    text << 'f';
-    for (int k = 0; k < 3; ++k) {
-      const int v = mesh.triangles[t][k] + 1, vt = split.corner[3 * t + k] + 1;
-      text << ' ' << v << '/' << vt;
-      if (normals) text << '/' << v;
-    }
-    text << '\n';
-  }
-  const std::string bytes = text.str();
-  WriteBytes(obj_path, "the mesh", bytes.data(), bytes.size());
-}
-
-void WriteGlb(const TriangleMesh& mesh, const std::string& path) {
-  const bool textured = mesh.textured();
-  SplitVertices split;
-  if (textured) {
-    split = SplitByTextureCoordinates(mesh);
-  } else {
-    split.vertex.resize(mesh.vertices.size());
-    std::iota(split.vertex.begin(), split.vertex.end(), 0);
-    for (const Eigen::Vector3i& t : mesh.triangles) {
-      for (int k = 0; k < 3; ++k) split.corner.push_back(t[k]);
-    }
-  }
-  const size_t n = split.vertex.size();
-  const bool normals = mesh.normals.size() == mesh.vertices.size();
-  const bool colours = !textured && mesh.colours.size() == mesh.vertices.size();
-  tinygltf::Model model;
-  model.asset.version = "2.0";
-  model.asset.generator = "raycarve";
-  if (mesh.triangles.empty()) {
-    // glTF has no empty accessors: an empty carve gives a scene with nothing in it.
-    model.scenes.emplace_back();
-    model.defaultScene = 0;
-    const std::string temporary = TemporaryPathFor(path);
-    tinygltf::TinyGLTF writer;
-    errno = 0;
-    if (!writer.WriteGltfSceneToFile(&model, temporary, false, true, false, true)) {
-      ThrowWriteFailure(temporary, "the glTF mesh", errno);
-    }
-    RenameIntoPlace(temporary, path);
-    return;
-  }
-  tinygltf::Buffer buffer;
-  auto append = [&buffer](const void* data, size_t bytes) {
-    const size_t offset = buffer.data.size();
-    buffer.data.resize(offset + bytes);
-    if (bytes > 0) std::memcpy(buffer.data.data() + offset, data, bytes);
-    while (buffer.data.size() % 4 != 0) buffer.data.push_back(0);
-    return offset;
-  };
-  auto add_view = [&](size_t offset, size_t bytes, int target) {
-    tinygltf::BufferView view;
-    view.buffer = 0;
-    view.byteOffset = offset;
-    view.byteLength = bytes;
-    view.target = target;
-    model.bufferViews.push_back(view);
-    return static_cast<int>(model.bufferViews.size() - 1);
-  };
-  auto add_accessor = [&](int view, int component, int type, size_t count, bool normalized) {
-    tinygltf::Accessor accessor;
-    accessor.bufferView = view;
-    accessor.componentType = component;
-    accessor.type = type;
-    accessor.count = count;
-    accessor.normalized = normalized;
-    model.accessors.push_back(accessor);
-    return static_cast<int>(model.accessors.size() - 1);
-  };
-  std::vector<float> positions, normal_values, uvs;
-  std::vector<uint8_t> colour_values;
-  Eigen::Vector3f low = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
-  Eigen::Vector3f high = -low;
-  for (const int v : split.vertex) {
-    const Eigen::Vector3f& p = mesh.vertices[v];
-    positions.insert(positions.end(), {p.x(), p.y(), p.z()});
-    low = low.cwiseMin(p);
-    high = high.cwiseMax(p);
-    if (normals) normal_values.insert(normal_values.end(), {mesh.normals[v].x(), mesh.normals[v].y(), mesh.normals[v].z()});
-    if (colours) {
-      colour_values.insert(colour_values.end(), {mesh.colours[v][0], mesh.colours[v][1], mesh.colours[v][2], 255});
-    }
-  }
-  for (const Eigen::Vector2f& uv : split.uv) uvs.insert(uvs.end(), {uv.x(), uv.y()});
-  std::vector<uint32_t> indices(split.corner.begin(), split.corner.end());
-  tinygltf::Primitive primitive;
-  primitive.mode = TINYGLTF_MODE_TRIANGLES;
-  const int position_accessor = add_accessor(
-      add_view(append(positions.data(), positions.size() * 4), positions.size() * 4,
-               TINYGLTF_TARGET_ARRAY_BUFFER),
-      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, false);
-  if (n > 0) {
-    model.accessors[position_accessor].minValues = {low.x(), low.y(), low.z()};
-    model.accessors[position_accessor].maxValues = {high.x(), high.y(), high.z()};
-  }
-  primitive.attributes["POSITION"] = position_accessor;
-  if (normals) {
-    primitive.attributes["NORMAL"] = add_accessor(
-        add_view(append(normal_values.data(), normal_values.size() * 4), normal_values.size() * 4,
-                 TINYGLTF_TARGET_ARRAY_BUFFER),
-        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, false);
-  }
-  if (colours) {
-    primitive.attributes["COLOR_0"] = add_accessor(
-        add_view(append(colour_values.data(), colour_values.size()), colour_values.size(),
-                 TINYGLTF_TARGET_ARRAY_BUFFER),
-        TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_VEC4, n, true);
-  }
-  if (textured) {
-    primitive.attributes["TEXCOORD_0"] = add_accessor(
-        add_view(append(uvs.data(), uvs.size() * 4), uvs.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, n, false);
-  }
-  primitive.indices = add_accessor(
-      add_view(append(indices.data(), indices.size() * 4), indices.size() * 4,
-               TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
-      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size(), false);
-  tinygltf::Material material;
-  material.name = "raycarve";
-  material.pbrMetallicRoughness.metallicFactor = 0.0;
-  material.pbrMetallicRoughness.roughnessFactor = 1.0;
-  if (textured) {
-    const std::vector<uint8_t> png = EncodePng(mesh.texture, path);
-    tinygltf::Image image;
-    image.mimeType = "image/png";
-    image.bufferView = add_view(append(png.data(), png.size()), png.size(), 0);
-    model.images.push_back(image);
-    tinygltf::Sampler sampler;
-    sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-    sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-    sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-    sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-    model.samplers.push_back(sampler);
-    tinygltf::Texture texture;
-    texture.source = 0;
-    texture.sampler = 0;
-    model.textures.push_back(texture);
-    material.pbrMetallicRoughness.baseColorTexture.index = 0;
-  }
-  model.materials.push_back(material);
-  primitive.material = 0;
-  tinygltf::Mesh gltf_mesh;
-  gltf_mesh.name = "raycarve";
-  gltf_mesh.primitives.push_back(primitive);
-  model.meshes.push_back(gltf_mesh);
-  tinygltf::Node node;
-  node.mesh = 0;
-  model.nodes.push_back(node);
-  tinygltf::Scene scene;
-  scene.nodes.push_back(0);
-  model.scenes.push_back(scene);
-  model.defaultScene = 0;
-  model.asset.version = "2.0";
-  model.asset.generator = "raycarve";
-  model.buffers.push_back(std::move(buffer));
-  const std::string temporary = TemporaryPathFor(path);
-  tinygltf::TinyGLTF writer;
-  errno = 0;
-  if (!writer.WriteGltfSceneToFile(&model, temporary, /*embedImages=*/false, /*embedBuffers=*/true,
-                                   /*prettyPrint=*/false, /*writeBinary=*/true)) {
-    ThrowWriteFailure(temporary, "the glTF mesh", errno);
-  }
-  RenameIntoPlace(temporary, path);
 }
 
 }  // namespace exporter

@@ -1,7 +1,7 @@
 #pragma once
 // A texture atlas for a mesh from the photos: each triangle takes its colours from the photo that
 // sees it best, neighbours share photos where they can, and the pieces of photo are packed into
-// one image. Then the textured mesh's files: OBJ + MTL + PNG, and glTF 2.0 binary (GLB).
+// one image. Its files: export/mesh_formats.h.
 
 #include <cstdint>
 #include <string>
@@ -57,17 +57,6 @@ struct MeshTextureSummary {
 MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& views,
                                          const std::vector<std::vector<uint32_t>>& seen_by,
                                          const MeshTextureOptions& options, TriangleMesh* mesh);
-
-// Writes `<stem>.obj`, `<stem>.mtl` and `<stem>_texture.png` beside each other (`obj_path` ends
-// in .obj): positions, normals, the corners' texture coordinates, one material whose diffuse map
-// is the atlas. Each file under a temporary name and renamed; throws InputError naming the file
-// on failure. The mesh must be textured.
-void WriteTexturedObj(const TriangleMesh& mesh, const std::string& obj_path);
-
-// Writes the mesh as glTF 2.0 binary: positions, normals, and the texture (PNG, embedded) with
-// its coordinates when the mesh is textured, else the vertex colours (COLOR_0). Temporary name
-// and rename; throws InputError naming the file on failure.
-void WriteGlb(const TriangleMesh& mesh, const std::string& path);
 
 }  // namespace exporter
 }  // namespace raycarve

@@ -12,6 +12,7 @@
 #include "calib/input_error.h"
 #include "calib/model_writer.h"
 #include "pipeline/carve_report.h"
+#include "export/mesh_formats.h"
 #include "export/preview.h"
 #include "pipeline/output_files.h"
 
@@ -331,10 +332,7 @@ void CarvePipeline::SampleCloud() {
                              model_.self_intersections.pairs_after == 0;
       run_.mesh_topology = exporter::AnalyseTopology(model_.mesh, none_left ? 0 : -1);
       exporter::WriteMeshPly(model_.mesh, (out / "mesh.ply").string());
-      // The formats other programs load: glTF binary (Blender, web viewers, game engines) and,
-      // textured, OBJ with its material and atlas.
-      exporter::WriteGlb(model_.mesh, (out / "mesh.glb").string());
-      if (model_.mesh.textured()) exporter::WriteTexturedObj(model_.mesh, (out / "mesh.obj").string());
+      exporter::WriteMeshFormats(model_.mesh, out.string());
       // Something to look at: the mesh from three of the photos' cameras, beside the photos.
       cv::Mat preview = exporter::PreviewImage(model_.mesh, carved_);
       if (!preview.empty()) {

@@ -490,18 +490,15 @@ void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path)
   }
   WriteModel(scene.reconstruction, (root / "sparse" / "0").string(), ModelFormat::kBinary);
   std::vector<exporter::ColouredPoint> truth;
-  for (const Eigen::Vector3d& point : SampleTrueSurface(scene, 200000, 7, 2)) {
-    exporter::ColouredPoint coloured;
-    coloured.xyz = point.cast<float>();
-    truth.push_back(coloured);
-  }
-  if (scene.backdrop == Backdrop::kRoom) {
-    for (const Eigen::Vector3d& point : SampleRoomSurface(scene, kRoomTruthSamples, 8, 2)) {
+  const auto add = [&truth](const std::vector<Eigen::Vector3d>& points) {
+    for (const Eigen::Vector3d& point : points) {
       exporter::ColouredPoint coloured;
       coloured.xyz = point.cast<float>();
       truth.push_back(coloured);
     }
-  }
+  };
+  add(SampleTrueSurface(scene, 200000, 7, 2));
+  if (scene.backdrop == Backdrop::kRoom) add(SampleRoomSurface(scene, kRoomTruthSamples, 8, 2));
   exporter::WritePointCloudPly(truth, (root / "truth.ply").string());
 }
 

@@ -2,6 +2,7 @@
 // rectangle that the textured mesh must draw back, a triangle no photo sees whole that must keep
 // its vertices' colours, and the OBJ and glTF files read back.
 #include "export/mesh_texture.h"
+#include "export/mesh_formats.h"
 
 #include <cmath>
 #include <fstream>

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -12,6 +14,8 @@
 #include "calib/input_error.h"
 #include "calib/model_writer.h"
 #include "pipeline/carve_report.h"
+#include "pipeline/carve_summary.h"
+#include "pipeline/report_page.h"
 #include "export/mesh_formats.h"
 #include "export/preview.h"
 #include "pipeline/output_files.h"
@@ -218,7 +222,7 @@ void CarvePipeline::PlanOutputs() {
   // no earlier carve wrote.
   for (const char* name : {"cloud.ply", "cloud.ply.vis", "mesh.ply", "mesh.glb", "mesh.obj",
                            "mesh.mtl", "mesh_texture.png", "preview.png", "fused.ply",
-                           "fused.ply.vis", "sparse", "report.json", "convergence.csv"}) {
+                           "fused.ply.vis", "sparse", "report.json", "report.html", "convergence.csv"}) {
     CheckNoLinkInside(run_.output_path, name);
   }
   const fs::path sparse_folder = fs::weakly_canonical(out / "sparse");
@@ -419,6 +423,40 @@ void CarvePipeline::WriteMasks(const fs::path& staging) const {
   }
 }
 
+void CarvePipeline::WriteReportPage(const fs::path& staging) const {
+  ReportPageContent page;
+  page.title = run_.model_path;
+  page.summary = CarveSummaryText(request_, run_);
+  if (fs::exists(staging / "preview.png")) page.preview_image = "preview.png";
+  page.convergence = run_.result->statistics.curve;
+  // The 3D view starts as the photos saw the model: their mean up (-y of the camera), from the
+  // camera nearest the cameras' mean direction from the volume's centre (a photo's viewpoint: a
+  // ring's mean direction points straight up).
+  const Eigen::Vector3d centre = project_.bounds.box.center();
+  Eigen::Vector3d mean_direction = Eigen::Vector3d::Zero();
+  for (const CalibratedView& view : carved_) {
+    const Eigen::Matrix3d rotation = view.K.inverse() * view.P.leftCols<3>();
+    page.view_up -= rotation.row(1).transpose();
+    mean_direction += (view.centre - centre).normalized();
+  }
+  double best = -2.0;
+  for (const CalibratedView& view : carved_) {
+    const Eigen::Vector3d direction = (view.centre - centre).normalized();
+    if (direction.dot(mean_direction) > best) {
+      best = direction.dot(mean_direction);
+      page.view_from = direction;
+    }
+  }
+  const fs::path glb = staging / "mesh.glb";
+  if (fs::exists(glb)) {
+    page.glb_name = "mesh.glb";
+    std::ifstream file(glb, std::ios::binary);
+    page.glb.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+    if (!file && !file.eof()) throw InputError(glb.string() + ": cannot read back for report.html");
+  }
+  WriteTextFileAtomically((staging / "report.html").string(), ReportPageHtml(page));
+}
+
 void CarvePipeline::WriteOutputs() {
   CHECK(staged_) << "PlanOutputs must run before WriteOutputs";
   const Clock::time_point start = Clock::now();
@@ -442,6 +480,7 @@ void CarvePipeline::WriteOutputs() {
       csv << sample.seconds << "," << sample.carved << "," << sample.evaluated << "\n";
     }
     WriteTextFileAtomically((out / "convergence.csv").string(), csv.str());
+    WriteReportPage(out);
     WriteTextFileAtomically((out / "report.json").string(), CarveReportJson(request_, run_));
   });
   staged_->MoveIntoPlace("report.json");

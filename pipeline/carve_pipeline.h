@@ -142,6 +142,9 @@ class CarvePipeline {
   void DecideMasks();
   void RecordSeconds(const std::string& stage, double seconds);
   void WriteMasks(const std::filesystem::path& staging) const;
+  // report.html (pipeline/report_page.h): the summary, preview.png, the convergence plot and
+  // mesh.glb in a 3D view, read back from the staging folder.
+  void WriteReportPage(const std::filesystem::path& staging) const;
   void WriteDenseWorkspace(const std::filesystem::path& staging);
 
   const CarveRequest request_;

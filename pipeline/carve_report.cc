@@ -298,6 +298,8 @@ void WriteOutputs(const CarveRequest& request, const CarveRun& run, JsonWriter& 
       .Key("mesh_triangles").Value(static_cast<uint64_t>(run.num_mesh_triangles))
       .Key("mesh_vertices").Value(static_cast<uint64_t>(run.num_mesh_vertices))
       .Key("convergence").Value("convergence.csv")
+      .Key("preview").Value(request.mesh_kind == "smooth" ? "preview.png" : "")
+      .Key("page").Value("report.html")
       .EndObject();
 }
 

@@ -88,7 +88,7 @@ TEST_F(CarveCommands, CarveWritesCloudMeshReportAndCurve) {
             0)
       << output;
   EXPECT_NE(output.find("carving a 40x"), std::string::npos) << output;
-  EXPECT_NE(output.find("open with"), std::string::npos) << output;
+  EXPECT_NE(output.find("report.html in a browser"), std::string::npos) << output;
   for (const char* file : {"cloud.ply", "mesh.ply", "mesh.glb", "mesh.obj", "mesh.mtl",
                            "mesh_texture.png", "preview.png", "report.json", "convergence.csv"}) {
     EXPECT_TRUE(fs::is_regular_file(out + "/" + file)) << file;

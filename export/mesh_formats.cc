@@ -1,6 +1,7 @@
 #include "export/mesh_formats.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +22,14 @@ namespace raycarve {
 namespace exporter {
 
 namespace {
+
+// An sRGB byte as a linear value in 0..65535 (the sRGB transfer function inverted): glTF's vertex
+// colours are linear, and 16 bits keep the dark shades that 8 linear bits would merge.
+uint16_t LinearFromSrgb(uint8_t value) {
+  const double c = value / 255.0;
+  const double linear = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+  return static_cast<uint16_t>(std::lround(65535.0 * linear));
+}
 
 // The mesh's corners as vertices of their own where one vertex has several texture coordinates:
 // per output vertex, its mesh vertex and its coordinates; per triangle corner, its output vertex.
@@ -176,7 +185,7 @@ void WriteGlbFile(const TriangleMesh& mesh, const std::string& path, const Split
     return static_cast<int>(model.accessors.size() - 1);
   };
   std::vector<float> positions, normal_values, uvs;
-  std::vector<uint8_t> colour_values;
+  std::vector<uint16_t> colour_values;  // linear, as glTF's COLOR_0 is (the PLY's are sRGB)
   Eigen::Vector3f low = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
   Eigen::Vector3f high = -low;
   for (const int v : split.vertex) {
@@ -186,7 +195,9 @@ void WriteGlbFile(const TriangleMesh& mesh, const std::string& path, const Split
     high = high.cwiseMax(p);
     if (normals) normal_values.insert(normal_values.end(), {mesh.normals[v].x(), mesh.normals[v].y(), mesh.normals[v].z()});
     if (colours) {
-      colour_values.insert(colour_values.end(), {mesh.colours[v][0], mesh.colours[v][1], mesh.colours[v][2], 255});
+      colour_values.insert(colour_values.end(), {LinearFromSrgb(mesh.colours[v][0]),
+                                                 LinearFromSrgb(mesh.colours[v][1]),
+                                                 LinearFromSrgb(mesh.colours[v][2]), 65535});
     }
   }
   for (const Eigen::Vector2f& uv : split.uv) uvs.insert(uvs.end(), {uv.x(), uv.y()});
@@ -210,9 +221,9 @@ void WriteGlbFile(const TriangleMesh& mesh, const std::string& path, const Split
   }
   if (colours) {
     primitive.attributes["COLOR_0"] = add_accessor(
-        add_view(append(colour_values.data(), colour_values.size()), colour_values.size(),
+        add_view(append(colour_values.data(), colour_values.size() * 2), colour_values.size() * 2,
                  TINYGLTF_TARGET_ARRAY_BUFFER),
-        TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_VEC4, n, true);
+        TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, n, true);
   }
   if (textured) {
     primitive.attributes["TEXCOORD_0"] = add_accessor(

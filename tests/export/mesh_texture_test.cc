@@ -5,6 +5,7 @@
 #include "export/mesh_formats.h"
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <string>
 
@@ -194,8 +195,25 @@ TEST(WriteTexturedObj, TheFilesReadBack) {
   tinygltf::Model plain_model;
   ASSERT_TRUE(loader.LoadBinaryFromFile(&plain_model, &error, &warning, folder + "/plain.glb"))
       << error;
-  EXPECT_TRUE(plain_model.meshes[0].primitives[0].attributes.count("COLOR_0"));
+  ASSERT_TRUE(plain_model.meshes[0].primitives[0].attributes.count("COLOR_0"));
   EXPECT_TRUE(plain_model.images.empty());
+  // glTF's vertex colours are linear: read back through the sRGB curve, they are the mesh's.
+  const tinygltf::Accessor& colours =
+      plain_model.accessors[plain_model.meshes[0].primitives[0].attributes.at("COLOR_0")];
+  ASSERT_EQ(colours.componentType, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+  ASSERT_TRUE(colours.normalized);
+  ASSERT_EQ(colours.count, plain.vertices.size());
+  const tinygltf::BufferView& colour_view = plain_model.bufferViews[colours.bufferView];
+  const uint8_t* data = plain_model.buffers[0].data.data() + colour_view.byteOffset + colours.byteOffset;
+  for (size_t v = 0; v < colours.count; ++v) {
+    for (int c = 0; c < 3; ++c) {
+      uint16_t linear = 0;
+      std::memcpy(&linear, data + (4 * v + c) * 2, 2);
+      const double l = linear / 65535.0;
+      const double srgb = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
+      EXPECT_NEAR(255.0 * srgb, plain.colours[v][c], 0.5) << "vertex " << v << " channel " << c;
+    }
+  }
 }
 
 TEST(PreviewImage, PhotoBesideTheMeshFromItsCamera) {

@@ -78,6 +78,15 @@ std::vector<size_t> MaskedViews(const std::vector<CalibratedView>& views) {
 
 std::string MeshPartsSummary::Summary() const {
   char text[256];
+  if (!judged_by_masks) {
+    std::snprintf(text, sizeof(text),
+                  "mesh parts: %d; %d specks (under %.0f%% of the largest part, no sparse point on "
+                  "them, no masks) removed (%lld vertices), %d small parts kept for their sparse "
+                  "points; in %.2f s",
+                  parts, removed, 100.0 * kSpeckShare, static_cast<long long>(removed_vertices),
+                  anchored, seconds);
+    return text;
+  }
   std::snprintf(text, sizeof(text),
                 "mesh parts: %d; %d that fewer than %d of %d masked photos need and no sparse "
                 "point holds removed (%lld vertices), %d kept for a sparse point alone; in %.2f s",
@@ -147,26 +156,37 @@ std::vector<uint8_t> AnchoredParts(const TriangleMesh& mesh, const std::vector<i
                                    double anchor_radius) {
   const int n = static_cast<int>(mesh.vertices.size());
   std::vector<uint8_t> anchored(parts, 0);
-  if (!anchors.empty() && anchor_radius > 0.0) {
-    pcl::PointCloud<pcl::PointXYZ>::Ptr others(new pcl::PointCloud<pcl::PointXYZ>);
-    std::vector<int> vertex_of;
-    for (int i = 0; i < n; ++i) {
-      if (part[i] == largest) continue;
-      others->push_back(pcl::PointXYZ(mesh.vertices[i].x(), mesh.vertices[i].y(), mesh.vertices[i].z()));
+  if (anchors.empty() || !(anchor_radius > 0.0)) return anchored;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr others(new pcl::PointCloud<pcl::PointXYZ>);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr main_part(new pcl::PointCloud<pcl::PointXYZ>);
+  std::vector<int> vertex_of;
+  for (int i = 0; i < n; ++i) {
+    const pcl::PointXYZ point(mesh.vertices[i].x(), mesh.vertices[i].y(), mesh.vertices[i].z());
+    if (part[i] == largest) {
+      main_part->push_back(point);
+    } else {
+      others->push_back(point);
       vertex_of.push_back(i);
     }
-    if (!others->empty()) {
-      pcl::KdTreeFLANN<pcl::PointXYZ> tree;
-      tree.setInputCloud(others);
-      std::vector<int> found;
-      std::vector<float> squared;
-      for (const Eigen::Vector3d& point : anchors) {
-        const pcl::PointXYZ query(static_cast<float>(point.x()), static_cast<float>(point.y()),
-                                  static_cast<float>(point.z()));
-        tree.radiusSearch(query, anchor_radius, found, squared);
-        for (int k : found) anchored[part[vertex_of[k]]] = 1;
-      }
+  }
+  if (others->empty()) return anchored;
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree, main_tree;
+  tree.setInputCloud(others);
+  if (!main_part->empty()) main_tree.setInputCloud(main_part);
+  std::vector<int> found, nearest(1);
+  std::vector<float> squared, nearest_squared(1);
+  for (const Eigen::Vector3d& point : anchors) {
+    const pcl::PointXYZ query(static_cast<float>(point.x()), static_cast<float>(point.y()),
+                              static_cast<float>(point.z()));
+    if (tree.radiusSearch(query, anchor_radius, found, squared) == 0) continue;
+    // A sparse point holds the part it lies nearest to: one beside the main surface and a speck
+    // off it is the main surface's.
+    const size_t k = std::min_element(squared.begin(), squared.end()) - squared.begin();
+    if (!main_part->empty() && main_tree.nearestKSearch(query, 1, nearest, nearest_squared) == 1 &&
+        nearest_squared[0] <= squared[k]) {
+      continue;
     }
+    anchored[part[vertex_of[found[k]]]] = 1;
   }
   return anchored;
 }
@@ -186,8 +206,9 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
   int parts = 0;
   const std::vector<int> part = ConnectedParts(*mesh, &parts);
   summary.parts = parts;
-  if (parts < 2 || min_needing_views <= 0 ||
-      static_cast<int>(masked.size()) < min_needing_views) {
+  summary.judged_by_masks =
+      min_needing_views > 0 && static_cast<int>(masked.size()) >= min_needing_views;
+  if (parts < 2 || (!summary.judged_by_masks && anchors.empty())) {
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return summary;
   }
@@ -195,6 +216,25 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
   for (int i = 0; i < n; ++i) ++part_vertices[part[i]];
   const int largest = static_cast<int>(
       std::max_element(part_vertices.begin(), part_vertices.end()) - part_vertices.begin());
+  if (!summary.judged_by_masks) {
+    // No masks to say what the model needs: the sparse points alone speak for small parts.
+    const std::vector<uint8_t> anchored =
+        AnchoredParts(*mesh, part, parts, largest, anchors, anchor_radius);
+    std::vector<uint8_t> keep(parts, 1);
+    for (int p = 0; p < parts; ++p) {
+      if (p == largest || anchored[p] ||
+          part_vertices[p] >= kSpeckShare * static_cast<double>(part_vertices[largest])) {
+        summary.anchored += p != largest && anchored[p];
+        continue;
+      }
+      keep[p] = 0;
+      ++summary.removed;
+      summary.removed_vertices += part_vertices[p];
+    }
+    if (summary.removed > 0) KeepParts(part, keep, mesh);
+    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return summary;
+  }
   // The triangles grouped by part, as DrawMeshParts needs them.
   std::vector<int> triangle_part;
   const TriangleMesh grouped = GroupedByPart(*mesh, part, &triangle_part);

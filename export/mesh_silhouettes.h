@@ -13,11 +13,16 @@
 namespace raycarve {
 namespace exporter {
 
+// Without masks, parts below this share of the largest part's vertices are specks unless a
+// sparse point lies on them: a piece of a hundredth of the model that no feature was matched on.
+constexpr double kSpeckShare = 0.01;
+
 struct MeshPartsSummary {
   int parts = 0;           // connected components before
   int removed = 0;
   int64_t removed_vertices = 0;
   int anchored = 0;        // kept for a sparse point alone (no two masks needed them)
+  bool judged_by_masks = false;  // enough masked views; otherwise only specks were judged
   int masked_views = 0;
   int min_needing_views = 0;
   double seconds = 0.0;
@@ -33,10 +38,13 @@ struct MeshPartsSummary {
 // them. A separate object is seen on its own in most photos. The largest part always stays;
 // views without a mask count for nothing, and with fewer masked views than min_needing_views (or
 // min_needing_views <= 0) nothing is removed. A part with a vertex within `anchor_radius` of one
-// of `anchors` (reliable sparse points: features matched and triangulated across photos) stays
-// too: a real piece of the object the masks fail to show on its own (holes in masks made from
+// of `anchors` (reliable sparse points: features matched and triangulated across photos) that
+// lies nearer to it than to the largest part stays too: a real piece of the object the masks fail to show on its own (holes in masks made from
 // a backdrop the object shares colours with cut the model into pieces that overlap in every
-// photo). Normals and colours follow the vertices.
+// photo). Without enough masked views the masks cannot judge: then a part smaller than
+// kSpeckShare of the largest (in vertices) with no anchor within `anchor_radius` is a speck the
+// carve left floating, and goes; larger parts and parts holding a sparse point stay (with no
+// anchors at all, nothing goes). Normals and colours follow the vertices.
 MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
                                      int min_needing_views,
                                      const std::vector<Eigen::Vector3d>& anchors,

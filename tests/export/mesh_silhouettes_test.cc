@@ -252,6 +252,39 @@ TEST(RemoveUnneededParts, APhantomNoMaskNeedsGoesAndASeparateObjectStays) {
   EXPECT_EQ(mesh.vertices.size(), all.vertices.size());
 }
 
+TEST(RemoveUnneededParts, WithoutMasksSpecksGoUnlessASparsePointIsTheirs) {
+  // A ball (the model), three specks of a voxel or two, and a separate small object.
+  const TriangleMesh ball = VoxelBall(Eigen::Vector3d::Zero(), 0.7);
+  const TriangleMesh lone = VoxelBall(Eigen::Vector3d(0.0, 0.0, 0.88), 0.06);
+  const TriangleMesh featured = VoxelBall(Eigen::Vector3d(0.0, 0.88, 0.0), 0.06);
+  const TriangleMesh beside = VoxelBall(Eigen::Vector3d(-0.84, 0.0, 0.0), 0.06);
+  const TriangleMesh object = VoxelBall(Eigen::Vector3d(0.72, 0.72, 0.72), 0.15);
+  ASSERT_LT(lone.vertices.size(), kSpeckShare * ball.vertices.size());
+  ASSERT_GT(object.vertices.size(), kSpeckShare * ball.vertices.size());
+  const TriangleMesh all = Join(Join(Join(Join(ball, lone), featured), beside), object);
+  const std::vector<CalibratedView> views = {LookingAtOrigin(Eigen::Vector3d(0.0, 0.0, -3.0))};
+  // A sparse point on the featured speck's surface, and one on the ball's surface facing the
+  // speck beside it (nearer the ball: the ball's).
+  const std::vector<Eigen::Vector3d> anchors = {Eigen::Vector3d(0.0, 0.82, 0.0),
+                                                Eigen::Vector3d(-0.7, 0.0, 0.0)};
+  TriangleMesh mesh = all;
+  const MeshPartsSummary summary = RemoveUnneededParts(views, 2, anchors, 0.125, 0, &mesh);
+  EXPECT_FALSE(summary.judged_by_masks);
+  EXPECT_EQ(summary.parts, 5);
+  EXPECT_EQ(summary.removed, 2);
+  EXPECT_EQ(summary.anchored, 1);
+  EXPECT_EQ(summary.removed_vertices, static_cast<int64_t>(lone.vertices.size() + beside.vertices.size()));
+  ASSERT_EQ(mesh.vertices.size(), ball.vertices.size() + featured.vertices.size() + object.vertices.size());
+  for (const Eigen::Vector3f& v : mesh.vertices) {
+    EXPECT_FALSE(v.z() > 0.75f && v.x() < 0.5f);  // nothing of the lone speck
+    EXPECT_GT(v.x(), -0.76f);                    // nor of the one beside the ball
+  }
+  // With no sparse points at all there is nothing to judge by: everything stays.
+  mesh = all;
+  EXPECT_EQ(RemoveUnneededParts(views, 2, {}, 0.125, 0, &mesh).removed, 0);
+  EXPECT_EQ(mesh.vertices.size(), all.vertices.size());
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

@@ -24,14 +24,7 @@ namespace {
 // An 80x60 pinhole view at the origin looking down +z (x right, y down), f = 100, whose photo is
 // a pattern that differs at every pixel: a 4-pixel check over two gradients.
 CalibratedView PatternView() {
-  CalibratedView view;
-  view.width = 80;
-  view.height = 60;
-  view.K << 100, 0, 40, 0, 100, 30, 0, 0, 1;
-  view.cam_from_world.rotation = Eigen::Quaterniond::Identity();
-  view.cam_from_world.translation = Eigen::Vector3d::Zero();
-  view.centre = Eigen::Vector3d::Zero();
-  view.P = view.K * view.cam_from_world.ToMatrix();
+  CalibratedView view = testing::PinholeViewAtOrigin(80, 60, 100);
   view.image = cv::Mat(view.height, view.width, CV_8UC3);
   for (int row = 0; row < view.height; ++row) {
     for (int col = 0; col < view.width; ++col) {
@@ -40,7 +33,6 @@ CalibratedView PatternView() {
           cv::Vec3b(static_cast<uint8_t>(3 * col), static_cast<uint8_t>(4 * row), check ? 220 : 30);
     }
   }
-  view.valid = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(255));
   return view;
 }
 
@@ -220,15 +212,45 @@ TEST(PreviewImage, PhotoBesideTheMeshFromItsCamera) {
   const std::vector<CalibratedView> views = {PatternView(), PatternView()};
   TriangleMesh mesh = Rectangle(views[0]);
   const cv::Mat preview = PreviewImage(mesh, views, 3, 1600);
-  // Two views: two rows (the first and the last), photo | render, full size.
-  ASSERT_EQ(preview.size(), cv::Size(160, 120));
+  // Two views: two rows (the first and the last), photo | render, full size; then a row of three
+  // renders from outside the photos' directions, a third of the width each, a row high.
+  ASSERT_EQ(preview.size(), cv::Size(160, 180));
   EXPECT_EQ(cv::norm(preview(cv::Rect(0, 0, 80, 60)), views[0].image, cv::NORM_INF), 0.0);
   EXPECT_EQ(cv::norm(preview(cv::Rect(80, 0, 80, 60)), RenderMesh(mesh, views[0]).image,
                      cv::NORM_INF),
             0.0);
   // Narrower than two photos: each row scaled down to fit.
-  EXPECT_EQ(PreviewImage(mesh, views, 1, 80).size(), cv::Size(80, 30));
+  EXPECT_EQ(PreviewImage(mesh, views, 1, 80).size(), cv::Size(80, 60));
   EXPECT_TRUE(PreviewImage(mesh, {}, 3, 1600).empty());
+}
+
+TEST(ViewsFromOutside, FarFromThePhotosAndFramingTheWholeMesh) {
+  const std::vector<CalibratedView> views = {PatternView()};
+  const TriangleMesh mesh = Rectangle(views[0]);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& v : mesh.vertices) centre += v.cast<double>();
+  centre /= static_cast<double>(mesh.vertices.size());
+  const Eigen::Vector3d photo = (views[0].centre - centre).normalized();
+  const std::vector<CalibratedView> outside = ViewsFromOutside(mesh, views, 3, 120, 90);
+  ASSERT_EQ(outside.size(), 3u);
+  // One photo: the first view looks from the opposite side (the nearest candidate to it is 45
+  // degrees off), each at least 80 degrees from the photo's direction.
+  EXPECT_LT(photo.dot((outside[0].centre - centre).normalized()), std::cos(130.0 * M_PI / 180.0));
+  for (const CalibratedView& view : outside) {
+    EXPECT_LT(photo.dot((view.centre - centre).normalized()), std::cos(80.0 * M_PI / 180.0));
+    for (const Eigen::Vector3f& v : mesh.vertices) {
+      EXPECT_GT(view.Depth(v.cast<double>()), 0.0);
+      const Eigen::Vector2d pixel = view.Project(v.cast<double>());
+      EXPECT_GE(pixel.x(), 0.0);
+      EXPECT_LE(pixel.x(), view.width);
+      EXPECT_GE(pixel.y(), 0.0);
+      EXPECT_LE(pixel.y(), view.height);
+    }
+  }
+  // From behind, the flat rectangle shows its back (both sides are drawn); the next two see it
+  // edge-on (90 degrees from the photo), as a flat model is from its sides.
+  EXPECT_GT(cv::countNonZero(RenderMesh(mesh, outside[0]).silhouette), 1000);
+  EXPECT_TRUE(ViewsFromOutside(TriangleMesh(), views, 3, 120, 90).empty());
 }
 
 }  // namespace

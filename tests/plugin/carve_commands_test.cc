@@ -90,16 +90,17 @@ TEST_F(CarveCommands, CarveWritesCloudMeshReportAndCurve) {
   EXPECT_NE(output.find("carving a 40x"), std::string::npos) << output;
   EXPECT_NE(output.find("report.html in a browser"), std::string::npos) << output;
   for (const char* file : {"cloud.ply", "mesh.ply", "mesh.glb", "mesh.obj", "mesh.mtl",
-                           "mesh_texture.png", "preview.png", "report.json", "convergence.csv"}) {
+                           "mesh_texture.png", "preview.png", "report.json", "report.html",
+                           "convergence.csv"}) {
     EXPECT_TRUE(fs::is_regular_file(out + "/" + file)) << file;
   }
   // The preview: three rows of photo | mesh, each pair at the undistorted photos' size (the
-  // project's 96x72, or as near as undistortion leaves it).
+  // project's 96x72, or as near as undistortion leaves it), then a row of views from outside.
   const cv::Mat preview = cv::imread(out + "/preview.png", cv::IMREAD_COLOR);
   ASSERT_FALSE(preview.empty());
-  EXPECT_EQ(preview.rows % 3, 0);
+  EXPECT_EQ(preview.rows % 4, 0);
   EXPECT_NEAR(preview.cols / 2.0, 96.0, 8.0);
-  EXPECT_NEAR(preview.rows / 3.0, 72.0, 8.0);
+  EXPECT_NEAR(preview.rows / 4.0, 72.0, 8.0);
   const std::string report = testing::ReadFileBytes(out + "/report.json");
   EXPECT_GT(JsonNumber(report, "textured_triangles"), 0);
   EXPECT_NE(report.find("\"lengths\": \"the model's world units (COLMAP's frame)\""),

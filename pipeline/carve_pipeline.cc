@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -16,6 +17,7 @@
 #include "pipeline/carve_report.h"
 #include "pipeline/carve_summary.h"
 #include "pipeline/report_page.h"
+#include "export/mesh_colouring.h"
 #include "export/mesh_formats.h"
 #include "export/preview.h"
 #include "pipeline/output_files.h"
@@ -187,6 +189,26 @@ void CarvePipeline::CheckVolume() {
     throw InputError("raycarve " + scope_.command + ": " + reason);
   }
   CheckVolumeSeen(scope_.command, project_, carved_, request_.options.min_views, request_.bounds);
+  // Said before the work: a voxel finer than a pixel of the photos gains no detail (the photos
+  // cannot tell its neighbours apart), and each photo sample stands for several voxels.
+  const VoxelGrid grid(project_.bounds.box, request_.options.resolution);
+  const double pixel = exporter::MedianPixelFootprint(carved_, project_.bounds.box.center());
+  if (pixel > 0.0) {
+    run_.voxel_pixels = grid.voxel_size() / pixel;
+    run_.supported_resolution =
+        static_cast<int>(std::floor(request_.options.resolution * run_.voxel_pixels));
+    if (run_.voxel_pixels < 1.0) {
+      LOG(WARNING) << "at --resolution " << request_.options.resolution << " a voxel spans "
+                   << run_.voxel_pixels << " pixels of the photos (median at the volume's "
+                   << "centre): finer than they resolve. They support about --resolution "
+                   << run_.supported_resolution << " (a voxel of one pixel); larger photos "
+                   << "(--max_image_size) or cameras nearer the subject support more";
+    } else {
+      LOG(INFO) << "a voxel spans " << run_.voxel_pixels << " pixels of the photos (median at "
+                << "the volume's centre); they support about --resolution "
+                << run_.supported_resolution;
+    }
+  }
 }
 
 void CarvePipeline::PlanOutputs() {

@@ -53,6 +53,11 @@ struct CarveRun {
   std::vector<PhotoMaskInfo> mask_photos;  // per view: where its mask came from, what was found
   std::vector<std::string> view_names;     // the views carved, in carve order
   ColourCalibration colour;
+  // How large a voxel of the carve's grid is in the photos: its side over the median pixel
+  // footprint at the volume's centre (0 when no photo sees the centre), and the resolution
+  // whose voxel would span one pixel (what the photos can support).
+  double voxel_pixels = 0.0;
+  int supported_resolution = 0;
   // Masks agree.
   MaskAgreementStatistics mask_agreement;
   // Carve.

@@ -139,6 +139,10 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
       .Key("explicit").Value(run.bounds.is_explicit)
       .Key("around_focus").Value(run.bounds.around_focus)
       .EndObject();
+  json.Key("resolution_support").BeginObject()
+      .Key("voxel_pixels").Value(run.voxel_pixels)
+      .Key("supported_resolution").Value(run.supported_resolution)
+      .EndObject();
   const CaptureLayout& layout = run.layout;
   json.Key("capture").BeginObject()
       .Key("kind").Value(std::string(layout.object_centred ? "object" : "scene"))

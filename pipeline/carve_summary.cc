@@ -94,6 +94,24 @@ std::string MeshShape(const CarveRun& run) {
   return "NOT a closed 2-manifold: " + t.Faults();
 }
 
+// After the grid line: how many pixels of the photos a voxel spans, and, where under one, what
+// the photos support.
+std::string ResolutionText(const CarveRun& run) {
+  if (!(run.voxel_pixels > 0.0)) return "";
+  char text[320];
+  if (run.voxel_pixels >= 1.0) {
+    std::snprintf(text, sizeof(text), ", a voxel spans %.2f px of the photos", run.voxel_pixels);
+  } else {
+    std::snprintf(text, sizeof(text),
+                  ", a voxel spans %.2f px of the photos\n"
+                  "  resolution      finer than the photos resolve: they support about "
+                  "--resolution %d (a voxel of one pixel); larger photos (--max_image_size) or "
+                  "nearer cameras support more",
+                  run.voxel_pixels, run.supported_resolution);
+  }
+  return text;
+}
+
 void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string* text) {
   const CarveStatistics& s = run.result->statistics;
   std::string sparse_line = "none in the volume";
@@ -143,7 +161,7 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
   }
   Appendf(text, 
       "\ncarved %s\n"
-      "  grid            %d x %d x %d voxels of %.4g (%lld voxels)\n"
+      "  grid            %d x %d x %d voxels of %.4g (%lld voxels)%s\n"
       "  carved          %lld voxels (%lld by the visual hull of %d masked views, %lld by the "
       "sparse points' sight lines, %lld in specks%s), %lld evaluations\n"
       "  levels          %zu (%s)\n"
@@ -159,7 +177,8 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
       "  look            %s/report.html in a browser (the model in 3D, the figures, pictures);\n"
       "                  mesh.ply in MeshLab, CloudCompare, Open3D or colmap gui\n",
       run.model_path.c_str(), s.dimensions.x(), s.dimensions.y(), s.dimensions.z(), s.voxel_size,
-      static_cast<long long>(s.num_voxels), static_cast<long long>(s.carved),
+      static_cast<long long>(s.num_voxels), ResolutionText(run).c_str(),
+      static_cast<long long>(s.carved),
       static_cast<long long>(s.visual_hull_carved), s.views_with_masks,
       static_cast<long long>(s.free_space_level0_carved),
       static_cast<long long>(s.component_carved), floater_text.c_str(),

@@ -430,41 +430,54 @@ SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options) {
   return scene;
 }
 
+namespace {
+
+// `count` draws of `draw(&random, &point)` (false: nothing drawn) from a generator seeded with
+// `seed`, kept where `seen(point)`.
+template <typename Draw, typename Seen>
+std::vector<Eigen::Vector3d> KeepSeenDraws(int count, uint64_t seed, Draw draw, Seen seen) {
+  std::mt19937_64 random(seed);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < count; ++i) {
+    Eigen::Vector3d point;
+    if (draw(&random, &point) && seen(point)) points.push_back(point);
+  }
+  return points;
+}
+
+}  // namespace
+
 std::vector<Eigen::Vector3d> SampleTrueSurface(const SyntheticScene& scene,
                                                int count,
                                                uint64_t seed,
                                                int min_views) {
-  std::mt19937_64 random(seed);
-  std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < count; ++i) {
-    const Hit surface = SampleSurface(*scene.geometry, &random);
+  const auto draw = [&scene](std::mt19937_64* random, Eigen::Vector3d* point) {
+    *point = SampleSurface(*scene.geometry, random).point;
+    return true;
+  };
+  const auto seen = [&scene, min_views](const Eigen::Vector3d& point) {
+    if (min_views <= 0) return true;
     int views = 0;
     for (const auto& [image_id, image] : scene.reconstruction.images) {
       Eigen::Vector2d pixel;
-      views += SeenBy(*scene.geometry, surface.point, image,
+      views += SeenBy(*scene.geometry, point, image,
                       scene.reconstruction.cameras.at(image.camera_id), &pixel);
-      if (views >= min_views) break;
+      if (views >= min_views) return true;
     }
-    if (views >= min_views) points.push_back(surface.point);
-  }
-  return points;
+    return false;
+  };
+  return KeepSeenDraws(count, seed, draw, seen);
 }
 
 std::vector<Eigen::Vector3d> SampleRoomSurface(const SyntheticScene& scene,
                                                int count,
                                                uint64_t seed,
                                                int min_views) {
-  std::mt19937_64 random(seed);
-  std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < count; ++i) {
-    Eigen::Vector3d point;
-    if (!SampleRoomPoint(&random, &point)) continue;
-    if (RoomPointViews(scene.reconstruction, *scene.geometry, point, min_views).size() >=
-        static_cast<size_t>(min_views)) {
-      points.push_back(point);
-    }
-  }
-  return points;
+  const auto seen = [&scene, min_views](const Eigen::Vector3d& point) {
+    return RoomPointViews(scene.reconstruction, *scene.geometry, point, min_views).size() >=
+           static_cast<size_t>(min_views);
+  };
+  return KeepSeenDraws(count, seed, SampleRoomPoint, seen);
 }
 
 void WriteSyntheticProject(const SyntheticScene& scene, const std::string& path) {

@@ -316,5 +316,26 @@ CalibratedView PinholeViewLookingAtOrigin(const Eigen::Vector3d& centre, int wid
   return view;
 }
 
+Camera MakeCamera(camera_t id, CameraModelId model, int width, int height,
+                  std::vector<double> params) {
+  Camera camera;
+  camera.camera_id = id;
+  camera.model = model;
+  camera.width = width;
+  camera.height = height;
+  camera.params = std::move(params);
+  return camera;
+}
+
+CalibratedView PinholeViewAtOrigin(int width, int height, double focal) {
+  CalibratedView view;
+  view.width = width;
+  view.height = height;
+  view.K << focal, 0, 0.5 * width, 0, focal, 0.5 * height, 0, 0, 1;
+  view.P = view.K * view.cam_from_world.ToMatrix();
+  view.valid = cv::Mat(height, width, CV_8UC1, cv::Scalar(255));
+  return view;
+}
+
 }  // namespace testing
 }  // namespace raycarve

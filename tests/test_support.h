@@ -69,6 +69,10 @@ std::string ReadFileBytes(const std::string& path);
 namespace raycarve {
 namespace testing {
 
+// A camera of the given id, model, size and parameters (COLMAP's order).
+Camera MakeCamera(camera_t id, CameraModelId model, int width, int height,
+                  std::vector<double> params);
+
 // A random, consistent model: one camera of every COLMAP 3.8 model, `num_images` images with
 // random poses and points2D, and 3D points whose tracks refer to those points2D. Values use the
 // full double range of digits so that text round trips are really tested.
@@ -106,6 +110,11 @@ namespace testing {
 // at `centre` looking at the origin, its image's up towards +y (about). `valid` is all 255.
 CalibratedView PinholeViewLookingAtOrigin(const Eigen::Vector3d& centre, int width, int height,
                                           double focal);
+
+// A pinhole view at the world's origin looking down +z (x right, y down: cam_from_world the
+// identity), `width` x `height` pixels, focal length `focal`, the principal point at the
+// centre; K, cam_from_world, centre and P set, no photo, `valid` all 255.
+CalibratedView PinholeViewAtOrigin(int width, int height, double focal);
 
 }  // namespace testing
 }  // namespace raycarve

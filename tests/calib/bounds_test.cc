@@ -41,13 +41,7 @@ const Eigen::AlignedBox3d kObject(Eigen::Vector3d(-1, -2, 0), Eigen::Vector3d(1,
 Reconstruction CamerasLookingAt(const std::vector<Eigen::Vector3d>& centres,
                                 const std::vector<Eigen::Vector3d>& targets) {
   Reconstruction model;
-  Camera camera;
-  camera.camera_id = 1;
-  camera.model = CameraModelId::kPinhole;
-  camera.width = 640;
-  camera.height = 480;
-  camera.params = {500, 500, 320, 240};
-  model.cameras[1] = camera;
+  model.cameras[1] = testing::MakeCamera(1, CameraModelId::kPinhole, 640, 480, {500, 500, 320, 240});
   for (size_t i = 0; i < centres.size(); ++i) {
     const Eigen::Vector3d z = (targets[i] - centres[i]).normalized();
     const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();

@@ -151,13 +151,7 @@ TEST(ModelReader, CorruptedCountsAreErrorsNotAllocations) {
 
 TEST(ModelReader, UnknownModelIdInBinaryNamesFileCameraAndModel) {
   Reconstruction model;
-  Camera camera;
-  camera.camera_id = 3;
-  camera.model = CameraModelId::kPinhole;
-  camera.width = 10;
-  camera.height = 10;
-  camera.params = {1, 1, 5, 5};
-  model.cameras.emplace(3, camera);
+  model.cameras.emplace(3, testing::MakeCamera(3, CameraModelId::kPinhole, 10, 10, {1, 1, 5, 5}));
   std::string bytes = Bytes(WriteCamerasBinary, model);
   const int32_t newer = 12;  // SIMPLE_DIVISION in later COLMAP
   bytes.replace(8 + 4, 4, reinterpret_cast<const char*>(&newer), 4);

@@ -7,6 +7,7 @@
 
 #include "calib/pixel.h"
 #include "samples/synthetic_scene.h"
+#include "tests/test_support.h"
 
 namespace raycarve {
 namespace {
@@ -23,12 +24,8 @@ constexpr double kTolerancePx = 0.2;
 constexpr double kBiasTolerancePx = 0.05;
 
 Camera DistortedCamera(CameraModelId model) {
-  Camera camera;
-  camera.camera_id = 1;
-  camera.model = model;
-  camera.width = kWidth;
-  camera.height = kHeight;
-  camera.params = ExampleCameraParams(model, kWidth, kHeight, 0.8 * kWidth);
+  Camera camera =
+      testing::MakeCamera(1, model, kWidth, kHeight, ExampleCameraParams(model, kWidth, kHeight, 0.8 * kWidth));
   // Stronger radial distortion where the model has a k1 right after the intrinsics.
   if (model == CameraModelId::kOpenCv || model == CameraModelId::kFullOpenCv) camera.params[4] = -0.3;
   if (model == CameraModelId::kSimpleRadial || model == CameraModelId::kRadial) camera.params[3] = -0.3;

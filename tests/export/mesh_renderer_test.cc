@@ -12,17 +12,7 @@ namespace exporter {
 namespace {
 
 // A 40x30 pinhole view at the origin looking down +z (x right, y down), f = 50.
-CalibratedView Straight() {
-  CalibratedView view;
-  view.width = 40;
-  view.height = 30;
-  view.K << 50, 0, 20, 0, 50, 15, 0, 0, 1;
-  view.cam_from_world.rotation = Eigen::Quaterniond::Identity();
-  view.cam_from_world.translation = Eigen::Vector3d::Zero();
-  view.centre = Eigen::Vector3d::Zero();
-  view.P = view.K * view.cam_from_world.ToMatrix();
-  return view;
-}
+CalibratedView Straight() { return testing::PinholeViewAtOrigin(40, 30, 50); }
 
 // The world point at depth z that projects to COLMAP pixel (x, y).
 Eigen::Vector3f Unproject(const CalibratedView& view, double x, double y, double z) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "export/holdout_score.h"
+#include "tests/test_support.h"
 
 namespace raycarve {
 namespace exporter {
@@ -12,13 +13,8 @@ namespace {
 
 // A 100x80 pinhole view at the origin looking down +z, f = 100, principal point (50, 40).
 CalibratedView View() {
-  CalibratedView view;
-  view.width = 100;
-  view.height = 80;
-  view.K << 100, 0, 50, 0, 100, 40, 0, 0, 1;
-  view.P = view.K * view.cam_from_world.ToMatrix();
+  CalibratedView view = testing::PinholeViewAtOrigin(100, 80, 100);
   view.image = cv::Mat(80, 100, CV_8UC3, cv::Scalar(10, 20, 30));
-  view.valid = cv::Mat(80, 100, CV_8UC1, cv::Scalar(255));
   return view;
 }
 

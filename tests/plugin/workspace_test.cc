@@ -71,13 +71,8 @@ TEST(Workspace, SeveralMapperModelsGiveTheLargestOrTheOneAskedFor) {
 TEST(PhotoMemory, ARealSizeProjectFitsAtTheDefaultMaxImageSizeAndIsRefusedAtFullSize) {
   // 200 photos of 12 megapixels on a machine of 24 GiB.
   Reconstruction project;
-  Camera camera;
-  camera.camera_id = 1;
-  camera.model = CameraModelId::kSimpleRadial;
-  camera.width = 4000;
-  camera.height = 3000;
-  camera.params = {3500.0, 2000.0, 1500.0, 0.01};
-  project.cameras.emplace(1, camera);
+  project.cameras.emplace(
+      1, testing::MakeCamera(1, CameraModelId::kSimpleRadial, 4000, 3000, {3500.0, 2000.0, 1500.0, 0.01}));
   for (image_t id = 1; id <= 200; ++id) {
     Image image;
     image.image_id = id;

@@ -48,13 +48,18 @@ void ForEachCoveredPixel(const TriangleMesh& mesh, const CalibratedView& view,
     // (Tested before the bounding box: about half the triangles face away.)
     if (front_faces_only && area > 0.0) continue;
     // Pixel centres (col + 0.5, row + 0.5) inside the triangle's bounding box.
-    const int col_min = std::max(0, static_cast<int>(std::ceil(std::min({a.x(), b.x(), c.x()}) - 0.5)));
+    // (Clamped to the frame before they become ints: a vertex far off-screen, or nearly on the
+    // camera plane, projects beyond int's range.)
+    const auto bound = [](double value, int size) {
+      return static_cast<int>(std::clamp(value, -1.0, static_cast<double>(size)));
+    };
+    const int col_min = std::max(0, bound(std::ceil(std::min({a.x(), b.x(), c.x()}) - 0.5), view.width));
     const int col_max = std::min(view.width - 1,
-                                 static_cast<int>(std::floor(std::max({a.x(), b.x(), c.x()}) - 0.5)));
+                                 bound(std::floor(std::max({a.x(), b.x(), c.x()}) - 0.5), view.width));
     if (col_min > col_max) continue;
-    const int row_min = std::max(0, static_cast<int>(std::ceil(std::min({a.y(), b.y(), c.y()}) - 0.5)));
+    const int row_min = std::max(0, bound(std::ceil(std::min({a.y(), b.y(), c.y()}) - 0.5), view.height));
     const int row_max = std::min(view.height - 1,
-                                 static_cast<int>(std::floor(std::max({a.y(), b.y(), c.y()}) - 0.5)));
+                                 bound(std::floor(std::max({a.y(), b.y(), c.y()}) - 0.5), view.height));
     if (row_min > row_max) continue;
     const double inverse_area = 1.0 / area;
     // Barycentric weights of (x, y), screen space: w0 = e0 + x * dx0 + y * dy0, likewise w1;

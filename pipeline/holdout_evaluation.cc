@@ -12,6 +12,7 @@
 
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
+#include "export/gltf_reader.h"
 #include "export/carve_export.h"
 #include "export/mesh_renderer.h"
 #include "export/point_cloud_compare.h"
@@ -62,7 +63,7 @@ void ReplaceScoringMasks(const CarvePipeline& pipeline,
 
 // Someone else's model (options.model_path): a mesh drawn as it is, a cloud as splats.
 void ReadGivenModel(const HoldoutOptions& options, ScoredModel* scored, std::string* render) {
-  scored->model.mesh = exporter::ReadMeshOrCloudPly(options.model_path);
+  scored->model.mesh = exporter::ReadModelFile(options.model_path);
   const exporter::TriangleMesh& mesh = scored->model.mesh;
   if (!mesh.triangles.empty()) {
     *render = "mesh";

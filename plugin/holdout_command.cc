@@ -65,8 +65,10 @@ int RunHoldout(int argc, char** argv) {
                     "first solid voxel, in its colour) or the cloud's points as square splats",
                     {"mesh", "volume", "splats"});
   parser.AddDefault("model", &options.model_path,
-                    "score this PLY mesh or cloud instead of carving (COLMAP's fused.ply, another "
-                    "tool's mesh with vertex colours), on the same held-out views");
+                    "score this model instead of carving, on the same held-out views: a PLY "
+                    "mesh or cloud (COLMAP's fused.ply, a mesh with vertex colours) or a glTF "
+                    "mesh drawn with its texture (.glb, .gltf: raycarve's mesh.glb, another "
+                    "tool's)");
   parser.AddDefault("point_size", &options.point_size,
                     "splat side (world units) for a cloud given by --model (0: 1.5 x the cloud's "
                     "median neighbour spacing)");

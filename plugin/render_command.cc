@@ -13,6 +13,8 @@
 #include "calib/image_reader.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
+#include "export/gltf_reader.h"
+#include "export/mesh_renderer.h"
 #include "export/point_cloud_io.h"
 #include "export/point_renderer.h"
 #include "calib/view_reader.h"
@@ -35,10 +37,12 @@ int RunRender(int argc, char** argv) {
   double point_size = 0.0;
   OptionParser parser(
       "render",
-      "Draws a coloured point cloud (raycarve's cloud.ply, COLMAP's fused.ply) into cameras of a "
-      "COLMAP model, z-buffered splats: writes <name>.render.png and <name>.silhouette.png per "
+      "Draws a coloured point cloud (raycarve's cloud.ply, COLMAP's fused.ply; z-buffered splats) "
+      "or a mesh (PLY with faces; glTF .glb/.gltf with its texture) into cameras of a COLMAP "
+      "model: writes <name>.render.png and <name>.silhouette.png per "
       "camera (undistorted, pinhole), and with --image_path <name>.side.png (photo | render).");
-  parser.AddRequired("cloud_path", &input, "PLY point cloud to draw");
+  parser.AddRequired("cloud_path", &input,
+                     "the model to draw: a PLY point cloud or mesh, or a glTF mesh (.glb, .gltf)");
   parser.AddDeprecatedName("input", "cloud_path");
   parser.AddRequired("input_path", &model_path, "COLMAP model whose cameras draw it");
   parser.AddRequired("output_path", &output_path, "folder for the images (created)");
@@ -49,7 +53,15 @@ int RunRender(int argc, char** argv) {
   if (!parser.Parse(argc, argv)) return 0;
   if (!(point_size >= 0.0)) throw InputError("raycarve render: --point_size must be >= 0");
   const Reconstruction model = ReadModel(model_path);
-  const std::vector<exporter::ColouredPoint> points = exporter::ReadPointCloudPly(input);
+  // A mesh (PLY with faces, glTF: drawn with its texture) or a cloud (splats; it may be empty).
+  exporter::TriangleMesh mesh;
+  std::vector<exporter::ColouredPoint> points;
+  if (exporter::IsGltfPath(input)) {
+    mesh = exporter::ReadGltf(input);
+  } else {
+    points = exporter::ReadPointCloudPly(input);
+    if (!points.empty()) mesh = exporter::ReadMeshOrCloudPly(input);  // no triangles: a cloud
+  }
   std::set<std::string> wanted;
   std::stringstream list(names);
   std::string name;
@@ -58,7 +70,7 @@ int RunRender(int argc, char** argv) {
   }
   // The images go into the output folder: never the model's, the photos' or the cloud's place.
   CheckOutputFileOutside(output_path, model_path, "input model");
-  CheckOutputFileOutside(output_path, input, "input cloud");
+  CheckOutputFileOutside(output_path, input, "input model file");
   if (!image_path.empty()) CheckOutputFileOutside(output_path, image_path, "photo folder");
   std::error_code error;
   std::filesystem::create_directories(output_path, error);
@@ -89,7 +101,9 @@ int RunRender(int argc, char** argv) {
       cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
     }
     const CalibratedView view = MakeCalibratedView(camera, image, rgb, source);
-    const exporter::Rendering rendering = exporter::RenderPoints(points, view, point_size);
+    const exporter::Rendering rendering = mesh.empty()
+                                              ? exporter::RenderPoints(points, view, point_size)
+                                              : exporter::RenderMesh(mesh, view);
     const std::string file = std::filesystem::path(image.name).filename().string();
     for (const char* suffix : {".render.png", ".silhouette.png", ".side.png"}) {
       CheckNoLinkInside(output_path, file + suffix);
@@ -112,8 +126,11 @@ int RunRender(int argc, char** argv) {
       throw InputError(model_path + ": no image named '" + missing + "' in the model");
     }
   }
-  std::printf("render: drew %zu points into %d cameras of %s; images in %s\n", points.size(),
-              rendered, model_path.c_str(), output_path.c_str());
+  const std::string drawn = mesh.empty() ? std::to_string(points.size()) + " points"
+                                          : std::to_string(mesh.triangles.size()) + " triangles" +
+                                                (mesh.textured() ? " (textured)" : "");
+  std::printf("render: drew %s into %d cameras of %s; images in %s\n", drawn.c_str(), rendered,
+              model_path.c_str(), output_path.c_str());
   return 0;
 }
 

@@ -1,0 +1,34 @@
+// The glTF reader (ReadGltf: tinygltf's parser, then raycarve's own checks of accessors, indices
+// and node trees, and the texture atlas), then what render and holdout --model do next: draw the
+// mesh with its texture.
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+
+#include "calib/input_error.h"
+#include "export/gltf_reader.h"
+#include "export/mesh_renderer.h"
+#include "tests/fuzz/fuzz_target.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  // The reader takes files: one per process, rewritten for every input.
+  static const std::string path = (std::filesystem::temp_directory_path() /
+                                   ("raycarve_gltf_fuzz_" + std::to_string(getpid()) + ".glb"))
+                                      .string();
+  {
+    std::ofstream file(path, std::ios::binary | std::ios::trunc);
+    file.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  }
+  try {
+    const raycarve::exporter::TriangleMesh mesh = raycarve::exporter::ReadGltf(path);
+    raycarve::CalibratedView view;
+    view.width = 32;
+    view.height = 24;
+    view.K << 30, 0, 16, 0, 30, 12, 0, 0, 1;
+    view.P = view.K * view.cam_from_world.ToMatrix();
+    raycarve::exporter::RenderMesh(mesh, view);
+  } catch (const raycarve::InputError&) {
+  }
+  return 0;
+}

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -197,6 +198,16 @@ void CarvePipeline::CheckVolume() {
     run_.voxel_pixels = grid.voxel_size() / pixel;
     run_.supported_resolution =
         static_cast<int>(std::floor(request_.options.resolution * run_.voxel_pixels));
+    if (request_.min_voxel_pixels > 0.0 && run_.voxel_pixels < request_.min_voxel_pixels) {
+      char text[96];
+      std::snprintf(text, sizeof(text), "a voxel would span %.2f pixels of the photos", run_.voxel_pixels);
+      throw InputError("raycarve " + scope_.command + ": --resolution " +
+                       std::to_string(request_.options.resolution) + ": " + text +
+                       " (median at the volume's centre), finer than they resolve: they support "
+                       "about --resolution " + std::to_string(run_.supported_resolution) +
+                       " (a voxel of one pixel). Give a lower --resolution, larger photos "
+                       "(--max_image_size), or --min_voxel_pixels 0 to carve anyway");
+    }
     if (run_.voxel_pixels < 1.0) {
       LOG(WARNING) << "at --resolution " << request_.options.resolution << " a voxel spans "
                    << run_.voxel_pixels << " pixels of the photos (median at the volume's "

@@ -30,6 +30,10 @@ void FinishCarveRequest(CarveRequest* request) {
   std::string reason;
   if (!request->view_options.background.IsValid(&reason)) throw InputError(reason);
   if (!request->options.IsValid(&reason)) throw InputError(reason);
+  if (!(request->min_voxel_pixels >= 0.0) || !std::isfinite(request->min_voxel_pixels)) {
+    throw InputError("--min_voxel_pixels: must be a number >= 0 (0: never refuse), got " +
+                     std::to_string(request->min_voxel_pixels));
+  }
   if (request->options.num_threads != -1 &&
       (request->options.num_threads < 1 || request->options.num_threads > 1024)) {
     throw InputError("--num_threads: must be -1 (every core) or 1 to 1024, got " +

@@ -70,6 +70,12 @@ struct CarveRequest {
 
   // Carve.
   CarveOptions options;
+  // A grid whose voxels span fewer pixels of the photos than this (median at the volume's
+  // centre) is refused before the work: there the photos cannot tell a voxel from its
+  // neighbours, rays pass between voxels that are never judged, and the carve degrades (the
+  // paper scene at 0.93 px: F-score 88% against 94% at 1.85 px; at 0.46 px it collapses to 20%).
+  // 0: never refused.
+  double min_voxel_pixels = 0.5;
   double progress_seconds = 2.0;  // between progress reports
 
   // Surface and colour. mesh.ply: "smooth" (welded, coloured from the photos) or "voxels" (the

@@ -55,6 +55,10 @@ void AddCarvingFlags(OptionParser* parser, CarveRequest* request, CarveFlagText*
   parser->BeginGroup("Carve");
   parser->AddDefault("resolution", &request->options.resolution,
                      "voxels along the longest axis of the volume");
+  parser->AddDefault("min_voxel_pixels", &request->min_voxel_pixels,
+                     "refuse a --resolution whose voxels span fewer pixels of the photos than "
+                     "this (median at the volume's centre; finer than the photos resolve, the "
+                     "carve degrades); 0: never refuse");
   parser->AddDefault("threshold", &text->threshold,
                      "largest consistent error, RGB units 0-255; auto: per level of detail from "
                      "the reliable sparse points: with masks the --auto_threshold_quantile of "

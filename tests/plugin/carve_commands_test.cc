@@ -303,6 +303,27 @@ TEST_F(CarveCommands, ABackdropOfTwoColoursBehindAFrameGivesMasksAndSaysWhatItFo
   EXPECT_GT(JsonNumber(report, "visual_hull_carved"), 0);
 }
 
+TEST_F(CarveCommands, AGridFinerThanThePhotosResolveIsRefusedWithWhatTheySupport) {
+  // The project's photos are 96x72: at 40 voxels a voxel spans pixels (the carve above), at 400
+  // a tenth of that.
+  const std::string out = *root_ + "/too_fine";
+  ExpectUserError("carve --workspace_path " + Project() + " --output_path " + out +
+                      " --resolution 400",
+                  {"--resolution 400: a voxel would span 0.", "pixels of the photos",
+                   "they support about --resolution", "--min_voxel_pixels 0"});
+  EXPECT_FALSE(fs::exists(out + "/report.json"));
+  // The figures behind the refusal, in a carve's report: the supported resolution is the
+  // resolution times the pixels a voxel spans.
+  std::string output;
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + out +
+                    " --resolution 24", &output), 0) << output;
+  const std::string report = testing::ReadFileBytes(out + "/report.json");
+  const double pixels = JsonNumber(report, "voxel_pixels");
+  EXPECT_GT(pixels, 0.5);
+  EXPECT_NEAR(JsonNumber(report, "supported_resolution"), std::floor(24 * pixels), 0.5);
+  EXPECT_LT(JsonNumber(report, "supported_resolution"), 400 * 0.5);
+}
+
 TEST_F(CarveCommands, AVolumeNoPhotoSeesIsRefusedWithWhatEachPhotoSees) {
   // A --bbox far from where the cameras look (as in another frame or unit).
   ExpectUserError("carve --workspace_path " + Project() + " --output_path " + *root_ +

@@ -26,6 +26,10 @@
 namespace raycarve {
 namespace {
 
+// The default resolution is lowered to what the photos resolve, but not below this: a coarser
+// grid than this says the photos are too small for the volume, and the refusal says so.
+constexpr int kMinLoweredResolution = 16;
+
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
@@ -191,34 +195,47 @@ void CarvePipeline::CheckVolume() {
   }
   CheckVolumeSeen(scope_.command, project_, carved_, request_.options.min_views, request_.bounds);
   // Said before the work: a voxel finer than a pixel of the photos gains no detail (the photos
-  // cannot tell its neighbours apart), and each photo sample stands for several voxels.
-  const VoxelGrid grid(project_.bounds.box, request_.options.resolution);
+  // cannot tell its neighbours apart, and rays pass between voxels that are then never judged).
   const double pixel = exporter::MedianPixelFootprint(carved_, project_.bounds.box.center());
-  if (pixel > 0.0) {
+  if (!(pixel > 0.0)) return;
+  const auto measure = [&] {
+    const VoxelGrid grid(project_.bounds.box, request_.options.resolution);
     run_.voxel_pixels = grid.voxel_size() / pixel;
     run_.supported_resolution =
         static_cast<int>(std::floor(request_.options.resolution * run_.voxel_pixels));
-    if (request_.min_voxel_pixels > 0.0 && run_.voxel_pixels < request_.min_voxel_pixels) {
-      char text[96];
-      std::snprintf(text, sizeof(text), "a voxel would span %.2f pixels of the photos", run_.voxel_pixels);
-      throw InputError("raycarve " + scope_.command + ": --resolution " +
-                       std::to_string(request_.options.resolution) + ": " + text +
-                       " (median at the volume's centre), finer than they resolve: they support "
-                       "about --resolution " + std::to_string(run_.supported_resolution) +
-                       " (a voxel of one pixel). Give a lower --resolution, larger photos "
-                       "(--max_image_size), or --min_voxel_pixels 0 to carve anyway");
-    }
-    if (run_.voxel_pixels < 1.0) {
-      LOG(WARNING) << "at --resolution " << request_.options.resolution << " a voxel spans "
-                   << run_.voxel_pixels << " pixels of the photos (median at the volume's "
-                   << "centre): finer than they resolve. They support about --resolution "
-                   << run_.supported_resolution << " (a voxel of one pixel); larger photos "
-                   << "(--max_image_size) or cameras nearer the subject support more";
-    } else {
-      LOG(INFO) << "a voxel spans " << run_.voxel_pixels << " pixels of the photos (median at "
-                << "the volume's centre); they support about --resolution "
-                << run_.supported_resolution;
-    }
+  };
+  measure();
+  char text[96];
+  std::snprintf(text, sizeof(text), "a voxel would span %.2f pixels of the photos", run_.voxel_pixels);
+  if (!request_.resolution_given && run_.voxel_pixels < 1.0 && run_.supported_resolution >= kMinLoweredResolution) {
+    // The default is for photos that resolve it: lowered to what these photos do.
+    LOG(WARNING) << "at the default --resolution " << request_.options.resolution << " " << text
+                 << " (median at the volume's centre), finer than they resolve: carving at "
+                 << "--resolution " << run_.supported_resolution
+                 << " instead (a voxel of one pixel; give --resolution to choose)";
+    run_.resolution_lowered_from = request_.options.resolution;
+    request_.options.resolution = run_.supported_resolution;
+    measure();
+    return;
+  }
+  if (request_.min_voxel_pixels > 0.0 && run_.voxel_pixels < request_.min_voxel_pixels) {
+    throw InputError("raycarve " + scope_.command + ": --resolution " +
+                     std::to_string(request_.options.resolution) + ": " + text +
+                     " (median at the volume's centre), finer than they resolve: they support "
+                     "about --resolution " + std::to_string(run_.supported_resolution) +
+                     " (a voxel of one pixel). Give a lower --resolution, larger photos "
+                     "(--max_image_size), or --min_voxel_pixels 0 to carve anyway");
+  }
+  if (run_.voxel_pixels < 1.0) {
+    LOG(WARNING) << "at --resolution " << request_.options.resolution << " a voxel spans "
+                 << run_.voxel_pixels << " pixels of the photos (median at the volume's "
+                 << "centre): finer than they resolve. They support about --resolution "
+                 << run_.supported_resolution << " (a voxel of one pixel); larger photos "
+                 << "(--max_image_size) or cameras nearer the subject support more";
+  } else {
+    LOG(INFO) << "a voxel spans " << run_.voxel_pixels << " pixels of the photos (median at "
+              << "the volume's centre); they support about --resolution "
+              << run_.supported_resolution;
   }
 }
 

@@ -58,6 +58,8 @@ struct CarveRun {
   // whose voxel would span one pixel (what the photos can support).
   double voxel_pixels = 0.0;
   int supported_resolution = 0;
+  // The default --resolution when it was lowered to supported_resolution (0: not lowered).
+  int resolution_lowered_from = 0;
   // Masks agree.
   MaskAgreementStatistics mask_agreement;
   // Carve.
@@ -152,7 +154,7 @@ class CarvePipeline {
   void WriteReportPage(const std::filesystem::path& staging) const;
   void WriteDenseWorkspace(const std::filesystem::path& staging);
 
-  const CarveRequest request_;
+  CarveRequest request_;  // CheckVolume may lower a default resolution
   const PipelineScope scope_;
   LoadedProject project_;
   std::vector<CalibratedView> carved_;

@@ -142,6 +142,7 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
   json.Key("resolution_support").BeginObject()
       .Key("voxel_pixels").Value(run.voxel_pixels)
       .Key("supported_resolution").Value(run.supported_resolution)
+      .Key("default_lowered_from").Value(run.resolution_lowered_from)
       .EndObject();
   const CaptureLayout& layout = run.layout;
   json.Key("capture").BeginObject()

@@ -74,8 +74,10 @@ struct CarveRequest {
   // centre) is refused before the work: there the photos cannot tell a voxel from its
   // neighbours, rays pass between voxels that are never judged, and the carve degrades (the
   // paper scene at 0.93 px: F-score 88% against 94% at 1.85 px; at 0.46 px it collapses to 20%).
-  // 0: never refused.
+  // 0: never refused. A resolution the user did not give (the default) is instead lowered to
+  // the one whose voxel spans a pixel, whenever its voxels would span less than one.
   double min_voxel_pixels = 0.5;
+  bool resolution_given = true;  // false: options.resolution is the default, and may be lowered
   double progress_seconds = 2.0;  // between progress reports
 
   // Surface and colour. mesh.ply: "smooth" (welded, coloured from the photos) or "voxels" (the

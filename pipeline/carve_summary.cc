@@ -99,7 +99,13 @@ std::string MeshShape(const CarveRun& run) {
 std::string ResolutionText(const CarveRun& run) {
   if (!(run.voxel_pixels > 0.0)) return "";
   char text[320];
-  if (run.voxel_pixels >= 1.0) {
+  if (run.resolution_lowered_from > 0) {
+    std::snprintf(text, sizeof(text),
+                  ", a voxel spans %.2f px of the photos\n"
+                  "  resolution      the default %d lowered to %d: the photos resolve no finer "
+                  "(--resolution chooses)",
+                  run.voxel_pixels, run.resolution_lowered_from, run.supported_resolution);
+  } else if (run.voxel_pixels >= 1.0) {
     std::snprintf(text, sizeof(text), ", a voxel spans %.2f px of the photos", run.voxel_pixels);
   } else {
     std::snprintf(text, sizeof(text),

@@ -64,7 +64,7 @@ int RunBenchmark(int argc, char** argv) {
   parser.AddExample("raycarve benchmark --workspace_path P --reference P/truth.ply",
                     "the paper's Table 1 and Figure 6 on P, each cloud against a true surface");
   if (!parser.Parse(argc, argv)) return 0;
-  ApplyCarveFlags(text, &request);
+  ApplyCarveFlags(parser, text, &request);
   options.methods = ParseMethods(methods_text);
   const MethodComparison comparison = CompareCarveMethods(request, options);
   std::printf("\n%s\n%s\nwritten to %s/ (benchmark.json, table.md, figure6.csv, figure6.png)\n",

@@ -34,7 +34,7 @@ int RunCarve(int argc, char** argv) {
   parser.AddExample("raycarve carve --workspace_path P --bbox -1,-1,0,1,1,1.5 --background_colour none",
                     "an explicit volume, no masks (a scene without a plain backdrop)");
   if (!parser.Parse(argc, argv)) return 0;
-  ApplyCarveFlags(text, &request);
+  ApplyCarveFlags(parser, text, &request);
 
   ProgressDisplay display;
   PipelineScope scope;

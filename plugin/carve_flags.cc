@@ -277,7 +277,8 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   parser->BeginGroup("");
 }
 
-void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request) {
+void ApplyCarveFlags(const OptionParser& parser, const CarveFlagText& text, CarveRequest* request) {
+  request->resolution_given = parser.IsSet("resolution");
   if (text.pattern_threshold == "auto") {
     request->options.auto_pattern_threshold = true;
     request->options.pattern_threshold = kFallbackPatternThreshold;

@@ -38,7 +38,9 @@ struct CarveFlagText {
   std::string background = "auto";
 };
 void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* text);
-void ApplyCarveFlags(const CarveFlagText& text, CarveRequest* request);
+// `parser` (after Parse) says which flags were given: a --resolution not given may be lowered to
+// what the photos resolve (CarveRequest::resolution_given).
+void ApplyCarveFlags(const OptionParser& parser, const CarveFlagText& text, CarveRequest* request);
 
 // The carve options a user changes first: what `--help` shows of carve and holdout.
 extern const char* const kBasicCarveFlags[10];

@@ -83,7 +83,7 @@ int RunHoldout(int argc, char** argv) {
   parser.AddExample("raycarve holdout --workspace_path P --model P/dense/fused.ply",
                     "score another model (COLMAP's fused cloud) on the same held-out photos");
   if (!parser.Parse(argc, argv)) return 0;
-  ApplyCarveFlags(text, &request);
+  ApplyCarveFlags(parser, text, &request);
   PrintEvaluation(EvaluateHeldOutViews(request, options));
   return 0;
 }

@@ -322,6 +322,18 @@ TEST_F(CarveCommands, AGridFinerThanThePhotosResolveIsRefusedWithWhatTheySupport
   EXPECT_GT(pixels, 0.5);
   EXPECT_NEAR(JsonNumber(report, "supported_resolution"), std::floor(24 * pixels), 0.5);
   EXPECT_LT(JsonNumber(report, "supported_resolution"), 400 * 0.5);
+  EXPECT_EQ(JsonNumber(report, "default_lowered_from"), 0);  // given: never lowered
+  // The default (128) is lowered to what the photos resolve, and says so.
+  const std::string lowered = *root_ + "/default_resolution";
+  ASSERT_EQ(Run("carve --workspace_path " + Project() + " --output_path " + lowered, &output), 0)
+      << output;
+  EXPECT_NE(output.find("the default 128 lowered to"), std::string::npos) << output;
+  const std::string lowered_report = testing::ReadFileBytes(lowered + "/report.json");
+  EXPECT_EQ(JsonNumber(lowered_report, "default_lowered_from"), 128);
+  const int supported = static_cast<int>(JsonNumber(lowered_report, "supported_resolution"));
+  EXPECT_LT(supported, 128);
+  EXPECT_NEAR(JsonNumber(lowered_report, "voxel_pixels"), 1.0, 0.1);
+  EXPECT_EQ(JsonNumber(lowered_report, "resolution"), supported);
 }
 
 TEST_F(CarveCommands, AVolumeNoPhotoSeesIsRefusedWithWhatEachPhotoSees) {

@@ -169,7 +169,8 @@ std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid&
   return on_wall;
 }
 
-void RemoveGridWalls(ModelMesh* model) {
+void RemoveGridWalls(ModelMesh* model, const std::vector<Eigen::Vector3d>& anchors,
+                     double anchor_radius) {
   TriangleMesh& mesh = model->mesh;
   CHECK(model->on_grid_wall.size() == mesh.vertices.size());
   model->triangles_before_walls = static_cast<int64_t>(mesh.triangles.size());
@@ -183,6 +184,17 @@ void RemoveGridWalls(ModelMesh* model) {
     }
   }
   if (model->wall_triangles_removed == 0) return;
+  mesh.triangles = std::move(kept);
+  // Slivers that only the wall held to the rest: specks now (SpeckVertices), left out too.
+  const std::vector<uint8_t> speck = SpeckVertices(mesh, anchors, anchor_radius);
+  kept.clear();
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    if (speck[t[0]]) {
+      ++model->wall_sliver_triangles_removed;
+    } else {
+      kept.push_back(t);
+    }
+  }
   mesh.triangles = std::move(kept);
   // The vertices still used, renumbered in order, with everything kept per vertex.
   std::vector<int> new_index(mesh.vertices.size(), -1);
@@ -321,7 +333,15 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   model.on_grid_wall = GridWallVertices(model.mesh, grid);
   model.grid_wall_vertices =
       std::count(model.on_grid_wall.begin(), model.on_grid_wall.end(), uint8_t{1});
-  if (options.remove_grid_walls) RemoveGridWalls(&model);
+  if (options.remove_grid_walls) {
+    RemoveGridWalls(&model, options.sparse_points, 1.5 * grid.voxel_size());
+    if (model.wall_sliver_triangles_removed > 0) {
+      tell("mesh walls: " + std::to_string(model.wall_triangles_removed) + " triangles on the " +
+           "volume box's walls left out, then " +
+           std::to_string(model.wall_sliver_triangles_removed) + " triangles of slivers only the " +
+           "walls held to the model (no sparse point on them)");
+    }
+  }
   MeshColouringOptions colouring;
   colouring.min_views = options.min_views;
   colouring.depth_tolerance = grid.voxel_size();

@@ -125,12 +125,16 @@ struct ModelMesh {
   std::vector<uint8_t> on_grid_wall;
   int64_t grid_wall_vertices = 0;    // before the wall's triangles are left out
   int64_t wall_triangles_removed = 0;
+  int64_t wall_sliver_triangles_removed = 0;  // specks the walls' removal left (not counted above)
   int64_t triangles_before_walls = 0;
 };
 
 // Leaves out the triangles whose three corners are on the grid's wall (model->on_grid_wall),
-// and the vertices no triangle uses any more (with their per-vertex data), counting them.
-void RemoveGridWalls(ModelMesh* model);
+// then the parts that become specks without them (SpeckVertices: under 1% of the largest part,
+// no anchor of `anchors` within `anchor_radius` nearer to them than to the largest part), and
+// the vertices no triangle uses any more (with their per-vertex data), counting them.
+void RemoveGridWalls(ModelMesh* model, const std::vector<Eigen::Vector3d>& anchors = {},
+                     double anchor_radius = 0.0);
 // Per vertex of `mesh` (with normals), 1 where it lies on the wall of `grid` (see
 // ModelMesh::on_grid_wall).
 std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid& grid);

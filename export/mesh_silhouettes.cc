@@ -191,7 +191,37 @@ std::vector<uint8_t> AnchoredParts(const TriangleMesh& mesh, const std::vector<i
   return anchored;
 }
 
+// Per part: a speck (under kSpeckShare of the largest part's vertices, not anchored).
+std::vector<uint8_t> SpeckParts(const std::vector<int64_t>& part_vertices, int largest,
+                                const std::vector<uint8_t>& anchored) {
+  std::vector<uint8_t> speck(part_vertices.size(), 0);
+  for (size_t p = 0; p < part_vertices.size(); ++p) {
+    speck[p] = static_cast<int>(p) != largest && !anchored[p] &&
+               part_vertices[p] < kSpeckShare * static_cast<double>(part_vertices[largest]);
+  }
+  return speck;
+}
+
 }  // namespace
+
+std::vector<uint8_t> SpeckVertices(const TriangleMesh& mesh,
+                                   const std::vector<Eigen::Vector3d>& anchors,
+                                   double anchor_radius) {
+  std::vector<uint8_t> on_speck(mesh.vertices.size(), 0);
+  int parts = 0;
+  const std::vector<int> part = ConnectedParts(mesh, &parts);
+  if (parts < 2 || anchors.empty()) return on_speck;
+  std::vector<int64_t> part_vertices(parts, 0);
+  for (const int p : part) {
+    if (p >= 0) ++part_vertices[p];
+  }
+  const int largest = static_cast<int>(
+      std::max_element(part_vertices.begin(), part_vertices.end()) - part_vertices.begin());
+  const std::vector<uint8_t> speck =
+      SpeckParts(part_vertices, largest, AnchoredParts(mesh, part, parts, largest, anchors, anchor_radius));
+  for (size_t i = 0; i < part.size(); ++i) on_speck[i] = part[i] >= 0 && speck[part[i]];
+  return on_speck;
+}
 
 MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
                                      int min_needing_views,
@@ -220,13 +250,11 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
     // No masks to say what the model needs: the sparse points alone speak for small parts.
     const std::vector<uint8_t> anchored =
         AnchoredParts(*mesh, part, parts, largest, anchors, anchor_radius);
+    const std::vector<uint8_t> speck = SpeckParts(part_vertices, largest, anchored);
     std::vector<uint8_t> keep(parts, 1);
     for (int p = 0; p < parts; ++p) {
-      if (p == largest || anchored[p] ||
-          part_vertices[p] >= kSpeckShare * static_cast<double>(part_vertices[largest])) {
-        summary.anchored += p != largest && anchored[p];
-        continue;
-      }
+      summary.anchored += p != largest && anchored[p] && !speck[p];
+      if (!speck[p]) continue;
       keep[p] = 0;
       ++summary.removed;
       summary.removed_vertices += part_vertices[p];

@@ -50,6 +50,13 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
                                      const std::vector<Eigen::Vector3d>& anchors,
                                      double anchor_radius, int num_threads, TriangleMesh* mesh);
 
+// Per vertex of `mesh`: 1 where it belongs to a speck as RemoveUnneededParts judges parts
+// without masks (a part under kSpeckShare of the largest part's vertices with no anchor within
+// `anchor_radius` nearer to it than to the largest part); all 0 without anchors or with one part.
+std::vector<uint8_t> SpeckVertices(const TriangleMesh& mesh,
+                                   const std::vector<Eigen::Vector3d>& anchors,
+                                   double anchor_radius);
+
 // Pulls the vertices of a closed mesh's outlines in along their normals onto the masks' edges.
 //
 // The carve keeps whole voxels and the iso-surface and its smoothing round them, so the mesh's

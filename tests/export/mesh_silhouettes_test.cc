@@ -283,6 +283,18 @@ TEST(RemoveUnneededParts, WithoutMasksSpecksGoUnlessASparsePointIsTheirs) {
   mesh = all;
   EXPECT_EQ(RemoveUnneededParts(views, 2, {}, 0.125, 0, &mesh).removed, 0);
   EXPECT_EQ(mesh.vertices.size(), all.vertices.size());
+  // SpeckVertices (what the box's walls' removal uses) marks the same two specks' vertices.
+  const std::vector<uint8_t> speck = SpeckVertices(all, anchors, 0.125);
+  ASSERT_EQ(speck.size(), all.vertices.size());
+  size_t offset = ball.vertices.size();
+  for (const TriangleMesh* part : {&lone, &featured, &beside, &object}) {
+    const bool expected = part == &lone || part == &beside;
+    for (size_t i = 0; i < part->vertices.size(); ++i) EXPECT_EQ(speck[offset + i], expected);
+    offset += part->vertices.size();
+  }
+  for (size_t i = 0; i < ball.vertices.size(); ++i) EXPECT_EQ(speck[i], 0);
+  const std::vector<uint8_t> without_anchors = SpeckVertices(all, {}, 0.125);
+  EXPECT_EQ(std::count(without_anchors.begin(), without_anchors.end(), 1), 0);
 }
 
 }  // namespace

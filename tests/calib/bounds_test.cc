@@ -12,6 +12,7 @@
 #include "calib/model_reader.h"
 #include "samples/synthetic_scene.h"
 #include "tests/test_support.h"
+#include "tests/scene_options.h"
 
 namespace raycarve {
 namespace {
@@ -160,11 +161,7 @@ TEST(Bounds, WithoutTrimmingOutliersStretchTheBox) {
 TEST(Bounds, TheRoomAroundTheObjectIsLeftOut) {
   // The generated scene in a textured room whose floor and wall hold as many sparse points as the
   // scene: the room is framed by the few photos facing it, the scene by all of them.
-  SyntheticSceneOptions options;
-  options.num_views = 12;
-  options.width = 160;
-  options.height = 120;
-  options.num_surface_samples = 1500;
+  SyntheticSceneOptions options = testing::SceneOptions(12, 160, 120, false, 1500);
   options.backdrop = Backdrop::kRoom;
   const SyntheticScene room = GenerateSyntheticScene(options);
   BoundsOptions keep_all;

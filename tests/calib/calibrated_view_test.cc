@@ -15,17 +15,14 @@
 #include "calib/view_reader.h"
 #include "samples/synthetic_scene.h"
 #include "tests/test_support.h"
+#include "tests/scene_options.h"
 
 namespace raycarve {
 namespace {
 
 SyntheticSceneOptions SmallScene(CameraModelId model) {
-  SyntheticSceneOptions options;
-  options.num_views = 5;
-  options.width = 160;
-  options.height = 120;
+  SyntheticSceneOptions options = testing::SceneOptions(5, 160, 120, false, 400);
   options.camera_model = model;
-  options.num_surface_samples = 400;
   options.supersampling = 1;
   return options;
 }

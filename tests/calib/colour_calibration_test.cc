@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "samples/synthetic_scene.h"
+#include "tests/scene_options.h"
 
 namespace raycarve {
 namespace {
@@ -28,14 +29,7 @@ double MeanDifference(const CalibratedView& a, const CalibratedView& b) {
 }
 
 // Eight photos of 200x150 with 3000 candidate sparse points.
-SyntheticSceneOptions EightPhotos() {
-  SyntheticSceneOptions options;
-  options.num_views = 8;
-  options.width = 200;
-  options.height = 150;
-  options.num_surface_samples = 3000;
-  return options;
-}
+SyntheticSceneOptions EightPhotos() { return testing::SceneOptions(8, 200, 150, false, 3000); }
 
 TEST(ColourCalibration, UndoesKnownExposureAndWhiteBalanceChangesOfSomePhotos) {
   const SyntheticScene scene = GenerateSyntheticScene(EightPhotos());
@@ -114,12 +108,7 @@ TEST(ColourCalibration, PaysWhereExposuresDifferNotWherePhotosAgree) {
 }
 
 TEST(ColourCalibration, WithoutSharedPointsNothingChanges) {
-  SyntheticSceneOptions options;
-  options.num_views = 3;
-  options.width = 64;
-  options.height = 48;
-  options.num_surface_samples = 0;
-  const SyntheticScene scene = GenerateSyntheticScene(options);
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(3, 64, 48));
   std::vector<CalibratedView> views = Views(scene);
   const ColourCalibration calibration = EstimateColourCalibration(scene.reconstruction, views);
   EXPECT_EQ(calibration.points_used, 0);

@@ -10,25 +10,10 @@
 #include "carve/visibility.h"
 #include "carve/volume.h"
 #include "samples/synthetic_scene.h"
+#include "tests/scene_options.h"
 
 namespace raycarve {
 namespace testing {
-
-// Options of a small synthetic scene for tests: `views` cameras of `width` x `height`, no sparse
-// points unless asked, and a patchwork sky or a uniform backdrop.
-inline SyntheticSceneOptions SceneOptions(int views,
-                                          int width,
-                                          int height,
-                                          bool uniform_backdrop = false,
-                                          int surface_samples = 0) {
-  SyntheticSceneOptions options;
-  options.num_views = views;
-  options.width = width;
-  options.height = height;
-  options.num_surface_samples = surface_samples;
-  options.backdrop = uniform_backdrop ? Backdrop::kUniform : Backdrop::kPatchwork;
-  return options;
-}
 
 // A small generated scene with 2,000 sparse points and a patchwork sky.
 inline SyntheticScene Scene(int views, int width, int height) {

@@ -10,18 +10,12 @@
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
 #include "tests/test_support.h"
+#include "tests/scene_options.h"
 
 namespace raycarve {
 namespace {
 
-SyntheticSceneOptions Small() {
-  SyntheticSceneOptions options;
-  options.num_views = 6;
-  options.width = 200;
-  options.height = 150;
-  options.num_surface_samples = 600;
-  return options;
-}
+SyntheticSceneOptions Small() { return testing::SceneOptions(6, 200, 150, false, 600); }
 
 TEST(SyntheticScene, SameOptionsGiveTheSameSceneBitForBit) {
   const SyntheticScene a = GenerateSyntheticScene(Small());

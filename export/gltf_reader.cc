@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -32,6 +33,40 @@ struct ImageLoad {
   std::map<int, cv::Mat> images;
 };
 
+// The most texels one texture may have: 8192 x 8192 (192 MiB decoded). A header that announces
+// more is refused before decoding (a small PNG of zeros can announce gigabytes).
+constexpr int64_t kMaxTexturePixels = int64_t{1} << 26;
+
+// The width and height a PNG's IHDR or a JPEG's frame header announces; {0, 0} when not found.
+std::pair<int64_t, int64_t> AnnouncedSize(const unsigned char* bytes, int size, bool png) {
+  const auto big_endian = [bytes](int at, int count) {
+    int64_t value = 0;
+    for (int k = 0; k < count; ++k) value = (value << 8) | bytes[at + k];
+    return value;
+  };
+  if (png) {
+    if (size < 24) return {0, 0};
+    return {big_endian(16, 4), big_endian(20, 4)};
+  }
+  // JPEG: segments after SOI; a start of frame (0xC0-0xCF but 0xC4, 0xC8, 0xCC) holds the size.
+  int at = 2;
+  while (at + 9 < size) {
+    if (bytes[at] != 0xFF) return {0, 0};
+    const int marker = bytes[at + 1];
+    if (marker == 0xFF) {
+      ++at;
+      continue;
+    }
+    const int length = static_cast<int>(big_endian(at + 2, 2));
+    if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC) {
+      return {big_endian(at + 7, 2), big_endian(at + 5, 2)};
+    }
+    if (length < 2) return {0, 0};
+    at += 2 + length;
+  }
+  return {0, 0};
+}
+
 bool DecodeImage(tinygltf::Image* image, const int index, std::string* error, std::string*, int,
                  int, const unsigned char* bytes, int size, void* user_data) {
   auto* load = static_cast<ImageLoad*>(user_data);
@@ -55,8 +90,22 @@ bool DecodeImage(tinygltf::Image* image, const int index, std::string* error, st
   static const unsigned char kJpeg[3] = {0xFF, 0xD8, 0xFF};
   const bool png = size >= 8 && std::memcmp(bytes, kPng, 8) == 0;
   const bool jpeg = size >= 3 && std::memcmp(bytes, kJpeg, 3) == 0;
+  if (png || jpeg) {
+    const auto [width, height] = AnnouncedSize(bytes, size, png);
+    if (width <= 0 || height <= 0 || width > kMaxTexturePixels / height) {
+      *error = name + ": its header announces " + std::to_string(width) + " x " +
+               std::to_string(height) + " pixels (at most " + std::to_string(kMaxTexturePixels) +
+               " are read)";
+      return false;
+    }
+  }
   cv::Mat encoded(1, std::max(size, 0), CV_8UC1, const_cast<unsigned char*>(bytes));
-  cv::Mat bgr = png || jpeg ? cv::imdecode(encoded, cv::IMREAD_COLOR) : cv::Mat();
+  cv::Mat bgr;
+  try {
+    if (png || jpeg) bgr = cv::imdecode(encoded, cv::IMREAD_COLOR);
+  } catch (const cv::Exception&) {
+    bgr = cv::Mat();
+  }
   if (bgr.empty()) {
     *error = name + " does not decode as PNG or JPEG";
     return false;

@@ -148,6 +148,16 @@ TEST(ReadGltf, DamagedFilesAreRefusedNamingTheFile) {
   std::memcpy(far_index.buffers[view.buffer].data.data() + view.byteOffset + indices.byteOffset, &far, 4);
   ASSERT_TRUE(io.WriteGltfSceneToFile(&far_index, folder + "/far.glb", false, true, false, true));
   expect_refused(folder + "/far.glb", "past the primitive's");
+  // A texture whose PNG header announces 100,000 x 100,000 pixels: refused before decoding.
+  std::string huge = bytes;
+  const size_t png = huge.find("\x89PNG\r\n\x1a\n");
+  ASSERT_NE(png, std::string::npos);
+  for (const size_t at : {png + 16, png + 20}) {
+    const char size[4] = {0, 0x01, static_cast<char>(0x86), static_cast<char>(0xA0)};  // 100000
+    huge.replace(at, 4, size, 4);
+  }
+  testing::WriteFile(folder + "/huge.glb", huge);
+  expect_refused(folder + "/huge.glb", "announces 100000 x 100000 pixels");
 }
 
 }  // namespace

@@ -10,5 +10,28 @@
 // input holds.
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
+
+namespace raycarve {
+namespace fuzzing {
+
+// For readers that take a file: `data` written to one temporary file per process and per `name`
+// (raycarve_<name>_fuzz_<pid><extension>), rewritten for every input; returns its path.
+inline std::string WriteInputFile(const std::string& name, const std::string& extension,
+                                  const uint8_t* data, size_t size) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("raycarve_" + name + "_fuzz_" + std::to_string(getpid()) + extension))
+                               .string();
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  file.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  return path;
+}
+
+}  // namespace fuzzing
+}  // namespace raycarve

@@ -18,13 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     return true;
   }();
   (void)limited;
-  static const std::string path = (std::filesystem::temp_directory_path() /
-                                   ("raycarve_image_fuzz_" + std::to_string(getpid()) + ".img"))
-                                      .string();
-  {
-    std::ofstream file(path, std::ios::binary | std::ios::trunc);
-    file.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
-  }
+  const std::string path = raycarve::fuzzing::WriteInputFile("image", ".img", data, size);
   for (const int flags : {cv::IMREAD_COLOR, cv::IMREAD_GRAYSCALE}) {
     try {
       const cv::Mat image = raycarve::ReadImage(path, flags);

@@ -12,14 +12,7 @@
 #include "tests/fuzz/fuzz_target.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  // The readers take files: one per process, rewritten for every input.
-  static const std::string path = (std::filesystem::temp_directory_path() /
-                                   ("raycarve_ply_fuzz_" + std::to_string(getpid()) + ".ply"))
-                                      .string();
-  {
-    std::ofstream file(path, std::ios::binary | std::ios::trunc);
-    file.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
-  }
+  const std::string path = raycarve::fuzzing::WriteInputFile("ply", ".ply", data, size);
   try {
     const std::vector<raycarve::exporter::ColouredPoint> cloud = raycarve::exporter::ReadPointCloudPly(path);
     std::vector<Eigen::Vector3f> xyz;

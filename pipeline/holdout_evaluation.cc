@@ -12,7 +12,7 @@
 
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
-#include "export/gltf_reader.h"
+#include "export/mesh_file_reader.h"
 #include "export/carve_export.h"
 #include "export/mesh_renderer.h"
 #include "export/point_cloud_compare.h"

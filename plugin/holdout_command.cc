@@ -67,8 +67,8 @@ int RunHoldout(int argc, char** argv) {
   parser.AddDefault("model", &options.model_path,
                     "score this model instead of carving, on the same held-out views: a PLY "
                     "mesh or cloud (COLMAP's fused.ply, a mesh with vertex colours) or a glTF "
-                    "mesh drawn with its texture (.glb, .gltf: raycarve's mesh.glb, another "
-                    "tool's)");
+                    "or OBJ mesh drawn with its texture (.glb, .gltf, .obj: raycarve's mesh.glb "
+                    "or mesh.obj, another tool's)");
   parser.AddDefault("point_size", &options.point_size,
                     "splat side (world units) for a cloud given by --model (0: 1.5 x the cloud's "
                     "median neighbour spacing)");

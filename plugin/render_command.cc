@@ -13,7 +13,7 @@
 #include "calib/image_reader.h"
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
-#include "export/gltf_reader.h"
+#include "export/mesh_file_reader.h"
 #include "export/mesh_renderer.h"
 #include "export/point_cloud_io.h"
 #include "export/point_renderer.h"
@@ -38,11 +38,11 @@ int RunRender(int argc, char** argv) {
   OptionParser parser(
       "render",
       "Draws a coloured point cloud (raycarve's cloud.ply, COLMAP's fused.ply; z-buffered splats) "
-      "or a mesh (PLY with faces; glTF .glb/.gltf with its texture) into cameras of a COLMAP "
+      "or a mesh (PLY with faces; glTF .glb/.gltf or OBJ with its texture) into cameras of a COLMAP "
       "model: writes <name>.render.png and <name>.silhouette.png per "
       "camera (undistorted, pinhole), and with --image_path <name>.side.png (photo | render).");
   parser.AddRequired("cloud_path", &input,
-                     "the model to draw: a PLY point cloud or mesh, or a glTF mesh (.glb, .gltf)");
+                     "the model to draw: a PLY point cloud or mesh, or a glTF (.glb, .gltf) or OBJ mesh");
   parser.AddDeprecatedName("input", "cloud_path");
   parser.AddRequired("input_path", &model_path, "COLMAP model whose cameras draw it");
   parser.AddRequired("output_path", &output_path, "folder for the images (created)");
@@ -53,11 +53,11 @@ int RunRender(int argc, char** argv) {
   if (!parser.Parse(argc, argv)) return 0;
   if (!(point_size >= 0.0)) throw InputError("raycarve render: --point_size must be >= 0");
   const Reconstruction model = ReadModel(model_path);
-  // A mesh (PLY with faces, glTF: drawn with its texture) or a cloud (splats; it may be empty).
+  // A mesh (PLY with faces; glTF or OBJ, drawn with its texture) or a cloud (splats; it may be empty).
   exporter::TriangleMesh mesh;
   std::vector<exporter::ColouredPoint> points;
-  if (exporter::IsGltfPath(input)) {
-    mesh = exporter::ReadGltf(input);
+  if (exporter::IsGltfPath(input) || exporter::IsObjPath(input)) {
+    mesh = exporter::ReadModelFile(input);
   } else {
     points = exporter::ReadPointCloudPly(input);
     if (!points.empty()) mesh = exporter::ReadMeshOrCloudPly(input);  // no triangles: a cloud

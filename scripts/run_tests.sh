@@ -16,7 +16,7 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYCARVE_ASAN_ENABL
 cmake --build build-asan -j"$jobs" --target raycarve calib_model_reader_test calib_middlebury_test \
   calib_colmap_program_test export_point_cloud_io_test plugin_option_parser_test \
   plugin_command_line_test plugin_model_input_test plugin_carve_commands_test \
-  fuzz_model_reader fuzz_middlebury fuzz_ply fuzz_option_parser fuzz_image fuzz_gltf >&2
+  fuzz_model_reader fuzz_middlebury fuzz_ply fuzz_option_parser fuzz_image fuzz_gltf fuzz_obj >&2
 (cd build-asan && ctest --output-on-failure --timeout 900 -j"$jobs" \
   -R 'calib/(model_reader|middlebury|colmap_program)_test|export/point_cloud_io_test|'\
 'plugin/(option_parser|command_line|model_input|carve_commands)_test|fuzz/')

@@ -7,7 +7,7 @@
 #include <unistd.h>
 
 #include "calib/input_error.h"
-#include "export/gltf_reader.h"
+#include "export/mesh_file_reader.h"
 #include "export/mesh_renderer.h"
 #include "tests/fuzz/fuzz_target.h"
 

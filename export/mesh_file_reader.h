@@ -1,6 +1,7 @@
 #pragma once
-// Reading a textured mesh that another program (or raycarve) wrote as glTF 2.0, so that holdout
-// can score it and render can draw it. tinygltf stays inside the .cc file.
+// Reading a textured mesh that another program (or raycarve) wrote, as glTF 2.0 or Wavefront OBJ,
+// so that holdout can score it and render can draw it. tinygltf and tinyobjloader stay inside
+// the .cc file.
 
 #include <string>
 
@@ -22,11 +23,21 @@ namespace exporter {
 // its buffer, an index past the vertices, no triangles, an image that does not decode).
 TriangleMesh ReadGltf(const std::string& path);
 
+// Reads a Wavefront OBJ mesh (tinyobjloader; polygons fanned into triangles) with the materials
+// of its .mtl: the diffuse texture maps (map_Kd, beside the OBJ or as the MTL names them) side by
+// side in one atlas as ReadGltf does, with the OBJ's texture coordinates (v up) turned to v
+// down; vertex colours where the file has them; normals computed from the triangles. Throws
+// InputError naming the file (an index past the vertices, no triangles, a texture that cannot be
+// read or announces more than 8192 x 8192 texels).
+TriangleMesh ReadObj(const std::string& path);
+
 // Whether `path` names a glTF file (extension .glb or .gltf, any case).
 bool IsGltfPath(const std::string& path);
+// Whether `path` names an OBJ file (extension .obj, any case).
+bool IsObjPath(const std::string& path);
 
-// The model at `path` by its extension: .glb or .gltf (ReadGltf), else PLY (ReadMeshOrCloudPly:
-// a mesh, or a cloud with no triangles).
+// The model at `path` by its extension: .glb or .gltf (ReadGltf), .obj (ReadObj), else PLY
+// (ReadMeshOrCloudPly: a mesh, or a cloud with no triangles).
 TriangleMesh ReadModelFile(const std::string& path);
 
 }  // namespace exporter

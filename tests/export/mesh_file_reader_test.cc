@@ -1,10 +1,11 @@
 // Reading glTF back: raycarve's own mesh.glb (textured and vertex-coloured) must draw as the mesh
 // it was written from; node transforms place the vertices; damaged files are refused with the
 // file named, never read past their buffers.
-#include "export/gltf_reader.h"
+#include "export/mesh_file_reader.h"
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -68,6 +69,40 @@ TEST(ReadGltf, RaycarvesTexturedGlbDrawsAsTheMeshItWasWrittenFrom) {
   ASSERT_GT(cv::countNonZero(original.silhouette), 2000);
   // The atlas moves the texture by a column: bilinear samples agree within a level on average.
   EXPECT_LT(MeanDifference(original.image, again.image), 1.0);
+}
+
+TEST(ReadObj, RaycarvesTexturedObjDrawsAsTheMeshItWasWrittenFrom) {
+  const std::string folder = testing::MakeTemporaryDirectory("obj_textured");
+  const TriangleMesh mesh = TexturedQuad();
+  WriteTexturedObj(mesh, folder + "/mesh.obj");
+  const TriangleMesh read = ReadModelFile(folder + "/mesh.obj");
+  ASSERT_TRUE(read.textured());
+  ASSERT_EQ(read.triangles.size(), 2u);
+  for (size_t t = 0; t < 2; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(read.vertices[read.triangles[t][k]], mesh.vertices[mesh.triangles[t][k]]);
+    }
+  }
+  const CalibratedView view = testing::PinholeViewAtOrigin(80, 60, 100);
+  const Rendering original = RenderMesh(mesh, view);
+  const Rendering again = RenderMesh(read, view);
+  EXPECT_EQ(cv::countNonZero(original.silhouette != again.silhouette), 0);
+  EXPECT_LT(MeanDifference(original.image, again.image), 1.0);
+  // Damaged: a face past the vertices, a texture that is not there.
+  testing::WriteFile(folder + "/far.obj", "v 0 0 1\nv 1 0 1\nv 0 1 1\nf 1 2 9\n");
+  try {
+    ReadObj(folder + "/far.obj");
+    ADD_FAILURE() << "far.obj was read";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find(folder + "/far.obj"), std::string::npos) << error.what();
+  }
+  std::filesystem::remove(folder + "/mesh_texture.png");
+  try {
+    ReadObj(folder + "/mesh.obj");
+    ADD_FAILURE() << "mesh.obj was read without its texture";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("mesh_texture.png"), std::string::npos) << error.what();
+  }
 }
 
 TEST(ReadGltf, VertexColoursComeBackAsTheirSrgbBytes) {

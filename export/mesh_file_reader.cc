@@ -39,6 +39,22 @@ struct ImageLoad {
 // more is refused before decoding (a small PNG of zeros can announce gigabytes).
 constexpr int64_t kMaxTexturePixels = int64_t{1} << 26;
 
+// Why a texture of `width` x `height` is not read ("" when it is): not a size, or more texels
+// than kMaxTexturePixels (checked without overflow).
+std::string TextureSizeRefusal(int64_t width, int64_t height) {
+  if (width > 0 && height > 0 && width <= kMaxTexturePixels / height) return "";
+  return std::to_string(width) + " x " + std::to_string(height) + " pixels (at most " +
+         std::to_string(kMaxTexturePixels) + " are read)";
+}
+
+// A path's extension in lower case (".glb", ".obj"; "" without one).
+std::string LowerCaseExtension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
 // The width and height a PNG's IHDR or a JPEG's frame header announces; {0, 0} when not found.
 std::pair<int64_t, int64_t> AnnouncedSize(const unsigned char* bytes, int size, bool png) {
   const auto big_endian = [bytes](int at, int count) {
@@ -94,10 +110,9 @@ bool DecodeImage(tinygltf::Image* image, const int index, std::string* error, st
   const bool jpeg = size >= 3 && std::memcmp(bytes, kJpeg, 3) == 0;
   if (png || jpeg) {
     const auto [width, height] = AnnouncedSize(bytes, size, png);
-    if (width <= 0 || height <= 0 || width > kMaxTexturePixels / height) {
-      *error = name + ": its header announces " + std::to_string(width) + " x " +
-               std::to_string(height) + " pixels (at most " + std::to_string(kMaxTexturePixels) +
-               " are read)";
+    const std::string refusal = TextureSizeRefusal(width, height);
+    if (!refusal.empty()) {
+      *error = name + ": its header announces " + refusal;
       return false;
     }
   }
@@ -366,8 +381,7 @@ TriangleMesh ReadGltf(const std::string& path) {
   loader.SetImageLoader(DecodeImage, &load);
   const std::map<int, cv::Mat>& images = load.images;
   std::string error, warning;
-  std::string extension = std::filesystem::path(path).extension().string();
-  const bool binary = extension != ".gltf" && extension != ".GLTF";
+  const bool binary = LowerCaseExtension(path) != ".gltf";
   const bool loaded = binary ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
                              : loader.LoadASCIIFromFile(&model, &error, &warning, path);
   if (!loaded) {
@@ -463,11 +477,8 @@ TriangleMesh ReadObj(const std::string& path) {
       continue;
     }
     const cv::Size size = ReadImageSize(file);
-    if (size.width <= 0 || size.height <= 0 || size.width > kMaxTexturePixels / size.height) {
-      throw InputError(file + ": the texture of " + path + " is " + std::to_string(size.width) +
-                       " x " + std::to_string(size.height) + " pixels (at most " +
-                       std::to_string(kMaxTexturePixels) + " are read)");
-    }
+    const std::string refusal = TextureSizeRefusal(size.width, size.height);
+    if (!refusal.empty()) throw InputError(file + ": the texture of " + path + " is " + refusal);
     const cv::Mat bgr = ReadImage(file, cv::IMREAD_COLOR);
     if (bgr.empty()) throw InputError(file + ": the texture of " + path + " cannot be decoded");
     cv::Mat rgb;
@@ -522,17 +533,10 @@ TriangleMesh ReadObj(const std::string& path) {
   return std::move(gathered.mesh);
 }
 
-bool IsObjPath(const std::string& path) {
-  std::string extension = std::filesystem::path(path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension == ".obj";
-}
+bool IsObjPath(const std::string& path) { return LowerCaseExtension(path) == ".obj"; }
 
 bool IsGltfPath(const std::string& path) {
-  std::string extension = std::filesystem::path(path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string extension = LowerCaseExtension(path);
   return extension == ".glb" || extension == ".gltf";
 }
 

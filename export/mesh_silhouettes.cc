@@ -191,6 +191,15 @@ std::vector<uint8_t> AnchoredParts(const TriangleMesh& mesh, const std::vector<i
   return anchored;
 }
 
+// Per part (ConnectedParts: `part` per vertex, `parts` of them) its vertices; *largest the part
+// with the most.
+std::vector<int64_t> PartSizes(const std::vector<int>& part, int parts, int* largest) {
+  std::vector<int64_t> sizes(parts, 0);
+  for (const int p : part) ++sizes[p];
+  *largest = static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+  return sizes;
+}
+
 // Per part: a speck (under kSpeckShare of the largest part's vertices, not anchored).
 std::vector<uint8_t> SpeckParts(const std::vector<int64_t>& part_vertices, int largest,
                                 const std::vector<uint8_t>& anchored) {
@@ -211,15 +220,11 @@ std::vector<uint8_t> SpeckVertices(const TriangleMesh& mesh,
   int parts = 0;
   const std::vector<int> part = ConnectedParts(mesh, &parts);
   if (parts < 2 || anchors.empty()) return on_speck;
-  std::vector<int64_t> part_vertices(parts, 0);
-  for (const int p : part) {
-    if (p >= 0) ++part_vertices[p];
-  }
-  const int largest = static_cast<int>(
-      std::max_element(part_vertices.begin(), part_vertices.end()) - part_vertices.begin());
+  int largest = 0;
+  const std::vector<int64_t> part_vertices = PartSizes(part, parts, &largest);
   const std::vector<uint8_t> speck =
       SpeckParts(part_vertices, largest, AnchoredParts(mesh, part, parts, largest, anchors, anchor_radius));
-  for (size_t i = 0; i < part.size(); ++i) on_speck[i] = part[i] >= 0 && speck[part[i]];
+  for (size_t i = 0; i < part.size(); ++i) on_speck[i] = speck[part[i]];
   return on_speck;
 }
 
@@ -232,7 +237,6 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
   summary.min_needing_views = min_needing_views;
   const std::vector<size_t> masked = MaskedViews(views);
   summary.masked_views = static_cast<int>(masked.size());
-  const int n = static_cast<int>(mesh->vertices.size());
   int parts = 0;
   const std::vector<int> part = ConnectedParts(*mesh, &parts);
   summary.parts = parts;
@@ -242,10 +246,8 @@ MeshPartsSummary RemoveUnneededParts(const std::vector<CalibratedView>& views,
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return summary;
   }
-  std::vector<int64_t> part_vertices(parts, 0);
-  for (int i = 0; i < n; ++i) ++part_vertices[part[i]];
-  const int largest = static_cast<int>(
-      std::max_element(part_vertices.begin(), part_vertices.end()) - part_vertices.begin());
+  int largest = 0;
+  const std::vector<int64_t> part_vertices = PartSizes(part, parts, &largest);
   if (!summary.judged_by_masks) {
     // No masks to say what the model needs: the sparse points alone speak for small parts.
     const std::vector<uint8_t> anchored =

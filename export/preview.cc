@@ -36,6 +36,15 @@ CalibratedView ViewFrom(const Eigen::Vector3d& target, double distance,
 
 }  // namespace
 
+Eigen::Vector3d PhotosUp(const std::vector<CalibratedView>& views) {
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  for (const CalibratedView& view : views) {
+    const Eigen::Matrix3d rotation = view.K.inverse() * view.P.leftCols<3>();
+    up -= rotation.row(1).transpose();  // the camera's -y: up in the photo
+  }
+  return up.norm() < 1e-9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d(up.normalized());
+}
+
 std::vector<CalibratedView> ViewsFromOutside(const TriangleMesh& mesh,
                                              const std::vector<CalibratedView>& views, int count,
                                              int width, int height) {
@@ -44,15 +53,9 @@ std::vector<CalibratedView> ViewsFromOutside(const TriangleMesh& mesh,
   Eigen::AlignedBox3d box;
   for (const Eigen::Vector3f& v : mesh.vertices) box.extend(v.cast<double>());
   const Eigen::Vector3d target = box.center();
-  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d up = PhotosUp(views);
   std::vector<Eigen::Vector3d> seen_from;
-  for (const CalibratedView& view : views) {
-    const Eigen::Matrix3d rotation = view.K.inverse() * view.P.leftCols<3>();
-    up -= rotation.row(1).transpose();  // the camera's -y: up in the photo
-    seen_from.push_back((view.centre - target).normalized());
-  }
-  if (up.norm() < 1e-9) up = Eigen::Vector3d::UnitZ();
-  up.normalize();
+  for (const CalibratedView& view : views) seen_from.push_back((view.centre - target).normalized());
   // Directions around the model: above, below, and eight around the horizon and 45 degrees up;
   // the `count` farthest (in angle) from every photo's, each next one also far from those taken.
   Eigen::Vector3d side = up.unitOrthogonal();

@@ -20,6 +20,10 @@ namespace exporter {
 cv::Mat PreviewImage(const TriangleMesh& mesh, const std::vector<CalibratedView>& views,
                      int count = 3, int max_width = 1600);
 
+// The photos' mean up direction in the world: the mean of their cameras' -y axes (up in a
+// photo), unit; +z where they cancel out (or there are none).
+Eigen::Vector3d PhotosUp(const std::vector<CalibratedView>& views);
+
 // `count` pinhole cameras of `width` x `height` (40 degrees across) framing the whole mesh from
 // the directions farthest from the photos': of above, below (the photos' mean up, their camera
 // -y axes) and sixteen around and above the model, each next one the farthest from the photos and

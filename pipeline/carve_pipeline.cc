@@ -483,12 +483,9 @@ void CarvePipeline::WriteReportPage(const fs::path& staging) const {
   // camera nearest the cameras' mean direction from the volume's centre (a photo's viewpoint: a
   // ring's mean direction points straight up).
   const Eigen::Vector3d centre = project_.bounds.box.center();
+  page.view_up = exporter::PhotosUp(carved_);
   Eigen::Vector3d mean_direction = Eigen::Vector3d::Zero();
-  for (const CalibratedView& view : carved_) {
-    const Eigen::Matrix3d rotation = view.K.inverse() * view.P.leftCols<3>();
-    page.view_up -= rotation.row(1).transpose();
-    mean_direction += (view.centre - centre).normalized();
-  }
+  for (const CalibratedView& view : carved_) mean_direction += (view.centre - centre).normalized();
   double best = -2.0;
   for (const CalibratedView& view : carved_) {
     const Eigen::Vector3d direction = (view.centre - centre).normalized();

@@ -229,13 +229,16 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     if (level + 1 == num_levels) RemoveComponents(options, carver.get(), &statistics);
     sample(SecondsSince(start));
     level_statistics.carved =
-        carver->carved() + carver->visual_hull().carved + carver->free_space().carved;
+        carver->carved() + carver->visual_hull().carved + carver->free_space().carved +
+        carver->beyond_ground_carved();
     level_statistics.free_space_carved = carver->free_space().carved;
     statistics.free_space_carved += carver->free_space().carved;
     statistics.free_space_sight_lines = carver->free_space().sight_lines;
     statistics.free_space_seconds += carver->free_space().seconds;
     level_statistics.evaluated = carver->evaluated();
     level_statistics.protected_kept = carver->protected_kept();
+    statistics.ground_voxels = carver->ground_voxels();
+    statistics.beyond_ground_carved += carver->beyond_ground_carved();
     level_statistics.final_solid = carver->volume().num_solid();
     level_statistics.seconds = SecondsSince(level_start);
     statistics.levels.push_back(level_statistics);

@@ -21,6 +21,7 @@
 #include "carve/view_workers.h"
 #include "carve/voxel_colour_sums.h"
 #include "carve/free_space.h"
+#include "carve/ground.h"
 #include "carve/visual_hull.h"
 #include "carve/volume.h"
 
@@ -181,6 +182,9 @@ struct CarveOptions {
   // empty space, so the voxels on the sight line from the view's centre to the point are carved
   // before colouring, up to this many voxels short of the point. 0: off.
   double free_space_margin_voxels = 0.0;
+  // The ground under an unmasked capture (see carve/ground.h): its voxels are never carved by
+  // the consistency test. Empty: none.
+  Ground ground;
 
   bool IsValid(std::string* reason) const;
 };
@@ -220,6 +224,8 @@ struct CarveStatistics {
   double free_space_seconds = 0.0;
   std::string FreeSpaceSummary() const;  // one line for the log
   std::string FloaterSummary() const;    // likewise, for the components without sparse points
+  int64_t ground_voxels = 0;  // under the ground (CarveOptions::ground), at the final level
+  int64_t beyond_ground_carved = 0;  // below the plane past the ground's edge, every level
   int64_t component_carved = 0;  // small components removed (CarveOptions::min_component_voxels)
   // Components removed for holding no sparse point (CarveOptions::unsupported_component_points):
   // how many, their voxels, and the points they were expected to hold (the largest).

@@ -65,8 +65,16 @@ Volume PreCarved(const std::vector<CalibratedView>& views,
                  Volume volume,
                  const CarveOptions& options,
                  VisualHullStatistics* hull,
-                 FreeSpaceStatistics* free_space) {
+                 FreeSpaceStatistics* free_space,
+                 int64_t* beyond_ground) {
   if (options.visual_hull) *hull = CarveVisualHull(views, &volume, options.num_threads);
+  std::vector<int64_t> exposed;
+  for (int64_t voxel : BeyondGroundVoxels(volume.grid(), options.ground)) {
+    if (!volume.IsSolid(voxel)) continue;
+    volume.Carve(voxel, &exposed);
+    exposed.clear();
+    ++*beyond_ground;
+  }
   if (options.free_space_margin_voxels > 0.0 && !options.surface_points.empty()) {
     *free_space = CarveFreeSpace(views, options.surface_points, options.free_space_margin_voxels,
                                  &volume, options.num_threads);
@@ -103,7 +111,8 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                                      const CarveOptions& options,
                                      const VisibilityFactory& factory)
     : views_(views),
-      volume_(PreCarved(views, std::move(start), options, &visual_hull_, &free_space_)),
+      volume_(PreCarved(views, std::move(start), options, &visual_hull_, &free_space_,
+                        &beyond_ground_carved_)),
       workers_(static_cast<int>(views.size()),
                options.method == CarveMethod::kRay ? options.num_threads : 1),
       visibility_(factory ? factory(views, volume_)
@@ -125,12 +134,18 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
     usable_pixels_ += usable.empty() ? static_cast<int64_t>(view.width) * view.height
                                      : cv::countNonZero(usable);
   }
-  if (options.protect_surface_points) {
+  if (options.protect_surface_points || !options.ground.empty()) {
     protected_.assign((volume_.grid().num_voxels() + 63) / 64, 0);
+  }
+  if (options.protect_surface_points) {
     for (int64_t voxel : SurfacePointVoxels(volume_.grid(), options.surface_points)) {
       protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
     }
     known_depth_ = KnownSurfaceDepths(views, volume_.grid(), options.surface_points);
+  }
+  for (int64_t voxel : GroundVoxels(volume_.grid(), options.ground)) {
+    protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
+    ++ground_voxels_;
   }
   batched_ = Batched(options) && ray_visibility_ != nullptr && ray_visibility_->ViewParallel();
   batch_voxels_ = batched_ ? options.batch_voxels : 1;

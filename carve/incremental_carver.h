@@ -85,6 +85,10 @@ class IncrementalCarver {
   // Evaluations that found a protected voxel inconsistent and kept it
   // (CarveOptions::protect_surface_points).
   int64_t protected_kept() const { return protected_kept_; }
+  // Voxels under the ground (CarveOptions::ground), never carved by colour.
+  int64_t ground_voxels() const { return ground_voxels_; }
+  // Voxels below the plane beyond the ground's edge, carved before colouring (BeyondGroundVoxels).
+  int64_t beyond_ground_carved() const { return beyond_ground_carved_; }
   bool IsProtected(int64_t voxel) const {
     return !protected_.empty() && ((protected_[voxel >> 6] >> (voxel & 63)) & 1) != 0;
   }
@@ -159,6 +163,7 @@ class IncrementalCarver {
   const std::vector<CalibratedView>& views_;
   VisualHullStatistics visual_hull_;  // declared before volume_: filled while volume_ is built
   FreeSpaceStatistics free_space_;    // likewise
+  int64_t beyond_ground_carved_ = 0;  // likewise
   Volume volume_;
   ViewWorkers workers_;  // declared before visibility_, which uses it to set up rays
   std::unique_ptr<Visibility> visibility_;
@@ -317,6 +322,7 @@ class IncrementalCarver {
   std::vector<uint64_t> protected_;  // a bit per voxel; empty without protection
   std::vector<cv::Mat> known_depth_;  // per view, KnownSurfaceDepths; empty without protection
   int64_t protected_kept_ = 0;
+  int64_t ground_voxels_ = 0;
   size_t max_queue_ = 0;
   int64_t evaluated_ = 0;
   int64_t carved_ = 0;

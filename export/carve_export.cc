@@ -169,6 +169,23 @@ std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid&
   return on_wall;
 }
 
+std::vector<uint8_t> GroundFillVertices(const TriangleMesh& mesh, const Ground& ground,
+                                        double voxel_size) {
+  std::vector<uint8_t> fill(mesh.vertices.size(), 0);
+  if (ground.empty()) return fill;
+  const GroundMap map(ground);
+  const Eigen::Vector3d up = ground.normal.normalized();
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
+    const double height = map.Height(p);
+    if (height >= -(ground.depth + 0.25 * voxel_size)) continue;
+    const bool facing_up = i < mesh.normals.size() && mesh.normals[i].cast<double>().dot(up) >= 0.5;
+    if (facing_up && height >= -(ground.depth + voxel_size)) continue;
+    fill[i] = map.NearGround(p, 1.5 * voxel_size);
+  }
+  return fill;
+}
+
 void RemoveGridWalls(ModelMesh* model, const std::vector<Eigen::Vector3d>& anchors,
                      double anchor_radius) {
   TriangleMesh& mesh = model->mesh;
@@ -334,10 +351,19 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   model.grid_wall_vertices =
       std::count(model.on_grid_wall.begin(), model.on_grid_wall.end(), uint8_t{1});
   if (options.remove_grid_walls) {
+    const std::vector<uint8_t> fill =
+        GroundFillVertices(model.mesh, options.ground, grid.voxel_size());
+    for (const Eigen::Vector3i& t : model.mesh.triangles) {
+      const bool on_wall =
+          model.on_grid_wall[t[0]] && model.on_grid_wall[t[1]] && model.on_grid_wall[t[2]];
+      model.ground_fill_triangles_removed += !on_wall && fill[t[0]] && fill[t[1]] && fill[t[2]];
+    }
+    for (size_t i = 0; i < fill.size(); ++i) model.on_grid_wall[i] |= fill[i];
     RemoveGridWalls(&model, options.sparse_points, 1.5 * grid.voxel_size());
-    if (model.wall_sliver_triangles_removed > 0) {
+    if (model.wall_sliver_triangles_removed > 0 || model.ground_fill_triangles_removed > 0) {
       tell("mesh walls: " + std::to_string(model.wall_triangles_removed) + " triangles on the " +
-           "volume box's walls left out, then " +
+           "volume box's walls left out (" + std::to_string(model.ground_fill_triangles_removed) +
+           " more of the held ground's sides and underside), then " +
            std::to_string(model.wall_sliver_triangles_removed) + " triangles of slivers only the " +
            "walls held to the model (no sparse point on them)");
     }

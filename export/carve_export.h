@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "carve/carver.h"
+#include "carve/ground.h"
 #include "calib/calibrated_view.h"
 #include "export/mesh_colouring.h"
 #include "export/mesh_refinement.h"
@@ -93,6 +94,10 @@ struct ModelMeshOptions {
   // where the box cuts. The box comes from the sparse points with a margin, so it does not lie
   // on a surface they saw. false: kept, the mesh closed by the box.
   bool remove_grid_walls = true;
+  // The ground the carve held (CarveOptions::ground): with remove_grid_walls, the held solid's
+  // sides and underside below the plane (GroundFillVertices) are left out with the walls: they
+  // stand for no surface the photos saw. Empty: none.
+  Ground ground;
   // Threads for refining and colouring (0 or less: every core); the mesh does not depend on it.
   int num_threads = 0;
   // After colouring, a texture atlas from the photos (TextureMeshFromPhotos): each triangle
@@ -127,6 +132,9 @@ struct ModelMesh {
   int64_t wall_triangles_removed = 0;
   int64_t wall_sliver_triangles_removed = 0;  // specks the walls' removal left (not counted above)
   int64_t triangles_before_walls = 0;
+  // Of wall_triangles_removed, those of the ground's fill (all three corners GroundFillVertices)
+  // that were not on the walls as well.
+  int64_t ground_fill_triangles_removed = 0;
 };
 
 // Leaves out the triangles whose three corners are on the grid's wall (model->on_grid_wall),
@@ -138,6 +146,12 @@ void RemoveGridWalls(ModelMesh* model, const std::vector<Eigen::Vector3d>& ancho
 // Per vertex of `mesh` (with normals), 1 where it lies on the wall of `grid` (see
 // ModelMesh::on_grid_wall).
 std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid& grid);
+// Per vertex of `mesh` (with normals), 1 where it lies on the held ground's fill: its foot on the
+// plane within 1.5 voxels of the ground, and more than the ground's depth and a voxel below the
+// plane, or more than its depth and a quarter voxel below it facing sideways or down (the
+// normal over 60 degrees from the plane's). The top of the ground, facing up, is kept.
+std::vector<uint8_t> GroundFillVertices(const TriangleMesh& mesh, const Ground& ground,
+                                        double voxel_size);
 
 // One line on the smoothing after refinement: passes, the photos' mean pin, the mean move.
 std::string FinalSmoothingSummary(const ModelMesh& model, const ModelMeshOptions& options);

@@ -1,7 +1,11 @@
 #include "export/supporting_plane.h"
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
+#include <utility>
 
+#include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl/sample_consensus/ransac.h>
@@ -76,6 +80,81 @@ SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
   plane.found = plane.on_plane_share >= kMinSupportShare && plane.below_share <= kMaxBelowShare &&
                 plane.cameras_above_share >= kMinCamerasAbove;
   return plane;
+}
+
+namespace {
+
+// The convex hull of points on a plane (Andrew's monotone chain in the plane's coordinates),
+// counter-clockwise about `normal`.
+std::vector<Eigen::Vector3d> HullOnPlane(const std::vector<Eigen::Vector3d>& points,
+                                         const Eigen::Vector3d& normal) {
+  const Eigen::Vector3d helper =
+      std::abs(normal.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d u = normal.cross(helper).normalized(), v = normal.cross(u);
+  std::vector<std::pair<Eigen::Vector2d, size_t>> q;
+  for (size_t i = 0; i < points.size(); ++i) q.push_back({{u.dot(points[i]), v.dot(points[i])}, i});
+  std::sort(q.begin(), q.end(), [](const auto& a, const auto& b) {
+    return a.first.x() < b.first.x() || (a.first.x() == b.first.x() && a.first.y() < b.first.y());
+  });
+  const auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  std::vector<size_t> hull(2 * q.size());
+  size_t k = 0;
+  for (size_t i = 0; i < q.size(); ++i) {  // lower chain
+    while (k >= 2 && cross(q[hull[k - 2]].first, q[hull[k - 1]].first, q[i].first) <= 0.0) --k;
+    hull[k++] = i;
+  }
+  for (size_t i = q.size() - 1, lower = k + 1; i-- > 0;) {  // upper chain
+    while (k >= lower && cross(q[hull[k - 2]].first, q[hull[k - 1]].first, q[i].first) <= 0.0) --k;
+    hull[k++] = i;
+  }
+  std::vector<Eigen::Vector3d> outline;
+  for (size_t i = 0; i + 1 < k; ++i) outline.push_back(points[q[hull[i]].second]);
+  return outline;
+}
+
+}  // namespace
+
+Ground GroundUnder(const SupportingPlane& plane, const std::vector<Eigen::Vector3d>& points) {
+  Ground ground;
+  if (!plane.found) return ground;
+  std::vector<Eigen::Vector3d> on, below;
+  for (const Eigen::Vector3d& p : points) {
+    const double distance = plane.normal.dot(p) + plane.offset;
+    if (std::abs(distance) <= plane.tolerance) on.push_back(p - distance * plane.normal);
+    if (distance < -plane.tolerance) below.push_back(p - distance * plane.normal);
+  }
+  if (on.size() < 3) return ground;
+  // Centred, for single precision (as in FitSupportingPlane).
+  const Eigen::Vector3d centre = on.front();
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  cloud->reserve(on.size());
+  for (const Eigen::Vector3d& p : on) {
+    const Eigen::Vector3d q = p - centre;
+    cloud->push_back(pcl::PointXYZ(static_cast<float>(q.x()), static_cast<float>(q.y()),
+                                   static_cast<float>(q.z())));
+  }
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  std::vector<double> spacing;
+  pcl::Indices found;
+  std::vector<float> distances;
+  for (const pcl::PointXYZ& p : cloud->points) {
+    if (tree.nearestKSearch(p, 2, found, distances) == 2) spacing.push_back(std::sqrt(distances[1]));
+  }
+  if (spacing.empty()) return ground;
+  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
+  const double radius = 2.0 * spacing[spacing.size() / 2];
+  if (!(radius > 0.0)) return ground;
+  ground.normal = plane.normal;
+  ground.offset = plane.offset;
+  ground.depth = plane.tolerance;
+  ground.radius = radius;
+  ground.outline = HullOnPlane(on, plane.normal);
+  ground.footprint = std::move(on);
+  ground.holes = std::move(below);
+  return ground;
 }
 
 }  // namespace exporter

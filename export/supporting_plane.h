@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include "carve/ground.h"
+
 namespace raycarve {
 namespace exporter {
 
@@ -36,6 +38,12 @@ constexpr double kMinCamerasAbove = 0.8;
 // 20 points: not found.
 SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
                                    const std::vector<Eigen::Vector3d>& cameras, double tolerance);
+
+// The ground a found support makes (empty when `plane` is not a support): the points of
+// `points` on the plane (within its tolerance) as the footprint, their convex hull as the outline,
+// the feet of the points below it as holes, all reaching twice the median spacing between
+// neighbours on the plane; `depth` the plane's tolerance.
+Ground GroundUnder(const SupportingPlane& plane, const std::vector<Eigen::Vector3d>& points);
 
 }  // namespace exporter
 }  // namespace raycarve

@@ -187,8 +187,40 @@ void CarvePipeline::AgreeMasks() {
   if (run_.mask_agreement.views > 0) RecordSeconds("agree_masks", SecondsSince(start));
 }
 
+void CarvePipeline::DecideGround() {
+  run_.ground = Ground();
+  if (!run_.plane.found) {
+    run_.ground_reason = "no supporting plane";
+  } else if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
+    run_.ground_reason = "masks bound the subject";
+  } else if (!request_.hold_ground) {
+    run_.ground_reason = "--hold_ground 0";
+  } else {
+    // The floor runs on beyond the box: its points around the box too (the box's margin has
+    // none of its own), those of the carved photos.
+    const Eigen::AlignedBox3d& box = project_.bounds.box;
+    const Eigen::AlignedBox3d around(box.min() - 0.5 * box.sizes(), box.max() + 0.5 * box.sizes());
+    std::vector<Eigen::Vector3d> points;
+    for (const SurfacePoint& point : SurfacePointsOf(project_.reconstruction, carved_, around)) {
+      points.push_back(point.xyz);
+    }
+    run_.ground = exporter::GroundUnder(run_.plane, points);
+    std::ostringstream text;
+    text.precision(3);
+    if (run_.ground.empty()) {
+      text << "no sparse point of the carved photos on the plane";
+    } else {
+      text << "held solid under the plane, within " << run_.ground.radius << " of its "
+           << run_.ground.footprint.size() << " sparse points";
+    }
+    run_.ground_reason = text.str();
+  }
+  LOG(INFO) << "ground: " << run_.ground_reason;
+}
+
 void CarvePipeline::CheckVolume() {
   CHECK(loaded_);
+  DecideGround();
   std::string reason;
   if (!CheckCarveFits(carved_, project_.bounds.box, request_.options, &reason)) {
     throw InputError("raycarve " + scope_.command + ": " + reason);
@@ -335,6 +367,7 @@ CarveResult CarvePipeline::CarveWith(CarveOptions options,
                      ": " + reason);
   }
   options.surface_points = surface_points_;
+  options.ground = run_.ground;
   return CarveVolume(carved_, project_.bounds.box, options, progress, progress_interval_seconds);
 }
 
@@ -343,6 +376,7 @@ void CarvePipeline::MakeSurface() {
   if (request_.mesh_kind != "smooth") return;  // --mesh voxels: the voxels' faces, when written
   const Clock::time_point start = Clock::now();
   exporter::ModelMeshOptions options = request_.mesh;
+  options.ground = run_.ground;
   for (const SurfacePoint& point : surface_points_) options.sparse_points.push_back(point.xyz);
   // Each step's line as it ends: the mesh stage can take longer than the carve.
   options.progress = [](const std::string& line) { LOG(INFO) << line; };

@@ -43,7 +43,10 @@ struct CarveRun {
   std::string output_path;
   Bounds bounds;
   CaptureLayout layout;
-  exporter::SupportingPlane plane;  // the plane the subject stands on (reported only)
+  exporter::SupportingPlane plane;  // the plane the subject stands on
+  // The ground under it held solid by the carve (CarveRequest::hold_ground); empty: none.
+  Ground ground;
+  std::string ground_reason;  // why there is none, or where it is
   int num_views = 0;  // the views carved
   int num_missing_images = 0;
   int masks_from_files = 0;
@@ -147,6 +150,7 @@ class CarvePipeline {
 
  private:
   void DecideMasks();
+  void DecideGround();  // run_.ground, once the masks are decided
   void RecordSeconds(const std::string& stage, double seconds);
   void WriteMasks(const std::filesystem::path& staging) const;
   // report.html (pipeline/report_page.h): the summary, preview.png, the convergence plot and

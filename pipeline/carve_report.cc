@@ -169,6 +169,12 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
       .Key("on_plane_share").Value(plane.on_plane_share)
       .Key("below_share").Value(plane.below_share)
       .Key("cameras_above_share").Value(plane.cameras_above_share)
+      .Key("ground_held").Value(!run.ground.empty())
+      .Key("ground").Value(run.ground_reason)
+      .Key("ground_footprint_points").Value(static_cast<int64_t>(run.ground.footprint.size()))
+      .Key("ground_reach").Value(run.ground.radius)
+      .Key("ground_voxels").Value(s.ground_voxels)
+      .Key("beyond_ground_carved").Value(s.beyond_ground_carved)
       .EndObject();
   json.EndObject();
   json.Key("statistics").BeginObject()

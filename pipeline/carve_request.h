@@ -70,6 +70,10 @@ struct CarveRequest {
 
   // Carve.
   CarveOptions options;
+  // Without masks, when the sparse points show a supporting plane (a floor, a table top): what
+  // lies under it, where its points are, is held solid (CarveOptions::ground): colour carving
+  // through a plain or repeating floor would open it and show the photos the volume under it.
+  bool hold_ground = true;
   // A grid whose voxels span fewer pixels of the photos than this (median at the volume's
   // centre) is refused before the work: there the photos cannot tell a voxel from its
   // neighbours, rays pass between voxels that are never judged, and the carve degrades (the

@@ -195,7 +195,14 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
       sparse_line.c_str(),
       (run.layout.Summary() +
        (run.bounds.around_focus ? "\n                  the volume: the box around their focus" : "") +
-       "\n                  " + run.plane.Summary())
+       "\n                  " + run.plane.Summary() +
+       (run.plane.found ? "\n                  ground: " + run.ground_reason +
+                              (run.ground.empty() ? std::string()
+                                                  : " (" + std::to_string(s.ground_voxels) +
+                                                        " voxels; " +
+                                                        std::to_string(s.beyond_ground_carved) +
+                                                        " below it past its edge carved)")
+                        : std::string()))
           .c_str(),
       mask_line.c_str(),
       silhouette_line.c_str(), run.output_path.c_str(),

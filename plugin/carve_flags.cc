@@ -84,6 +84,10 @@ void AddCarvingFlags(OptionParser* parser, CarveRequest* request, CarveFlagText*
   parser->AddDefault("free_space_margin", &request->options.free_space_margin_voxels,
                      "carve the sight lines from each photo to the reliable sparse points it saw "
                      "(empty space), stopping this many voxels short of the point; 0: off");
+  parser->AddDefault("hold_ground", &request->hold_ground,
+                     "without masks, where the sparse points show a plane the subject stands on "
+                     "(a floor, a table top): keep what lies under it, where its points are, "
+                     "solid (colour carving never opens the floor)");
   parser->AddDefault("floater_expected_points", &request->options.unsupported_component_points,
                      "carve a piece of the model (26-connected, under a quarter of the largest) "
                      "that holds no reliable sparse point where the points' density on the model "

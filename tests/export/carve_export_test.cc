@@ -460,6 +460,60 @@ TEST(CarveExport, AnEmptyCarveGivesAnEmptyMesh) {
   }
 }
 
+TEST(CarveExport, TheHeldGroundsSidesAndUndersideAreFillAndItsTopIsNot) {
+  // The ground the carve held: a slab under the plane z = 0.5 over the square [0.25, 0.75]^2,
+  // away from the grid's walls. Its top is the floor the photos saw; its sides and underside
+  // stand for nothing they saw.
+  const VoxelGrid grid(Eigen::AlignedBox3d(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()), 24);
+  const double voxel = grid.voxel_size();
+  std::vector<uint64_t> solid((grid.num_voxels() + 63) / 64, 0);
+  for (int k = 0; k < 12; ++k) {
+    for (int j = 6; j < 18; ++j) {
+      for (int i = 6; i < 18; ++i) {
+        const int64_t index = grid.Index(Eigen::Vector3i(i, j, k));
+        solid[index >> 6] |= uint64_t{1} << (index & 63);
+      }
+    }
+  }
+  Ground ground;
+  ground.normal = Eigen::Vector3d::UnitZ();
+  ground.offset = -0.5;
+  ground.depth = 0.01;
+  ground.radius = 2.0 * voxel;
+  for (int j = 0; j <= 12; ++j) {
+    for (int i = 0; i <= 12; ++i) ground.footprint.emplace_back(0.25 + i * voxel, 0.25 + j * voxel, 0.5);
+  }
+  ground.outline = {{0.25, 0.25, 0.5}, {0.75, 0.25, 0.5}, {0.75, 0.75, 0.5}, {0.25, 0.75, 0.5}};
+  SurfaceMeshSummary summary;
+  const TriangleMesh mesh = MeshSolidVoxels(Volume(grid, solid), SurfaceMeshOptions(), &summary);
+  ASSERT_FALSE(mesh.empty());
+  const std::vector<uint8_t> fill = GroundFillVertices(mesh, ground, voxel);
+  ASSERT_EQ(fill.size(), mesh.vertices.size());
+  int tops = 0, sides = 0, bottoms = 0;
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Eigen::Vector3f& p = mesh.vertices[i];
+    const Eigen::Vector3f& n = mesh.normals[i];
+    const bool inner = (p.head<2>().array() > 0.25f + 2 * voxel).all() &&
+                       (p.head<2>().array() < 0.75f - 2 * voxel).all();
+    if (p.z() > 0.5 - 0.25 * voxel && inner) {
+      ++tops;
+      EXPECT_EQ(fill[i], 0) << p.transpose() << " normal " << n.transpose();
+    } else if (p.z() < 0.5 - 2 * voxel && p.z() > 2 * voxel) {
+      ++sides;
+      EXPECT_EQ(fill[i], 1) << p.transpose() << " normal " << n.transpose();
+    } else if (p.z() < 0.25 * voxel && inner) {
+      ++bottoms;
+      EXPECT_EQ(fill[i], 1) << p.transpose();
+    }
+  }
+  EXPECT_GT(tops, 50);
+  EXPECT_GT(sides, 50);
+  EXPECT_GT(bottoms, 50);
+  // No ground: no fill.
+  const std::vector<uint8_t> none = GroundFillVertices(mesh, Ground(), voxel);
+  EXPECT_EQ(std::count(none.begin(), none.end(), uint8_t{1}), 0);
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

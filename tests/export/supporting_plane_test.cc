@@ -67,6 +67,37 @@ TEST(FitSupportingPlane, ABallAloneOrATableSeenFromBelowIsNoSupport) {
   EXPECT_FALSE(FitSupportingPlane({}, under.cameras, 0.01).found);
 }
 
+TEST(GroundUnder, TheTablesPointsMakeTheGroundAndAStepDownMakesHoles) {
+  const Eigen::Vector3d n = Eigen::Vector3d(0.2, -0.1, 1.0).normalized();
+  const Eigen::Vector3d origin(1.0, 2.0, -0.5);
+  Scene scene = TableScene(origin, n, true);
+  // 40 points 0.4 below the table around 3 from its centre: a floor beyond its edge.
+  const Eigen::Vector3d u = n.unitOrthogonal();
+  for (int i = 0; i < 40; ++i) {
+    scene.points.push_back(origin - 0.4 * n + (3.0 + 0.01 * i) * u + 0.02 * i * n.cross(u));
+  }
+  const SupportingPlane plane = FitSupportingPlane(scene.points, scene.cameras, 0.01);
+  ASSERT_TRUE(plane.found) << plane.Summary();
+  const Ground ground = GroundUnder(plane, scene.points);
+  ASSERT_FALSE(ground.empty());
+  EXPECT_GE(ground.footprint.size(), 500u);
+  EXPECT_LT(ground.footprint.size(), 540u);  // and the few of the ball that touch the table
+  EXPECT_EQ(ground.holes.size(), 40u);
+  EXPECT_GE(ground.outline.size(), 8u);  // the disc's hull
+  // 500 points over a disc of radius 2: spacing about 0.08, reach twice that.
+  EXPECT_GT(ground.radius, 0.08);
+  EXPECT_LT(ground.radius, 0.3);
+  for (const Eigen::Vector3d& point : ground.footprint) {
+    EXPECT_NEAR(n.dot(point - origin), 0.0, 1e-3);  // the feet lie on the plane
+  }
+  const GroundMap map(ground);
+  EXPECT_EQ(map.At(origin + 1.5 * n.cross(u) - 0.3 * n), GroundMap::Foot::kGround);
+  EXPECT_EQ(map.At(origin + 3.1 * u - 0.3 * n), GroundMap::Foot::kNearHole);
+  EXPECT_EQ(map.At(origin - 3.0 * u - 0.3 * n), GroundMap::Foot::kNeither);
+  // No support, no ground.
+  EXPECT_TRUE(GroundUnder(SupportingPlane(), scene.points).empty());
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

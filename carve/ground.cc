@@ -1,0 +1,139 @@
+#include "carve/ground.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <glog/logging.h>
+
+namespace raycarve {
+namespace {
+
+constexpr double kMaxCells = 4096;
+
+// The voxels below the plane (centre more than its depth and a voxel under it) whose foot is of
+// `kind`.
+std::vector<int64_t> BelowPlane(const VoxelGrid& grid, const Ground& ground, GroundMap::Foot kind) {
+  std::vector<int64_t> voxels;
+  if (ground.empty() || !(ground.normal.norm() > 0.0)) return voxels;
+  const GroundMap map(ground);
+  const double below = ground.depth + grid.voxel_size();
+  const Eigen::Vector3i& dims = grid.dimensions();
+  for (int z = 0; z < dims.z(); ++z) {
+    for (int y = 0; y < dims.y(); ++y) {
+      for (int x = 0; x < dims.x(); ++x) {
+        const Eigen::Vector3i voxel(x, y, z);
+        const Eigen::Vector3d centre = grid.Centre(voxel);
+        if (map.Height(centre) < -below && map.At(centre) == kind) {
+          voxels.push_back(grid.Index(voxel));
+        }
+      }
+    }
+  }
+  return voxels;
+}
+
+}  // namespace
+
+GroundMap::GroundMap(const Ground& ground) {
+  CHECK(!ground.empty() && ground.normal.norm() > 0.0);
+  normal_ = ground.normal.normalized();
+  offset_ = ground.offset / ground.normal.norm();
+  const Eigen::Vector3d helper =
+      std::abs(normal_.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  u_ = normal_.cross(helper).normalized();
+  v_ = normal_.cross(u_);
+  Eigen::Vector2d low(HUGE_VAL, HUGE_VAL), high(-HUGE_VAL, -HUGE_VAL);
+  for (const auto* points : {&ground.footprint, &ground.holes}) {
+    for (const Eigen::Vector3d& point : *points) {
+      const Eigen::Vector2d q = OnPlane(point);
+      low = low.cwiseMin(q);
+      high = high.cwiseMax(q);
+    }
+  }
+  low_ = low.array() - ground.radius;
+  const Eigen::Vector2d extent = (high - low).array() + 2.0 * ground.radius;
+  cell_ = std::max(ground.radius / 4.0, extent.maxCoeff() / (kMaxCells - 2));
+  cols_ = static_cast<int>(std::ceil(extent.x() / cell_)) + 1;
+  rows_ = static_cast<int>(std::ceil(extent.y() / cell_)) + 1;
+  cells_.assign(static_cast<size_t>(cols_) * rows_, Foot::kNeither);
+  MarkDiscs(ground.footprint, ground.radius, Foot::kGround);
+  MarkOutline(ground.outline);
+  MarkDiscs(ground.holes, ground.radius, Foot::kNearHole);
+}
+
+int GroundMap::Col(const Eigen::Vector2d& q) const {
+  return static_cast<int>(std::floor(std::clamp((q.x() - low_.x()) / cell_, -1.0, cols_ + 1.0)));
+}
+
+int GroundMap::Row(const Eigen::Vector2d& q) const {
+  return static_cast<int>(std::floor(std::clamp((q.y() - low_.y()) / cell_, -1.0, rows_ + 1.0)));
+}
+
+void GroundMap::MarkDiscs(const std::vector<Eigen::Vector3d>& points, double radius, Foot value) {
+  const int reach = static_cast<int>(std::ceil(radius / cell_));
+  for (const Eigen::Vector3d& point : points) {
+    const Eigen::Vector2d q = OnPlane(point);
+    const int col = Col(q), row = Row(q);
+    for (int r = std::max(0, row - reach); r <= std::min(rows_ - 1, row + reach); ++r) {
+      for (int c = std::max(0, col - reach); c <= std::min(cols_ - 1, col + reach); ++c) {
+        if ((CellCentre(c, r) - q).squaredNorm() <= radius * radius) {
+          cells_[static_cast<size_t>(r) * cols_ + c] = value;
+        }
+      }
+    }
+  }
+}
+
+void GroundMap::MarkOutline(const std::vector<Eigen::Vector3d>& outline) {
+  if (outline.size() < 3) return;
+  std::vector<Eigen::Vector2d> corners;
+  for (const Eigen::Vector3d& point : outline) corners.push_back(OnPlane(point));
+  const size_t n = corners.size();
+  for (int r = 0; r < rows_; ++r) {
+    for (int c = 0; c < cols_; ++c) {
+      const Eigen::Vector2d q = CellCentre(c, r);
+      int positive = 0, negative = 0;  // inside a convex polygon: on one side of every edge
+      for (size_t i = 0; i < n; ++i) {
+        const Eigen::Vector2d edge = corners[(i + 1) % n] - corners[i];
+        const Eigen::Vector2d to = q - corners[i];
+        const double cross = edge.x() * to.y() - edge.y() * to.x();
+        positive += cross > 0.0;
+        negative += cross < 0.0;
+      }
+      if (positive == 0 || negative == 0) cells_[static_cast<size_t>(r) * cols_ + c] = Foot::kGround;
+    }
+  }
+}
+
+GroundMap::Foot GroundMap::At(const Eigen::Vector3d& point) const {
+  const Eigen::Vector2d q = OnPlane(point);
+  const int col = Col(q), row = Row(q);
+  if (col < 0 || row < 0 || col >= cols_ || row >= rows_) return Foot::kNeither;
+  return cells_[static_cast<size_t>(row) * cols_ + col];
+}
+
+bool GroundMap::NearGround(const Eigen::Vector3d& point, double reach) const {
+  const Eigen::Vector2d q = OnPlane(point);
+  const int col = Col(q), row = Row(q);
+  const int cells = static_cast<int>(std::ceil(reach / cell_));
+  for (int r = std::max(0, row - cells); r <= std::min(rows_ - 1, row + cells); ++r) {
+    for (int c = std::max(0, col - cells); c <= std::min(cols_ - 1, col + cells); ++c) {
+      if (cells_[static_cast<size_t>(r) * cols_ + c] == Foot::kGround &&
+          (CellCentre(c, r) - q).norm() <= reach + cell_) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+std::vector<int64_t> GroundVoxels(const VoxelGrid& grid, const Ground& ground) {
+  return BelowPlane(grid, ground, GroundMap::Foot::kGround);
+}
+
+std::vector<int64_t> BeyondGroundVoxels(const VoxelGrid& grid, const Ground& ground) {
+  return BelowPlane(grid, ground, GroundMap::Foot::kNeither);
+}
+
+}  // namespace raycarve

@@ -1,0 +1,85 @@
+// The ground under an unmasked capture against a plane whose answer is known: a square of floor
+// at z = 0 seen from above, with a step down beside it.
+#include "carve/ground.h"
+
+#include <algorithm>
+#include <set>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+namespace raycarve {
+namespace {
+
+// The floor's sparse points every 0.1 over the square [-1, 1]^2 at z = 0, its hull the square's
+// corners, reaching 0.2; one point seen 0.5 below the plane at (1.5, 1.5) (a step down).
+Ground SquareFloor() {
+  Ground ground;
+  ground.normal = Eigen::Vector3d::UnitZ();
+  ground.offset = 0.0;
+  ground.depth = 0.07;
+  ground.radius = 0.2;
+  for (int i = -10; i <= 10; ++i) {
+    for (int j = -10; j <= 10; ++j) ground.footprint.emplace_back(0.1 * i, 0.1 * j, 0.0);
+  }
+  ground.outline = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  ground.holes = {{1.5, 1.5, 0.0}};
+  return ground;
+}
+
+// Voxels of 0.1 over [-2, 2]^2 x [-1, 1]: centres at odd multiples of 0.05.
+const VoxelGrid kGrid(Eigen::AlignedBox3d(Eigen::Vector3d(-2, -2, -1), Eigen::Vector3d(2, 2, 1)), 40);
+
+TEST(GroundVoxels, HoldsWhatLiesUnderTheFloorAndNothingElse) {
+  ASSERT_NEAR(kGrid.voxel_size(), 0.1, 1e-12);
+  const Ground ground = SquareFloor();
+  const std::vector<int64_t> voxels = GroundVoxels(kGrid, ground);
+  ASSERT_TRUE(std::is_sorted(voxels.begin(), voxels.end()));
+  const std::set<int64_t> held(voxels.begin(), voxels.end());
+  int64_t under_square = 0;
+  for (int64_t index = 0; index < kGrid.num_voxels(); ++index) {
+    const Eigen::Vector3d c = kGrid.Centre(kGrid.Voxel(index));
+    const double edge = std::max(std::abs(c.x()), std::abs(c.y()));
+    // More than the depth and a voxel (0.17) below the plane, and under the square.
+    if (c.z() < -0.17 && edge < 1.06) {
+      ++under_square;
+      EXPECT_TRUE(held.count(index)) << c.transpose();
+    }
+    // Never above that, never beyond the square's reach (0.2 and a raster cell).
+    if (c.z() > -0.17 || edge > 1.3) EXPECT_FALSE(held.count(index)) << c.transpose();
+  }
+  EXPECT_EQ(under_square, 22 * 22 * 8);  // centres -1.05..1.05, 8 layers from -0.25 to -0.95
+  EXPECT_TRUE(GroundVoxels(kGrid, Ground()).empty());
+}
+
+TEST(BeyondGroundVoxels, EmptiesBelowThePlanePastTheFloorButNotNearAPointSeenThere) {
+  const Ground ground = SquareFloor();
+  const std::vector<int64_t> beyond = BeyondGroundVoxels(kGrid, ground);
+  const std::vector<int64_t> held = GroundVoxels(kGrid, ground);
+  std::vector<int64_t> both;
+  std::set_intersection(beyond.begin(), beyond.end(), held.begin(), held.end(),
+                        std::back_inserter(both));
+  EXPECT_TRUE(both.empty());
+  const std::set<int64_t> empty(beyond.begin(), beyond.end());
+  for (int64_t index = 0; index < kGrid.num_voxels(); ++index) {
+    const Eigen::Vector3d c = kGrid.Centre(kGrid.Voxel(index));
+    const double edge = std::max(std::abs(c.x()), std::abs(c.y()));
+    const double to_hole = (c.head<2>() - Eigen::Vector2d(1.5, 1.5)).norm();
+    if (c.z() < -0.17 && edge > 1.3 && to_hole > 0.3) EXPECT_TRUE(empty.count(index)) << c.transpose();
+    if (c.z() > -0.17 || edge < 1.1 || to_hole < 0.15) EXPECT_FALSE(empty.count(index)) << c.transpose();
+  }
+}
+
+TEST(GroundMap, TellsGroundHoleAndNeitherApartAndMeasuresHeight) {
+  const GroundMap map(SquareFloor());
+  EXPECT_EQ(map.At({0.3, -0.7, -0.4}), GroundMap::Foot::kGround);
+  EXPECT_EQ(map.At({1.5, 1.45, -0.4}), GroundMap::Foot::kNearHole);
+  EXPECT_EQ(map.At({-1.8, 0.0, -0.4}), GroundMap::Foot::kNeither);
+  EXPECT_EQ(map.At({1e30, -1e30, 0.0}), GroundMap::Foot::kNeither);  // far away: no overflow
+  EXPECT_NEAR(map.Height({0.2, 0.1, -0.35}), -0.35, 1e-12);
+  EXPECT_TRUE(map.NearGround({1.3, 0.0, -0.5}, 0.15));   // the square's reach ends near 1.2
+  EXPECT_FALSE(map.NearGround({1.7, 0.0, -0.5}, 0.15));
+}
+
+}  // namespace
+}  // namespace raycarve

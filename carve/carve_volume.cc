@@ -49,6 +49,7 @@ void ChooseLevelThresholds(const std::vector<CalibratedView>& level_views,
   rule.min_views = options.min_views;
   rule.masked = std::any_of(level_views.begin(), level_views.end(),
                             [](const CalibratedView& view) { return !view.mask.empty(); });
+  rule.correct_view_count = level_options->correct_view_count;
   rule.quantile = options.auto_threshold_quantile;
   rule.fallback = level_options->threshold;
   rule.pattern_fallback = options.pattern_threshold;
@@ -148,6 +149,9 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   for (int level = 0; level < num_levels; ++level) {
     const Clock::time_point level_start = Clock::now();
     CarveOptions level_options = options;
+    level_options.correct_view_count =
+        std::none_of(views.begin(), views.end(),
+                     [](const CalibratedView& view) { return !view.mask.empty(); });
     level_options.resolution = resolutions[level];
     level_options.lod_levels = 1;
     level_options.threshold =

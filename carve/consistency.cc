@@ -32,11 +32,15 @@ double MeanColourDifference::Error(const std::vector<ViewColourStats>& views,
                                    const Eigen::Vector3d& mean,
                                    int num_pixels) const {
   double weighted = 0.0;
+  int seen = 0;
   for (const ViewColourStats& view : views) {
     if (view.count == 0) continue;
     weighted += view.count * (view.sum / view.count - mean).norm();
+    ++seen;
   }
-  return weighted / num_pixels;
+  const double correction =
+      correct_view_count_ && seen > 1 ? std::sqrt(seen / (seen - 1.0)) : 1.0;
+  return correction * weighted / num_pixels;
 }
 
 double PooledStandardDeviation::Error(const std::vector<ViewColourStats>& views,
@@ -49,19 +53,21 @@ double PooledStandardDeviation::Error(const std::vector<ViewColourStats>& views,
   return std::sqrt(variance.sum() / 3.0);
 }
 
-std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod method) {
+std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod method,
+                                                             bool correct_view_count) {
   // kPatchCorrelation's colour part is the mean-colour test; its pattern part is in the carver.
   if (method == ConsistencyMethod::kStandardDeviation) {
     return std::make_unique<PooledStandardDeviation>();
   }
-  return std::make_unique<MeanColourDifference>();
+  return std::make_unique<MeanColourDifference>(correct_view_count);
 }
 
 ConsistencyTest::ConsistencyTest(ConsistencyMethod method,
                                  double threshold,
                                  int min_views,
-                                 double adaptive)
-    : function_(MakeConsistencyFunction(method)),
+                                 double adaptive,
+                                 bool correct_view_count)
+    : function_(MakeConsistencyFunction(method, correct_view_count)),
       threshold_(threshold),
       min_views_(min_views),
       adaptive_(adaptive) {}

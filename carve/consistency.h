@@ -60,11 +60,20 @@ class ConsistencyFunction {
 
 // The seed paper's test: per view j the mean m_j of its n_j pixels; m = sum n_j m_j / sum n_j;
 // the error is sum n_j |m_j - m| / sum n_j with |.| the Euclidean norm in RGB.
+// With `correct_view_count`, times sqrt(k / (k - 1)) for the k views with pixels: the means'
+// distance from their own mean understates their spread by that factor (for k equal views it is
+// exact: 0.71 for two views, 0.96 for twelve), so that a voxel seen by two or three views is
+// judged on the same scale as one seen by ten, instead of passing more easily.
 class MeanColourDifference : public ConsistencyFunction {
  public:
+  explicit MeanColourDifference(bool correct_view_count = false)
+      : correct_view_count_(correct_view_count) {}
   double Error(const std::vector<ViewColourStats>& views,
                const Eigen::Vector3d& mean,
                int num_pixels) const override;
+
+ private:
+  bool correct_view_count_ = false;
 };
 
 // Seitz and Dyer's test: the root mean square over the channels of the standard deviation of all
@@ -76,7 +85,8 @@ class PooledStandardDeviation : public ConsistencyFunction {
                int num_pixels) const override;
 };
 
-std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod method);
+std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod method,
+                                                             bool correct_view_count = false);
 
 // Decides whether a voxel's visible pixels agree on one colour: inconsistent when the function's
 // error exceeds `threshold` + `adaptive` x the voxel's within-view spread; a voxel seen by fewer
@@ -90,7 +100,8 @@ std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod m
 // background) gets none.
 class ConsistencyTest {
  public:
-  ConsistencyTest(ConsistencyMethod method, double threshold, int min_views, double adaptive = 0.0);
+  ConsistencyTest(ConsistencyMethod method, double threshold, int min_views, double adaptive = 0.0,
+                  bool correct_view_count = false);
   Consistency Evaluate(const std::vector<ViewColourStats>& views) const;
 
   // The within-view spread of `views` (RGB units; 0 without pixels).

@@ -101,9 +101,10 @@ void MeasurePointErrors(const std::vector<CalibratedView>& views,
                         const std::vector<SurfacePoint>& points,
                         ConsistencyMethod test_method,
                         int min_views,
+                        bool correct_view_count,
                         ThresholdEstimate* estimate_out) {
   ThresholdEstimate& estimate = *estimate_out;
-  const ConsistencyTest test(test_method, 0.0, min_views);
+  const ConsistencyTest test(test_method, 0.0, min_views, 0.0, correct_view_count);
   std::vector<ViewColourStats> stats;
   // The error of `voxel` judged from `point`'s views, or a negative value when not judged.
   const bool patterns = test_method == ConsistencyMethod::kPatchCorrelation;
@@ -168,7 +169,8 @@ ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
   ThresholdEstimate estimate;
   estimate.quantile = quantile;
   const bool patterns = test_method == ConsistencyMethod::kPatchCorrelation;
-  MeasurePointErrors(views, grid, points, test_method, rule.min_views, &estimate);
+  MeasurePointErrors(views, grid, points, test_method, rule.min_views, rule.correct_view_count,
+                     &estimate);
   estimate.masked = masked;
   auto choose = [&](const std::vector<double>& surface, const std::vector<double>& front) {
     return masked || front.empty() ? ThresholdEstimate::Quantile(surface, quantile)

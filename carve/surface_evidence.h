@@ -79,6 +79,7 @@ struct ThresholdRule {
   // The views have object masks, so the visual hull has removed the empty space the views see
   // against the background.
   bool masked = false;
+  bool correct_view_count = false;  // CarveOptions::correct_view_count
   double quantile = 0.99;         // with masks: the share of the surface voxels kept
   double fallback = 0.0;          // the threshold when too few points can be judged
   double pattern_fallback = 0.0;  // likewise the pattern threshold

@@ -1,6 +1,7 @@
 #include "carve/consistency.h"
 
 #include <cmath>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -37,6 +38,43 @@ TEST(MeanColourTest, IgnoresVariationWithinAViewAndUsesTheEuclideanNorm) {
   // Means (0,0,0) and (30,40,0), one pixel each: |m_j - m| = 25 each (a 3-4-5 triangle, halved).
   const std::vector<ViewColourStats> apart = {View(0, {{0, 0, 0}}), View(1, {{30, 40, 0}})};
   EXPECT_DOUBLE_EQ(ConsistencyTest(ConsistencyMethod::kMeanColour, 0.0, 2).Evaluate(apart).error, 25.0);
+}
+
+TEST(MeanColourTest, TheViewCountCorrectionPutsFewViewsOnTheScaleOfMany) {
+  // Two views apart by (30, 40, 0): 25 uncorrected, 25 sqrt(2) corrected.
+  const std::vector<ViewColourStats> two = {View(0, {{0, 0, 0}}), View(1, {{30, 40, 0}})};
+  EXPECT_DOUBLE_EQ(ConsistencyTest(ConsistencyMethod::kMeanColour, 0.0, 2, 0.0, true).Evaluate(two).error,
+                   25.0 * std::sqrt(2.0));
+  // One colour seen through noise (each view's mean off by a Gaussian of 10 per channel): the
+  // mean error over 4000 voxels seen by two views is sqrt(1/2) of that seen by twelve uncorrected
+  // (sqrt(11/12) for twelve), and the same corrected.
+  std::mt19937 random(5);
+  std::normal_distribution<double> noise(0.0, 10.0);
+  const auto mean_error = [&](int k, bool correct) {
+    const ConsistencyTest test(ConsistencyMethod::kMeanColour, 0.0, 2, 0.0, correct);
+    double sum = 0.0;
+    for (int trial = 0; trial < 4000; ++trial) {
+      std::vector<ViewColourStats> views;
+      for (int v = 0; v < k; ++v) {
+        views.push_back(View(v, {{100 + noise(random), 100 + noise(random), 100 + noise(random)}}));
+      }
+      sum += test.Evaluate(views).error;
+    }
+    return sum / 4000;
+  };
+  EXPECT_NEAR(mean_error(2, false) / mean_error(12, false), std::sqrt(0.5 / (11.0 / 12.0)), 0.03);
+  EXPECT_NEAR(mean_error(2, true) / mean_error(12, true), 1.0, 0.03);
+  // Three views (0, 0, 0), (0, 0, 0), (90, 0, 0): mean (30, 0, 0), distances 30, 30, 60: 40
+  // uncorrected, 40 sqrt(3/2) corrected; the standard deviation test is not affected.
+  const std::vector<ViewColourStats> three = {View(0, {{0, 0, 0}}), View(1, {{0, 0, 0}}),
+                                              View(2, {{90, 0, 0}})};
+  EXPECT_DOUBLE_EQ(ConsistencyTest(ConsistencyMethod::kMeanColour, 0.0, 2).Evaluate(three).error, 40.0);
+  EXPECT_DOUBLE_EQ(
+      ConsistencyTest(ConsistencyMethod::kMeanColour, 0.0, 2, 0.0, true).Evaluate(three).error,
+      40.0 * std::sqrt(1.5));
+  EXPECT_DOUBLE_EQ(
+      ConsistencyTest(ConsistencyMethod::kStandardDeviation, 0.0, 2, 0.0, true).Evaluate(three).error,
+      ConsistencyTest(ConsistencyMethod::kStandardDeviation, 0.0, 2).Evaluate(three).error);
 }
 
 TEST(StandardDeviationTest, PoolsAllPixelsOfAllViews) {

@@ -108,6 +108,10 @@ std::string Bounds::Summary() const {
     if (num_unframed > 0) text << ", " << num_unframed << " of the room around (framed by few photos)";
     text << " dropped; " << num_trimmed_outside << " trimmed as outliers)";
     if (around_focus) text << ", narrowed to the points framed around the cameras' focus";
+    if (depth_tried_points > 0) {
+      text << ", narrowed to the " << depth_resolved_points << " of " << depth_tried_points
+           << " points the photos place in depth to two voxels";
+    }
   }
   return text.str();
 }
@@ -396,6 +400,77 @@ std::vector<Eigen::Vector3d> FindOccluders(const Reconstruction& reconstruction,
     if (hiding_views >= kOccluderViews) occluders.push_back(point.xyz);
   }
   return occluders;
+}
+
+std::string DepthResolution::Summary() const {
+  std::ostringstream text;
+  text.precision(3);
+  text << resolved << " of " << points << " sparse points placed in depth to "
+       << kResolvedDepthVoxels << " voxels (of " << voxel << ") a pixel or better";
+  if (!box.isEmpty()) {
+    text << "; the box narrowed to them: (" << box.min().x() << ", " << box.min().y() << ", "
+         << box.min().z() << ") - (" << box.max().x() << ", " << box.max().y() << ", "
+         << box.max().z() << ")";
+  }
+  return text.str();
+}
+
+DepthResolution ResolveSceneDepth(const Reconstruction& reconstruction,
+                                  const std::map<image_t, double>& focal_px,
+                                  const Eigen::AlignedBox3d& box, int resolution) {
+  DepthResolution result;
+  if (box.isEmpty() || resolution <= 0) return result;
+  result.voxel = box.sizes().maxCoeff() / resolution;
+  std::map<image_t, Eigen::Vector3d> centres;
+  for (const auto& [id, image] : reconstruction.images) centres[id] = image.ProjectionCenter();
+  std::vector<Eigen::Vector3d> resolved;
+  std::vector<Eigen::Vector3d> rays;
+  std::vector<double> footprints;
+  for (const auto& [id, point] : reconstruction.points3D) {
+    if (!box.contains(point.xyz)) continue;
+    rays.clear();
+    footprints.clear();
+    for (const TrackElement& element : point.track) {
+      const auto focal = focal_px.find(element.image_id);
+      const auto centre = centres.find(element.image_id);
+      if (focal == focal_px.end() || centre == centres.end() || !(focal->second > 0.0)) continue;
+      const Eigen::Vector3d ray = centre->second - point.xyz;
+      const double distance = ray.norm();
+      if (!(distance > 0.0)) continue;
+      rays.push_back(ray / distance);
+      footprints.push_back(distance / focal->second);
+    }
+    if (rays.size() < 2) continue;
+    ++result.points;
+    double min_cosine = 1.0;  // the widest angle between two of its rays
+    for (size_t a = 0; a < rays.size(); ++a) {
+      for (size_t b = a + 1; b < rays.size(); ++b) min_cosine = std::min(min_cosine, rays[a].dot(rays[b]));
+    }
+    const double sine = std::sqrt(std::max(0.0, 1.0 - min_cosine * min_cosine));
+    std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2,
+                     footprints.end());
+    const double footprint = footprints[footprints.size() / 2];
+    if (footprint <= kResolvedDepthVoxels * result.voxel * sine) resolved.push_back(point.xyz);
+  }
+  result.resolved = static_cast<int>(resolved.size());
+  if (result.resolved == result.points || result.resolved < 20 ||
+      result.resolved < kMinResolvedShare * result.points) {
+    return result;
+  }
+  Eigen::Vector3d low, high;
+  std::vector<double> values(resolved.size());
+  for (int axis = 0; axis < 3; ++axis) {
+    for (size_t i = 0; i < resolved.size(); ++i) values[i] = resolved[i][axis];
+    std::sort(values.begin(), values.end());
+    const size_t trim = values.size() / 50;
+    low[axis] = values[trim];
+    high[axis] = values[values.size() - 1 - trim];
+  }
+  const double margin = 0.1 * (high - low).maxCoeff();
+  const Eigen::AlignedBox3d narrowed =
+      Eigen::AlignedBox3d(low.array() - margin, high.array() + margin).intersection(box);
+  if (!narrowed.isEmpty() && narrowed.volume() < 0.95 * box.volume()) result.box = narrowed;
+  return result;
 }
 
 }  // namespace raycarve

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,10 @@ struct Bounds {
   Eigen::AlignedBox3d box;
   bool is_explicit = false;     // given by the user, not computed
   bool around_focus = false;    // the box around the cameras' focus (CaptureLayout::focus_box)
+  // A scene's box narrowed to the sparse points its photos place in depth to a voxel
+  // (ResolveSceneDepth): their number, of the points tried; 0 of 0 when not narrowed.
+  int depth_resolved_points = 0;
+  int depth_tried_points = 0;
   int num_points = 0;           // points in the model
   int num_used = 0;             // points that passed the filters
   int num_short_track = 0;      // dropped for track length
@@ -110,6 +115,33 @@ constexpr int kOccluderViews = 2;
 constexpr int kMinOccluderPoints = 10;
 std::vector<Eigen::Vector3d> FindOccluders(const Reconstruction& reconstruction,
                                            const Eigen::AlignedBox3d& box);
+
+// How deep into a scene its photos resolve the carve's grid. A sparse point seen from cameras
+// whose rays to it meet at an angle of at most alpha, at a pixel footprint w (its distance over
+// the focal length in pixels, the median over its views), is placed in depth to about
+// w / sin(alpha) per pixel of error. Where that exceeds kResolvedDepthVoxels voxels (the
+// tolerance the model is measured at: the F-score's and holdout's depth agreement), colour cannot
+// place a surface there either: moving it that far in depth moves it less than a pixel between
+// the photos. Forward-facing captures see their background (a far wall, trees behind a facade)
+// from a baseline small against its distance: a box that reaches it gets coarse voxels, and the
+// carve fills the space in front of it with surfaces the photos cannot tell apart.
+struct DepthResolution {
+  int points = 0;      // points with 2+ views of known focal length, inside the box
+  int resolved = 0;    // of them, placed in depth to kResolvedDepthVoxels per pixel or better
+  double voxel = 0.0;  // the box's longest side over the resolution
+  // The resolved points' box (trimmed at 2% per axis, 10% margin) within the given one; empty
+  // when the box is kept: every point resolved, fewer than kMinResolvedShare of them or fewer
+  // than 20, or a box no smaller.
+  Eigen::AlignedBox3d box;
+  std::string Summary() const;
+};
+constexpr double kResolvedDepthVoxels = 2.0;
+constexpr double kMinResolvedShare = 0.5;
+// `focal_px`: per image the focal length in pixels of its photo as loaded (images without one
+// are not used).
+DepthResolution ResolveSceneDepth(const Reconstruction& reconstruction,
+                                  const std::map<image_t, double>& focal_px,
+                                  const Eigen::AlignedBox3d& box, int resolution);
 
 // Describes `reconstruction`'s cameras (at least 2 images; otherwise a default layout).
 CaptureLayout DescribeCapture(const Reconstruction& reconstruction);

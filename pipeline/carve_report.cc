@@ -138,6 +138,8 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
       .Key("max").Value(JsonArray(run.bounds.box.max()))
       .Key("explicit").Value(run.bounds.is_explicit)
       .Key("around_focus").Value(run.bounds.around_focus)
+      .Key("depth_resolved_points").Value(run.bounds.depth_resolved_points)
+      .Key("depth_tried_points").Value(run.bounds.depth_tried_points)
       .EndObject();
   json.Key("resolution_support").BeginObject()
       .Key("voxel_pixels").Value(run.voxel_pixels)

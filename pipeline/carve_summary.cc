@@ -195,6 +195,13 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
       sparse_line.c_str(),
       (run.layout.Summary() +
        (run.bounds.around_focus ? "\n                  the volume: the box around their focus" : "") +
+       (run.bounds.depth_tried_points > 0
+            ? "\n                  the volume: the " +
+                  std::to_string(run.bounds.depth_resolved_points) + " of " +
+                  std::to_string(run.bounds.depth_tried_points) +
+                  " sparse points the photos place in depth to two voxels (the rest too far for "
+                  "the cameras' baseline)"
+            : std::string()) +
        "\n                  " + run.plane.Summary() +
        (run.plane.found ? "\n                  ground: " + run.ground_reason +
                               (run.ground.empty() ? std::string()

@@ -62,6 +62,7 @@ ProjectRequest ProjectRequestOf(const CarveRequest& request, const std::string& 
   project.view_options = request.view_options;
   project.model_index = request.model_index;
   project.colour_calibration = ColourCalibrationModeOf(request);
+  project.resolution = request.options.resolution;
   return project;
 }
 
@@ -143,12 +144,29 @@ bool CaptureIsMasked(const ViewReaderSummary& summary) {
   return summary.masks_from_files + summary.masks_from_backdrop > MinorityBackdropMasks(summary);
 }
 
-void ChooseCaptureBox(const BoundsRequest& request, LoadedProject* project) {
+void ChooseCaptureBox(const BoundsRequest& request, int resolution, LoadedProject* project) {
   if (project->bounds.is_explicit || request.capture == "scene") return;
   const bool masked = CaptureIsMasked(project->view_summary);
   const CaptureLayout& layout = project->layout;
   const bool object = request.capture == "object" || (layout.object_centred && !masked);
-  if (!object) return;
+  if (!object) {
+    if (masked || resolution <= 0) return;
+    std::map<image_t, double> focal_px;
+    for (const CalibratedView& view : project->views) {
+      focal_px[view.image_id] = 0.5 * (view.K(0, 0) + view.K(1, 1));
+    }
+    const DepthResolution depth =
+        ResolveSceneDepth(project->reconstruction, focal_px, project->bounds.box, resolution);
+    LOG(INFO) << "scene depth: " << depth.Summary();
+    if (depth.box.isEmpty()) return;
+    project->bounds.box = depth.box;
+    project->bounds.depth_resolved_points = depth.resolved;
+    project->bounds.depth_tried_points = depth.points;
+    LOG(INFO) << "volume: a scene's box narrowed to the " << depth.resolved << " of "
+              << depth.points << " sparse points its photos place in depth to two voxels (the rest "
+              << "lie too far for the cameras' baseline; --capture scene or --bbox keeps them)";
+    return;
+  }
   if (layout.focus_box.isEmpty()) {
     LOG(WARNING) << "too few sparse points around the cameras' focus (" << layout.focus_box_points
                  << "): the box keeps every sparse point";
@@ -224,7 +242,7 @@ LoadedProject LoadProject(const ProjectRequest& request) {
                    "where that at least halves the spread: different exposures)";
     }
   }
-  ChooseCaptureBox(request.bounds, &project);
+  ChooseCaptureBox(request.bounds, request.resolution, &project);
   {
     std::vector<Eigen::Vector3d> points, cameras;
     for (const auto& [id, point] : project.reconstruction.points3D) {

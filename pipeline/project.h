@@ -85,6 +85,8 @@ struct ProjectRequest {
   int model_index = -1;
   ColourCalibrationMode colour_calibration = ColourCalibrationMode::kOff;
   int hold_out_every = 0;  // > 0: HoldOutImages before anything reads the sparse points
+  // The carve's --resolution, for a scene's box (ChooseCaptureBox); 0: not narrowed in depth.
+  int resolution = 0;
   // The workspace when already resolved (CarvePipeline::LockOutputs); else ResolveWorkspace.
   std::optional<WorkspacePaths> paths;
 };
@@ -113,9 +115,11 @@ int MinorityBackdropMasks(const ViewReaderSummary& summary);
 bool CaptureIsMasked(const ViewReaderSummary& summary);
 
 // The capture's box (BoundsRequest::capture): for an object, the computed box narrowed to the
-// one around the cameras' focus (CaptureLayout::focus_box), marked Bounds::around_focus; an
-// explicit box, a scene, or too few points there leave it as it is.
-void ChooseCaptureBox(const BoundsRequest& request, LoadedProject* project);
+// one around the cameras' focus (CaptureLayout::focus_box), marked Bounds::around_focus; for a
+// scene found by --capture auto without masks, narrowed to the sparse points its photos place in
+// depth to two voxels at `resolution` (ResolveSceneDepth; 0: not). An explicit box, --capture
+// scene, or too few points there leave it as it is.
+void ChooseCaptureBox(const BoundsRequest& request, int resolution, LoadedProject* project);
 
 // Memory held per photo pixel while carving (the photo, its undistorted view, validity and mask,
 // rays and their statistics): 13.6 bytes measured as the peak resident memory of carving 100

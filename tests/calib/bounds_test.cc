@@ -1,6 +1,7 @@
 #include "calib/bounds.h"
 
 #include <cmath>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -119,6 +120,60 @@ TEST(DescribeCapture, TellsCamerasAroundAPointFromCamerasFacingOneWay) {
   }
   layout = DescribeCapture(CamerasLookingAt(centres, targets));
   EXPECT_FALSE(layout.object_centred) << layout.Summary();
+}
+
+// Four cameras on a line 2 wide, 5 in front of a scene at the origin (all looking along +y,
+// 500 px focal length), seeing `near` points in the cube of side 2 there and `far` points on a
+// wall 25 away.
+Reconstruction ForwardScene(int near, int far) {
+  std::vector<Eigen::Vector3d> centres, targets;
+  for (int i = 0; i < 4; ++i) {
+    centres.emplace_back(-1.0 + 2.0 * i / 3.0, -5.0, 0.0);
+    targets.emplace_back(-1.0 + 2.0 * i / 3.0, 0.0, 0.0);
+  }
+  Reconstruction model = CamerasLookingAt(centres, targets);
+  model.points3D.clear();
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int p = 0; p < near + far; ++p) {
+    Point3D point;
+    point.xyz = p < near ? Eigen::Vector3d(unit(random), unit(random), unit(random))
+                         : Eigen::Vector3d(10.0 * unit(random), 20.0, 5.0 * unit(random));
+    point.track = {{1, 0}, {2, 0}, {3, 0}, {4, 0}};
+    model.points3D[static_cast<point3D_t>(p + 1)] = point;
+  }
+  return model;
+}
+
+TEST(ResolveSceneDepth, NarrowsAForwardCapturesBoxToWhatItsBaselinePlacesInDepth) {
+  const std::map<image_t, double> focal = {{1, 500.0}, {2, 500.0}, {3, 500.0}, {4, 500.0}};
+  const Eigen::AlignedBox3d all(Eigen::Vector3d(-10, -1, -5), Eigen::Vector3d(10, 20, 5));
+  // A voxel of 21/128 = 0.16. The cube: 5 away, rays 22 degrees apart, 0.01 a pixel: placed to
+  // 0.03 a pixel. The wall: 25 away, 4.6 degrees, 0.05 a pixel: to 0.63, over two voxels.
+  const DepthResolution depth = ResolveSceneDepth(ForwardScene(400, 300), focal, all, 128);
+  EXPECT_NEAR(depth.voxel, 21.0 / 128, 1e-9);
+  EXPECT_EQ(depth.points, 700);
+  EXPECT_EQ(depth.resolved, 400);
+  ASSERT_FALSE(depth.box.isEmpty()) << depth.Summary();
+  // The cube, trimmed at 2% per axis, with a tenth of its side as margin.
+  EXPECT_TRUE(depth.box.contains(Eigen::Vector3d(0.9, 0.9, -0.9)));
+  EXPECT_LT(depth.box.max().y(), 1.3);
+  EXPECT_GT(depth.box.min().x(), -1.3);
+  EXPECT_NE(depth.Summary().find("400 of 700"), std::string::npos) << depth.Summary();
+  // Every point placed (a finer baseline: the wall alone is 5 away): the box is kept.
+  EXPECT_TRUE(ResolveSceneDepth(ForwardScene(400, 0), focal, all, 128).box.isEmpty());
+  // Most points too far: the capture is of what lies far, and the box is kept.
+  const DepthResolution mostly_far = ResolveSceneDepth(ForwardScene(200, 500), focal, all, 128);
+  EXPECT_EQ(mostly_far.resolved, 200);
+  EXPECT_TRUE(mostly_far.box.isEmpty());
+  // A finer grid asks more of the baseline: at 2048 (a voxel of 0.01) only the cube's nearest
+  // points (4 away, placed to 0.018) are within two voxels: under half, the box is kept.
+  const DepthResolution fine = ResolveSceneDepth(ForwardScene(400, 300), focal, all, 2048);
+  EXPECT_GT(fine.resolved, 0);
+  EXPECT_LT(fine.resolved, 200);
+  EXPECT_TRUE(fine.box.isEmpty());
+  // Images without a focal length are not used.
+  EXPECT_EQ(ResolveSceneDepth(ForwardScene(400, 300), {{1, 500.0}}, all, 128).points, 0);
 }
 
 TEST(Bounds, ContainTheObjectAndIgnoreFarOutliers) {

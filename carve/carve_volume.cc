@@ -149,7 +149,10 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   for (int level = 0; level < num_levels; ++level) {
     const Clock::time_point level_start = Clock::now();
     CarveOptions level_options = options;
+    // Only where the threshold comes from the same corrected errors: a --threshold given as a
+    // number is on the seed paper's scale.
     level_options.correct_view_count =
+        options.auto_threshold &&
         std::none_of(views.begin(), views.end(),
                      [](const CalibratedView& view) { return !view.mask.empty(); });
     level_options.resolution = resolutions[level];

@@ -183,7 +183,8 @@ struct CarveOptions {
   // before colouring, up to this many voxels short of the point. 0: off.
   double free_space_margin_voxels = 0.0;
   // The mean-colour error corrected for the number of views (MeanColourDifference). CarveVolume
-  // sets it where no view has a mask: there colour alone carves the empty space, and voxels seen
+  // sets it where no view has a mask and the threshold is auto (a number given is on the seed
+  // paper's scale): there colour alone carves the empty space, and voxels seen
   // by two or three views passed too easily (on the generated unmasked scenes, half the cloud's
   // points seen by three photos lay off the truth, 3% of those seen by twelve). With masks it
   // cost 0.2-0.3 dB held out on the dino sets (the hull already bounds the object, and the

@@ -14,6 +14,24 @@
 namespace raycarve {
 namespace exporter {
 
+namespace {
+
+// `points` less `centre`, in single precision: centred, so that they keep their detail far from
+// the origin.
+pcl::PointCloud<pcl::PointXYZ>::Ptr CentredCloud(const std::vector<Eigen::Vector3d>& points,
+                                                 const Eigen::Vector3d& centre) {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  cloud->reserve(points.size());
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector3d q = p - centre;
+    cloud->push_back(pcl::PointXYZ(static_cast<float>(q.x()), static_cast<float>(q.y()),
+                                   static_cast<float>(q.z())));
+  }
+  return cloud;
+}
+
+}  // namespace
+
 std::string SupportingPlane::Summary() const {
   std::ostringstream text;
   text.precision(3);
@@ -32,17 +50,10 @@ SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
   plane.points = static_cast<int>(points.size());
   plane.tolerance = tolerance;
   if (points.size() < 20 || !(tolerance > 0.0)) return plane;
-  // Centred, so that single precision keeps the points' detail far from the origin.
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& p : points) centre += p;
   centre /= static_cast<double>(points.size());
-  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
-  cloud->reserve(points.size());
-  for (const Eigen::Vector3d& p : points) {
-    const Eigen::Vector3d q = p - centre;
-    cloud->push_back(pcl::PointXYZ(static_cast<float>(q.x()), static_cast<float>(q.y()),
-                                   static_cast<float>(q.z())));
-  }
+  const pcl::PointCloud<pcl::PointXYZ>::Ptr cloud = CentredCloud(points, centre);
   pcl::SampleConsensusModelPlane<pcl::PointXYZ>::Ptr model(
       new pcl::SampleConsensusModelPlane<pcl::PointXYZ>(cloud));  // fixed seed
   pcl::RandomSampleConsensus<pcl::PointXYZ> ransac(model, tolerance);
@@ -126,15 +137,7 @@ Ground GroundUnder(const SupportingPlane& plane, const std::vector<Eigen::Vector
     if (distance < -plane.tolerance) below.push_back(p - distance * plane.normal);
   }
   if (on.size() < 3) return ground;
-  // Centred, for single precision (as in FitSupportingPlane).
-  const Eigen::Vector3d centre = on.front();
-  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
-  cloud->reserve(on.size());
-  for (const Eigen::Vector3d& p : on) {
-    const Eigen::Vector3d q = p - centre;
-    cloud->push_back(pcl::PointXYZ(static_cast<float>(q.x()), static_cast<float>(q.y()),
-                                   static_cast<float>(q.z())));
-  }
+  const pcl::PointCloud<pcl::PointXYZ>::Ptr cloud = CentredCloud(on, on.front());
   pcl::KdTreeFLANN<pcl::PointXYZ> tree;
   tree.setInputCloud(cloud);
   std::vector<double> spacing;

@@ -232,6 +232,13 @@ void AppendGuidance(const CarveRequest& request, const CarveRun& run, std::strin
     Appendf(text, "  next            the volume's box cuts the surroundings around the subject (%.0f%% "
                 "of the surface lay on its walls):\n",
                 100.0 * run.WallShare());
+  } else if (run.bounds.depth_tried_points > 0) {
+    Appendf(text, "  next            a scene: the box holds the %d of %d sparse points the photos place "
+                "in depth (the rest: --capture scene, at coarser voxels and a depth they cannot "
+                "place), and cuts what runs on beyond them (%.0f%% of the surface lay on its "
+                "walls). To carve one subject alone:\n",
+                run.bounds.depth_resolved_points, run.bounds.depth_tried_points,
+                100.0 * run.WallShare());
   } else {
     Appendf(text, "  next            a scene: the box holds the sparse points several photos share, and "
                 "cuts what runs on beyond them (%.0f%% of the surface lay on its walls). To carve "

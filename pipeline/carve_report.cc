@@ -23,6 +23,7 @@ void WriteOptions(const CarveRequest& request, const CarveRun& run, JsonWriter& 
       .Key("pattern_threshold").Value(request.options.auto_pattern_threshold ? std::string("auto") : std::to_string(request.options.pattern_threshold))
       .Key("protect_surface_points").Value(request.options.protect_surface_points)
       .Key("free_space_margin").Value(request.options.free_space_margin_voxels)
+      .Key("hold_ground").Value(request.hold_ground)
       .Key("floater_expected_points").Value(request.options.unsupported_component_points)
       .Key("repair_silhouettes").Value(request.options.repair_silhouettes)
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)

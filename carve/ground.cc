@@ -90,19 +90,23 @@ void GroundMap::MarkOutline(const std::vector<Eigen::Vector3d>& outline) {
   std::vector<Eigen::Vector2d> corners;
   for (const Eigen::Vector3d& point : outline) corners.push_back(OnPlane(point));
   const size_t n = corners.size();
+  // Row by row: a convex polygon meets the line through the row's cell centres in one interval,
+  // between the lowest and highest crossing of its edges.
   for (int r = 0; r < rows_; ++r) {
-    for (int c = 0; c < cols_; ++c) {
-      const Eigen::Vector2d q = CellCentre(c, r);
-      int positive = 0, negative = 0;  // inside a convex polygon: on one side of every edge
-      for (size_t i = 0; i < n; ++i) {
-        const Eigen::Vector2d edge = corners[(i + 1) % n] - corners[i];
-        const Eigen::Vector2d to = q - corners[i];
-        const double cross = edge.x() * to.y() - edge.y() * to.x();
-        positive += cross > 0.0;
-        negative += cross < 0.0;
-      }
-      if (positive == 0 || negative == 0) cells_[static_cast<size_t>(r) * cols_ + c] = Foot::kGround;
+    const double y = CellCentre(0, r).y();
+    double low = HUGE_VAL, high = -HUGE_VAL;
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector2d& a = corners[i];
+      const Eigen::Vector2d& b = corners[(i + 1) % n];
+      if ((a.y() > y) == (b.y() > y)) continue;  // the edge does not cross the line
+      const double x = a.x() + (y - a.y()) / (b.y() - a.y()) * (b.x() - a.x());
+      low = std::min(low, x);
+      high = std::max(high, x);
     }
+    if (!(low <= high)) continue;
+    const int first = std::max(0, static_cast<int>(std::ceil((low - low_.x()) / cell_ - 0.5)));
+    const int last = std::min(cols_ - 1, static_cast<int>(std::floor((high - low_.x()) / cell_ - 0.5)));
+    for (int c = first; c <= last; ++c) cells_[static_cast<size_t>(r) * cols_ + c] = Foot::kGround;
   }
 }
 

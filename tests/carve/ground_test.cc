@@ -3,6 +3,7 @@
 #include "carve/ground.h"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include <Eigen/Geometry>
@@ -79,6 +80,30 @@ TEST(GroundMap, TellsGroundHoleAndNeitherApartAndMeasuresHeight) {
   EXPECT_NEAR(map.Height({0.2, 0.1, -0.35}), -0.35, 1e-12);
   EXPECT_TRUE(map.NearGround({1.3, 0.0, -0.5}, 0.15));   // the square's reach ends near 1.2
   EXPECT_FALSE(map.NearGround({1.7, 0.0, -0.5}, 0.15));
+}
+
+TEST(GroundMap, TheOutlineCoversWhatItsPointsLeaveBetweenThem) {
+  // Five points on a tilted plane (a pentagon's corners, 3 across), each reaching 0.1: inside the
+  // pentagon is ground because its hull says so, not because a point is near.
+  Ground ground;
+  ground.normal = Eigen::Vector3d(0.0, 0.6, 0.8);
+  ground.offset = 0.0;
+  ground.radius = 0.1;
+  const Eigen::Vector3d u = Eigen::Vector3d::UnitX(), v = ground.normal.cross(u);
+  for (int k = 0; k < 5; ++k) {
+    const double a = 2.0 * M_PI * k / 5.0;
+    ground.footprint.push_back(1.5 * (std::cos(a) * u + std::sin(a) * v));
+  }
+  ground.outline = ground.footprint;
+  const GroundMap map(ground);
+  EXPECT_EQ(map.At(Eigen::Vector3d::Zero() - 0.5 * ground.normal), GroundMap::Foot::kGround);
+  EXPECT_EQ(map.At(0.9 * v), GroundMap::Foot::kGround);
+  EXPECT_EQ(map.At(-1.2 * v), GroundMap::Foot::kGround);   // the pentagon reaches -1.28 there
+  EXPECT_EQ(map.At(-1.4 * v), GroundMap::Foot::kNeither);  // beyond its edge and its points' reach
+  EXPECT_EQ(map.At(1.7 * u), GroundMap::Foot::kNeither);
+  // Without the outline only the points' discs are ground.
+  ground.outline.clear();
+  EXPECT_EQ(GroundMap(ground).At(Eigen::Vector3d::Zero()), GroundMap::Foot::kNeither);
 }
 
 }  // namespace

@@ -144,7 +144,14 @@ Ground GroundUnder(const SupportingPlane& plane, const std::vector<Eigen::Vector
   pcl::Indices found;
   std::vector<float> distances;
   for (const pcl::PointXYZ& p : cloud->points) {
-    if (tree.nearestKSearch(p, 2, found, distances) == 2) spacing.push_back(std::sqrt(distances[1]));
+    // The nearest other point (past any at the same place: a point seen twice).
+    const int count = tree.nearestKSearch(p, 4, found, distances);
+    for (int k = 1; k < count; ++k) {
+      if (distances[k] > 0.0f) {
+        spacing.push_back(std::sqrt(distances[k]));
+        break;
+      }
+    }
   }
   if (spacing.empty()) return ground;
   std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());

@@ -96,6 +96,10 @@ TEST(GroundUnder, TheTablesPointsMakeTheGroundAndAStepDownMakesHoles) {
   EXPECT_EQ(map.At(origin - 3.0 * u - 0.3 * n), GroundMap::Foot::kNeither);
   // No support, no ground.
   EXPECT_TRUE(GroundUnder(SupportingPlane(), scene.points).empty());
+  // Every point twice (a point seen twice at the same place): the same reach.
+  std::vector<Eigen::Vector3d> twice = scene.points;
+  twice.insert(twice.end(), scene.points.begin(), scene.points.end());
+  EXPECT_NEAR(GroundUnder(plane, twice).radius, ground.radius, 1e-6);
 }
 
 }  // namespace

@@ -98,12 +98,18 @@ TEST(ReadObj, RaycarvesTexturedObjDrawsAsTheMeshItWasWrittenFrom) {
   }
 }
 
-TEST(ReadGltf, VertexColoursComeBackAsTheirSrgbBytes) {
-  const std::string folder = testing::MakeTemporaryDirectory("gltf_colours");
+// The textured quad without its texture (vertex colours only), written as `path` (GLB).
+TriangleMesh WritePlainQuadGlb(const std::string& path) {
   TriangleMesh mesh = TexturedQuad();
   mesh.corner_uvs.clear();
   mesh.texture = cv::Mat();
-  WriteGlb(mesh, folder + "/plain.glb");
+  WriteGlb(mesh, path);
+  return mesh;
+}
+
+TEST(ReadGltf, VertexColoursComeBackAsTheirSrgbBytes) {
+  const std::string folder = testing::MakeTemporaryDirectory("gltf_colours");
+  const TriangleMesh mesh = WritePlainQuadGlb(folder + "/plain.glb");
   const TriangleMesh read = ReadGltf(folder + "/plain.glb");
   EXPECT_FALSE(read.textured());
   ASSERT_EQ(read.colours.size(), mesh.colours.size());
@@ -117,10 +123,7 @@ TEST(ReadGltf, NodeTransformsPlaceTheVertices) {
   // raycarve's GLB turned into a .gltf whose node is scaled by 2, turned 90 degrees about z and
   // moved by (1, 2, 3): each vertex v must come back as R * 2v + t.
   const std::string folder = testing::MakeTemporaryDirectory("gltf_transform");
-  TriangleMesh mesh = TexturedQuad();
-  mesh.corner_uvs.clear();
-  mesh.texture = cv::Mat();
-  WriteGlb(mesh, folder + "/plain.glb");
+  const TriangleMesh mesh = WritePlainQuadGlb(folder + "/plain.glb");
   tinygltf::TinyGLTF io;
   tinygltf::Model model;
   std::string error, warning;

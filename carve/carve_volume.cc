@@ -146,15 +146,16 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       statistics.thread_work_seconds[t] += times.busy_seconds[t];
     }
   };
+  // Only where the threshold comes from the same corrected errors: a --threshold given as a
+  // number is on the seed paper's scale.
+  const bool correct_view_count =
+      options.auto_threshold &&
+      std::none_of(views.begin(), views.end(),
+                   [](const CalibratedView& view) { return !view.mask.empty(); });
   for (int level = 0; level < num_levels; ++level) {
     const Clock::time_point level_start = Clock::now();
     CarveOptions level_options = options;
-    // Only where the threshold comes from the same corrected errors: a --threshold given as a
-    // number is on the seed paper's scale.
-    level_options.correct_view_count =
-        options.auto_threshold &&
-        std::none_of(views.begin(), views.end(),
-                     [](const CalibratedView& view) { return !view.mask.empty(); });
+    level_options.correct_view_count = correct_view_count;
     level_options.resolution = resolutions[level];
     level_options.lod_levels = 1;
     level_options.threshold =

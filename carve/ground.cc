@@ -11,28 +11,6 @@ namespace {
 
 constexpr double kMaxCells = 4096;
 
-// The voxels below the plane (centre more than its depth and a voxel under it) whose foot is of
-// `kind`.
-std::vector<int64_t> BelowPlane(const VoxelGrid& grid, const Ground& ground, GroundMap::Foot kind) {
-  std::vector<int64_t> voxels;
-  if (ground.empty() || !(ground.normal.norm() > 0.0)) return voxels;
-  const GroundMap map(ground);
-  const double below = ground.depth + grid.voxel_size();
-  const Eigen::Vector3i& dims = grid.dimensions();
-  for (int z = 0; z < dims.z(); ++z) {
-    for (int y = 0; y < dims.y(); ++y) {
-      for (int x = 0; x < dims.x(); ++x) {
-        const Eigen::Vector3i voxel(x, y, z);
-        const Eigen::Vector3d centre = grid.Centre(voxel);
-        if (map.Height(centre) < -below && map.At(centre) == kind) {
-          voxels.push_back(grid.Index(voxel));
-        }
-      }
-    }
-  }
-  return voxels;
-}
-
 }  // namespace
 
 GroundMap::GroundMap(const Ground& ground) {
@@ -132,12 +110,33 @@ bool GroundMap::NearGround(const Eigen::Vector3d& point, double reach) const {
   return false;
 }
 
+BelowGround SplitBelowGround(const VoxelGrid& grid, const Ground& ground) {
+  BelowGround split;
+  if (ground.empty() || !(ground.normal.norm() > 0.0)) return split;
+  const GroundMap map(ground);
+  const double below = ground.depth + grid.voxel_size();
+  const Eigen::Vector3i& dims = grid.dimensions();
+  for (int z = 0; z < dims.z(); ++z) {
+    for (int y = 0; y < dims.y(); ++y) {
+      for (int x = 0; x < dims.x(); ++x) {
+        const Eigen::Vector3i voxel(x, y, z);
+        const Eigen::Vector3d centre = grid.Centre(voxel);
+        if (!(map.Height(centre) < -below)) continue;
+        const GroundMap::Foot foot = map.At(centre);
+        if (foot == GroundMap::Foot::kGround) split.held.push_back(grid.Index(voxel));
+        if (foot == GroundMap::Foot::kNeither) split.beyond.push_back(grid.Index(voxel));
+      }
+    }
+  }
+  return split;
+}
+
 std::vector<int64_t> GroundVoxels(const VoxelGrid& grid, const Ground& ground) {
-  return BelowPlane(grid, ground, GroundMap::Foot::kGround);
+  return SplitBelowGround(grid, ground).held;
 }
 
 std::vector<int64_t> BeyondGroundVoxels(const VoxelGrid& grid, const Ground& ground) {
-  return BelowPlane(grid, ground, GroundMap::Foot::kNeither);
+  return SplitBelowGround(grid, ground).beyond;
 }
 
 }  // namespace raycarve

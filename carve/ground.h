@@ -66,6 +66,15 @@ class GroundMap {
   std::vector<Foot> cells_;
 };
 
+// The voxels of `grid` more than the ground's depth and a voxel below the plane (by their
+// centres), in index order: `held`, whose foot is on the ground (GroundVoxels), and `beyond`,
+// whose foot is neither on it nor near a hole (BeyondGroundVoxels). One pass over the grid.
+struct BelowGround {
+  std::vector<int64_t> held;
+  std::vector<int64_t> beyond;
+};
+BelowGround SplitBelowGround(const VoxelGrid& grid, const Ground& ground);
+
 // The voxels of `grid` under the ground (centre more than the ground's depth and a voxel below
 // the plane, foot on the ground), in index order; none for an empty ground.
 std::vector<int64_t> GroundVoxels(const VoxelGrid& grid, const Ground& ground);

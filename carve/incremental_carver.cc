@@ -66,15 +66,18 @@ Volume PreCarved(const std::vector<CalibratedView>& views,
                  const CarveOptions& options,
                  VisualHullStatistics* hull,
                  FreeSpaceStatistics* free_space,
+                 std::vector<int64_t>* ground_held,
                  int64_t* beyond_ground) {
   if (options.visual_hull) *hull = CarveVisualHull(views, &volume, options.num_threads);
+  BelowGround below = SplitBelowGround(volume.grid(), options.ground);
   std::vector<int64_t> exposed;
-  for (int64_t voxel : BeyondGroundVoxels(volume.grid(), options.ground)) {
+  for (int64_t voxel : below.beyond) {
     if (!volume.IsSolid(voxel)) continue;
     volume.Carve(voxel, &exposed);
     exposed.clear();
     ++*beyond_ground;
   }
+  *ground_held = std::move(below.held);
   if (options.free_space_margin_voxels > 0.0 && !options.surface_points.empty()) {
     *free_space = CarveFreeSpace(views, options.surface_points, options.free_space_margin_voxels,
                                  &volume, options.num_threads);
@@ -112,7 +115,7 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                                      const VisibilityFactory& factory)
     : views_(views),
       volume_(PreCarved(views, std::move(start), options, &visual_hull_, &free_space_,
-                        &beyond_ground_carved_)),
+                        &ground_held_, &beyond_ground_carved_)),
       workers_(static_cast<int>(views.size()),
                options.method == CarveMethod::kRay ? options.num_threads : 1),
       visibility_(factory ? factory(views, volume_)
@@ -144,10 +147,9 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
     }
     known_depth_ = KnownSurfaceDepths(views, volume_.grid(), options.surface_points);
   }
-  for (int64_t voxel : GroundVoxels(volume_.grid(), options.ground)) {
-    protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
-    ++ground_voxels_;
-  }
+  for (int64_t voxel : ground_held_) protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
+  ground_voxels_ = static_cast<int64_t>(ground_held_.size());
+  std::vector<int64_t>().swap(ground_held_);
   batched_ = Batched(options) && ray_visibility_ != nullptr && ray_visibility_->ViewParallel();
   batch_voxels_ = batched_ ? options.batch_voxels : 1;
   view_parallel_ = !batched_ && ray_visibility_ != nullptr && ray_visibility_->ViewParallel() &&

@@ -87,7 +87,7 @@ class IncrementalCarver {
   int64_t protected_kept() const { return protected_kept_; }
   // Voxels under the ground (CarveOptions::ground), never carved by colour.
   int64_t ground_voxels() const { return ground_voxels_; }
-  // Voxels below the plane beyond the ground's edge, carved before colouring (BeyondGroundVoxels).
+  // Voxels below the plane beyond the ground's edge, carved before colouring (SplitBelowGround).
   int64_t beyond_ground_carved() const { return beyond_ground_carved_; }
   bool IsProtected(int64_t voxel) const {
     return !protected_.empty() && ((protected_[voxel >> 6] >> (voxel & 63)) & 1) != 0;
@@ -164,6 +164,7 @@ class IncrementalCarver {
   VisualHullStatistics visual_hull_;  // declared before volume_: filled while volume_ is built
   FreeSpaceStatistics free_space_;    // likewise
   int64_t beyond_ground_carved_ = 0;  // likewise
+  std::vector<int64_t> ground_held_;   // likewise: the voxels under the ground, until protected
   Volume volume_;
   ViewWorkers workers_;  // declared before visibility_, which uses it to set up rays
   std::unique_ptr<Visibility> visibility_;

@@ -118,6 +118,31 @@ std::string ResolutionText(const CarveRun& run) {
   return text;
 }
 
+// The summary's capture entry: how the cameras stand, the volume chosen, the supporting plane
+// and the ground held under it, a line each.
+std::string CaptureText(const CarveRun& run) {
+  const std::string next_line = "\n                  ";
+  std::string text = run.layout.Summary();
+  if (run.bounds.around_focus) text += next_line + "the volume: the box around their focus";
+  if (run.bounds.depth_tried_points > 0) {
+    text += next_line + "the volume: the " + std::to_string(run.bounds.depth_resolved_points) +
+            " of " + std::to_string(run.bounds.depth_tried_points) +
+            " sparse points the photos place in depth to two voxels (the rest too far for the "
+            "cameras' baseline)";
+  }
+  text += next_line + run.plane.Summary();
+  if (run.plane.found) {
+    text += next_line + "ground: " + run.ground_reason;
+    if (!run.ground.empty()) {
+      const CarveStatistics& s = run.result->statistics;
+      text += " (" + std::to_string(s.ground_voxels) + " voxels; " +
+              std::to_string(s.beyond_ground_carved) + " below it past its edge carved)";
+    }
+  }
+  return text;
+}
+
+
 void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string* text) {
   const CarveStatistics& s = run.result->statistics;
   std::string sparse_line = "none in the volume";
@@ -193,24 +218,7 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
       s.ThreadsText().c_str(), s.peak_memory_bytes / (1024.0 * 1024.0), ProcessPeakMiB(), static_cast<long long>(s.final_surface),
       static_cast<long long>(s.visible_surface), judged_voxels, request.options.min_views,
       sparse_line.c_str(),
-      (run.layout.Summary() +
-       (run.bounds.around_focus ? "\n                  the volume: the box around their focus" : "") +
-       (run.bounds.depth_tried_points > 0
-            ? "\n                  the volume: the " +
-                  std::to_string(run.bounds.depth_resolved_points) + " of " +
-                  std::to_string(run.bounds.depth_tried_points) +
-                  " sparse points the photos place in depth to two voxels (the rest too far for "
-                  "the cameras' baseline)"
-            : std::string()) +
-       "\n                  " + run.plane.Summary() +
-       (run.plane.found ? "\n                  ground: " + run.ground_reason +
-                              (run.ground.empty() ? std::string()
-                                                  : " (" + std::to_string(s.ground_voxels) +
-                                                        " voxels; " +
-                                                        std::to_string(s.beyond_ground_carved) +
-                                                        " below it past its edge carved)")
-                        : std::string()))
-          .c_str(),
+      CaptureText(run).c_str(),
       mask_line.c_str(),
       silhouette_line.c_str(), run.output_path.c_str(),
       run.num_cloud_points,

@@ -102,6 +102,7 @@ void RepairSilhouettesAndRecolour(const std::vector<CalibratedView>& views,
   colouring.lod_levels = 1;
   colouring.visual_hull = false;
   colouring.free_space_margin_voxels = 0.0;
+  colouring.distant_rays.clear();
   colouring.protect_surface_points = false;
   colouring.min_component_voxels = 0;
   colouring.unsupported_component_points = 0.0;
@@ -238,11 +239,13 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     sample(SecondsSince(start));
     level_statistics.carved =
         carver->carved() + carver->visual_hull().carved + carver->free_space().carved +
-        carver->beyond_ground_carved();
+        carver->distant().carved + carver->beyond_ground_carved();
     level_statistics.free_space_carved = carver->free_space().carved;
     statistics.free_space_carved += carver->free_space().carved;
     statistics.free_space_sight_lines = carver->free_space().sight_lines;
     statistics.free_space_seconds += carver->free_space().seconds;
+    statistics.distant_carved += carver->distant().carved;
+    statistics.distant_rays = carver->distant().sight_lines;
     level_statistics.evaluated = carver->evaluated();
     level_statistics.protected_kept = carver->protected_kept();
     statistics.ground_voxels = carver->ground_voxels();

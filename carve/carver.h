@@ -182,6 +182,10 @@ struct CarveOptions {
   // empty space, so the voxels on the sight line from the view's centre to the point are carved
   // before colouring, up to this many voxels short of the point. 0: off.
   double free_space_margin_voxels = 0.0;
+  // Free space from distant pixels (calib/distant_pixels.h; `view` indexes the carve's views): each
+  // ray's voxels are carved before colouring, up to the known surface where one lies on it
+  // (CarveDistantRays). Empty: none.
+  std::vector<DistantRay> distant_rays;
   // The mean-colour error corrected for the number of views (MeanColourDifference). CarveVolume
   // sets it where no view has a mask and the threshold is auto (a number given is on the seed
   // paper's scale): there colour alone carves the empty space, and voxels seen
@@ -230,6 +234,10 @@ struct CarveStatistics {
   int64_t free_space_level0_carved = 0;
   int64_t free_space_sight_lines = 0;
   double free_space_seconds = 0.0;
+  // Voxels removed by the distant pixels' rays (CarveOptions::distant_rays), summed over the
+  // levels; the rays that crossed the grid (at the final level).
+  int64_t distant_carved = 0;
+  int64_t distant_rays = 0;
   std::string FreeSpaceSummary() const;  // one line for the log
   std::string FloaterSummary() const;    // likewise, for the components without sparse points
   int64_t ground_voxels = 0;  // under the ground (CarveOptions::ground), at the final level

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <thread>
+
+#include "carve/known_surface.h"
 
 #include "carve/view_workers.h"
 
@@ -68,17 +71,23 @@ void SegmentVoxels(const VoxelGrid& grid,
   }
 }
 
-FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
-                                   const std::vector<SurfacePoint>& points,
-                                   double margin_voxels,
-                                   Volume* volume,
-                                   int num_threads) {
+namespace {
+
+// Carves every solid voxel that a line passes through, but those holding a surface point and
+// those in `keep`: `draw(k, &voxels)` appends line k's voxels (of `count`) and says whether it
+// crossed the grid. Lines are drawn on `num_threads` threads and their voxels carved in index
+// order, so the result does not depend on the count.
+FreeSpaceStatistics CarveLines(size_t count,
+                               const std::function<bool(size_t, std::vector<int64_t>*)>& draw,
+                               const std::vector<SurfacePoint>& points,
+                               const std::vector<int64_t>& keep,
+                               Volume* volume,
+                               int num_threads) {
   const auto start = std::chrono::steady_clock::now();
   FreeSpaceStatistics statistics;
   const VoxelGrid& grid = volume->grid();
-  const double margin = margin_voxels * grid.voxel_size();
   const int threads = std::max(1, std::min<int>(ResolveNumThreads(num_threads), 64));
-  // Per thread: a bit per voxel that some sight line passed through while solid.
+  // Per thread: a bit per voxel that some line passed through while solid.
   const size_t words = static_cast<size_t>((grid.num_voxels() + 63) / 64);
   std::vector<std::vector<uint64_t>> passed(threads);
   std::vector<int64_t> lines(threads, 0);
@@ -86,31 +95,11 @@ FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
     std::vector<uint64_t>& bits = passed[thread];
     bits.assign(words, 0);
     std::vector<int64_t> voxels;
-    for (size_t p = thread; p < points.size(); p += threads) {
-      const SurfacePoint& point = points[p];
-      // The side of the surface the point was seen from: the mean direction to its views (on a
-      // ring of cameras around a plane, its normal).
-      Eigen::Vector3d facing = Eigen::Vector3d::Zero();
-      for (int v : point.views) facing += (views[v].centre - point.xyz).normalized();
-      if (!(facing.norm() > 0.0)) continue;
-      facing.normalize();
-      for (int v : point.views) {
-        const Eigen::Vector3d& centre = views[v].centre;
-        const Eigen::Vector3d to_point = point.xyz - centre;
-        const double length = to_point.norm();
-        // The line stops `margin` above that plane (at most kMaxSlant margins along the line):
-        // a line that meets the surface at a slant would otherwise cut the surface beside the
-        // point.
-        const double rise = -to_point.dot(facing) / length;
-        if (!(rise > 0.0)) continue;
-        const double stop = margin / std::max(rise, 1.0 / kMaxSlant);
-        if (!(length > stop)) continue;
-        voxels.clear();
-        SegmentVoxels(grid, centre, centre + (1.0 - stop / length) * to_point, &voxels);
-        if (!voxels.empty()) ++lines[thread];
-        for (int64_t index : voxels) {
-          if (volume->IsSolid(index)) bits[index >> 6] |= uint64_t{1} << (index & 63);
-        }
+    for (size_t k = thread; k < count; k += threads) {
+      voxels.clear();
+      if (draw(k, &voxels)) ++lines[thread];
+      for (int64_t index : voxels) {
+        if (volume->IsSolid(index)) bits[index >> 6] |= uint64_t{1} << (index & 63);
       }
     }
   };
@@ -118,15 +107,16 @@ FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
   for (int thread = 1; thread < threads; ++thread) workers.emplace_back(find, thread);
   find(0);
   for (std::thread& worker : workers) worker.join();
-  // A voxel holding a point stays: a sight line that meets it passes the surface at a slant
-  // (or one of the two points is wrong).
-  std::vector<uint64_t> keep(words, 0);
-  for (int64_t index : SurfacePointVoxels(grid, points)) keep[index >> 6] |= uint64_t{1} << (index & 63);
+  // A voxel holding a point stays: a line that meets it passes the surface at a slant (or one of
+  // the two is wrong).
+  std::vector<uint64_t> kept(words, 0);
+  for (int64_t index : SurfacePointVoxels(grid, points)) kept[index >> 6] |= uint64_t{1} << (index & 63);
+  for (int64_t index : keep) kept[index >> 6] |= uint64_t{1} << (index & 63);
   std::vector<int64_t> exposed;
   for (size_t w = 0; w < words; ++w) {
     uint64_t word = 0;
     for (int thread = 0; thread < threads; ++thread) word |= passed[thread][w];
-    word &= ~keep[w];
+    word &= ~kept[w];
     while (word != 0) {
       const int bit = __builtin_ctzll(word);
       word &= word - 1;
@@ -135,10 +125,81 @@ FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
       ++statistics.carved;
     }
   }
-  for (int64_t count : lines) statistics.sight_lines += count;
+  for (int64_t lines_drawn : lines) statistics.sight_lines += lines_drawn;
   statistics.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return statistics;
+}
+
+}  // namespace
+
+FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
+                                   const std::vector<SurfacePoint>& points,
+                                   double margin_voxels,
+                                   Volume* volume,
+                                   int num_threads) {
+  const VoxelGrid& grid = volume->grid();
+  const double margin = margin_voxels * grid.voxel_size();
+  // One line per (point, view): the k-th point's views in turn.
+  std::vector<std::pair<uint32_t, uint32_t>> sightings;
+  for (size_t p = 0; p < points.size(); ++p) {
+    for (size_t k = 0; k < points[p].views.size(); ++k) sightings.emplace_back(p, k);
+  }
+  const auto draw = [&](size_t index, std::vector<int64_t>* voxels) {
+    const SurfacePoint& point = points[sightings[index].first];
+    // The side of the surface the point was seen from: the mean direction to its views (on a
+    // ring of cameras around a plane, its normal).
+    Eigen::Vector3d facing = Eigen::Vector3d::Zero();
+    for (int v : point.views) facing += (views[v].centre - point.xyz).normalized();
+    if (!(facing.norm() > 0.0)) return false;
+    facing.normalize();
+    const Eigen::Vector3d& centre = views[point.views[sightings[index].second]].centre;
+    const Eigen::Vector3d to_point = point.xyz - centre;
+    const double length = to_point.norm();
+    // The line stops `margin` above that plane (at most kMaxSlant margins along the line): a
+    // line that meets the surface at a slant would otherwise cut the surface beside the point.
+    const double rise = -to_point.dot(facing) / length;
+    if (!(rise > 0.0)) return false;
+    const double stop = margin / std::max(rise, 1.0 / kMaxSlant);
+    if (!(length > stop)) return false;
+    SegmentVoxels(grid, centre, centre + (1.0 - stop / length) * to_point, voxels);
+    return !voxels->empty();
+  };
+  return CarveLines(sightings.size(), draw, points, {}, volume, num_threads);
+}
+
+FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
+                                     const std::vector<DistantRay>& rays,
+                                     const std::vector<SurfacePoint>& points,
+                                     double margin_voxels,
+                                     const std::vector<int64_t>& keep,
+                                     Volume* volume,
+                                     int num_threads) {
+  const VoxelGrid& grid = volume->grid();
+  const std::vector<cv::Mat> known = KnownSurfaceDepths(views, grid, points);
+  const Eigen::AlignedBox3d box = grid.Box();
+  const double beyond = box.diagonal().norm();
+  const auto draw = [&](size_t index, std::vector<int64_t>* voxels) {
+    const DistantRay& ray = rays[index];
+    const CalibratedView& view = views[ray.view];
+    const Eigen::Vector3d& centre = view.centre;
+    // Camera depth per unit along the ray.
+    const double depth_rate = (view.cam_from_world.rotation * ray.direction).z();
+    if (!(depth_rate > 0.0)) return false;
+    double length = (box.center() - centre).norm() + beyond;
+    if (!known[ray.view].empty()) {
+      const Eigen::Vector2d pixel = view.Project(centre + ray.direction);
+      const int col = static_cast<int>(std::floor(pixel.x())), row = static_cast<int>(std::floor(pixel.y()));
+      if (col >= 0 && row >= 0 && col < known[ray.view].cols && row < known[ray.view].rows) {
+        const float depth = known[ray.view].at<float>(row, col);
+        if (depth > 0.0f) length = depth / depth_rate - margin_voxels * grid.voxel_size();
+      }
+    }
+    if (!(length > 0.0)) return false;
+    SegmentVoxels(grid, centre, centre + length * ray.direction, voxels);
+    return !voxels->empty();
+  };
+  return CarveLines(rays.size(), draw, points, keep, volume, num_threads);
 }
 
 }  // namespace raycarve

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "calib/calibrated_view.h"
+#include "calib/distant_pixels.h"
 #include "carve/surface_evidence.h"
 #include "carve/volume.h"
 
@@ -30,6 +31,21 @@ FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
                                    double margin_voxels,
                                    Volume* volume,
                                    int num_threads = 1);
+
+// Empty space from the distant pixels (calib/distant_pixels.h): a photo pixel that shows
+// something beyond the volume saw across all of it, so every solid voxel its ray passes through is
+// carved. Where the known surface (KnownSurfaceDepths: sparse points that photo saw near the
+// pixel) lies on the ray, the ray stops `margin_voxels` voxel widths in front of it: a window
+// that mirrors the sky shows it at infinity, and the wall's points around it say where the window
+// is. A voxel holding a surface point, and the voxels in `keep` (the held ground), are never
+// carved. `rays`' views index `views`. Same threads and order as CarveFreeSpace.
+FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
+                                     const std::vector<DistantRay>& rays,
+                                     const std::vector<SurfacePoint>& points,
+                                     double margin_voxels,
+                                     const std::vector<int64_t>& keep,
+                                     Volume* volume,
+                                     int num_threads = 1);
 
 // The voxels of `grid` that the segment from `from` to `to` passes through, in order (a voxel
 // whose closed cube the segment only touches at an edge or corner may or may not be listed),

@@ -66,6 +66,7 @@ Volume PreCarved(const std::vector<CalibratedView>& views,
                  const CarveOptions& options,
                  VisualHullStatistics* hull,
                  FreeSpaceStatistics* free_space,
+                 FreeSpaceStatistics* distant,
                  std::vector<int64_t>* ground_held,
                  int64_t* beyond_ground) {
   if (options.visual_hull) *hull = CarveVisualHull(views, &volume, options.num_threads);
@@ -81,6 +82,12 @@ Volume PreCarved(const std::vector<CalibratedView>& views,
   if (options.free_space_margin_voxels > 0.0 && !options.surface_points.empty()) {
     *free_space = CarveFreeSpace(views, options.surface_points, options.free_space_margin_voxels,
                                  &volume, options.num_threads);
+  }
+  if (!options.distant_rays.empty()) {
+    const double margin = options.free_space_margin_voxels > 0.0 ? options.free_space_margin_voxels
+                                                                 : kKnownSurfaceMarginVoxels;
+    *distant = CarveDistantRays(views, options.distant_rays, options.surface_points, margin,
+                                *ground_held, &volume, options.num_threads);
   }
   return volume;
 }
@@ -115,7 +122,7 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                                      const VisibilityFactory& factory)
     : views_(views),
       volume_(PreCarved(views, std::move(start), options, &visual_hull_, &free_space_,
-                        &ground_held_, &beyond_ground_carved_)),
+                        &distant_, &ground_held_, &beyond_ground_carved_)),
       workers_(static_cast<int>(views.size()),
                options.method == CarveMethod::kRay ? options.num_threads : 1),
       visibility_(factory ? factory(views, volume_)

@@ -71,6 +71,7 @@ class IncrementalCarver {
   const Volume& volume() const { return volume_; }
   const VisualHullStatistics& visual_hull() const { return visual_hull_; }
   const FreeSpaceStatistics& free_space() const { return free_space_; }
+  const FreeSpaceStatistics& distant() const { return distant_; }
   Volume* mutable_volume() { return &volume_; }
   Visibility& visibility() { return *visibility_; }
   // The ray-cast visibility, or nullptr with another method.
@@ -163,6 +164,7 @@ class IncrementalCarver {
   const std::vector<CalibratedView>& views_;
   VisualHullStatistics visual_hull_;  // declared before volume_: filled while volume_ is built
   FreeSpaceStatistics free_space_;    // likewise
+  FreeSpaceStatistics distant_;       // likewise
   int64_t beyond_ground_carved_ = 0;  // likewise
   std::vector<int64_t> ground_held_;   // likewise: the voxels under the ground, until protected
   Volume volume_;

@@ -61,6 +61,10 @@ void LogSurfacePointUses(const CarveOptions& options, size_t count) {
 // Logs what the carve did beyond colouring: free space, floaters, repair, thresholds.
 void LogCarve(const CarveOptions& options, const CarveStatistics& s) {
   if (s.free_space_sight_lines > 0) LOG(INFO) << s.FreeSpaceSummary();
+  if (s.distant_rays > 0) {
+    LOG(INFO) << "distant free space: " << s.distant_rays << " rays of distant pixels carved "
+              << s.distant_carved << " voxels";
+  }
   if (s.unsupported_components > 0) LOG(INFO) << s.FloaterSummary();
   if (s.silhouette_repair.views > 0) LOG(INFO) << s.silhouette_repair.Summary();
   for (const LevelStatistics& level : s.levels) {
@@ -218,9 +222,29 @@ void CarvePipeline::DecideGround() {
   LOG(INFO) << "ground: " << run_.ground_reason;
 }
 
+void CarvePipeline::FindDistant() {
+  run_.distant = DistantPixels();
+  distant_rays_.clear();
+  if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
+    run_.distant_reason = "masks say what is background";
+  } else if (!request_.distant_free_space) {
+    run_.distant_reason = "--distant_free_space 0";
+  } else {
+    run_.distant_reason.clear();
+    DistantOptions options;
+    options.num_threads = request_.options.num_threads;
+    run_.distant = FindDistantPixels(carved_, project_.bounds.box, options);
+    LOG(INFO) << run_.distant.Summary();
+    distant_rays_ = std::move(run_.distant.rays);
+    run_.distant.rays.clear();
+    RecordSeconds("distant_pixels", run_.distant.seconds);
+  }
+}
+
 void CarvePipeline::CheckVolume() {
   CHECK(loaded_);
   DecideGround();
+  FindDistant();
   std::string reason;
   if (!CheckCarveFits(carved_, project_.bounds.box, request_.options, &reason)) {
     throw InputError("raycarve " + scope_.command + ": " + reason);
@@ -368,6 +392,7 @@ CarveResult CarvePipeline::CarveWith(CarveOptions options,
   }
   options.surface_points = surface_points_;
   options.ground = run_.ground;
+  options.distant_rays = distant_rays_;
   return CarveVolume(carved_, project_.bounds.box, options, progress, progress_interval_seconds);
 }
 

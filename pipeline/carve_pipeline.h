@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "calib/atomic_file.h"
+#include "calib/distant_pixels.h"
 #include "carve/carver.h"
 #include "export/supporting_plane.h"
 #include "carve/mask_agreement.h"
@@ -47,6 +48,10 @@ struct CarveRun {
   // The ground under it held solid by the carve (CarveRequest::hold_ground); empty: none.
   Ground ground;
   std::string ground_reason;  // why there is none, or where it is
+  // The distant pixels (CarveRequest::distant_free_space): what was judged and found; `rays` is
+  // left empty here (the carve takes them).
+  DistantPixels distant;
+  std::string distant_reason;  // why none were looked for (empty when they were)
   int num_views = 0;  // the views carved
   int num_missing_images = 0;
   int masks_from_files = 0;
@@ -151,6 +156,7 @@ class CarvePipeline {
  private:
   void DecideMasks();
   void DecideGround();  // run_.ground, once the masks are decided
+  void FindDistant();   // distant_rays_ and run_.distant, once the masks are decided
   void RecordSeconds(const std::string& stage, double seconds);
   void WriteMasks(const std::filesystem::path& staging) const;
   // report.html (pipeline/report_page.h): the summary, preview.png, the convergence plot and
@@ -164,6 +170,7 @@ class CarvePipeline {
   std::vector<CalibratedView> carved_;
   std::vector<CalibratedView> held_out_;
   std::vector<SurfacePoint> surface_points_;
+  std::vector<DistantRay> distant_rays_;
   exporter::ModelMesh model_;
   std::vector<exporter::ColouredPoint> points_;
   std::vector<std::vector<uint32_t>> visibility_;  // per point, image indices (COLMAP's .vis)

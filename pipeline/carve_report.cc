@@ -24,6 +24,7 @@ void WriteOptions(const CarveRequest& request, const CarveRun& run, JsonWriter& 
       .Key("protect_surface_points").Value(request.options.protect_surface_points)
       .Key("free_space_margin").Value(request.options.free_space_margin_voxels)
       .Key("hold_ground").Value(request.hold_ground)
+      .Key("distant_free_space").Value(request.distant_free_space)
       .Key("floater_expected_points").Value(request.options.unsupported_component_points)
       .Key("repair_silhouettes").Value(request.options.repair_silhouettes)
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
@@ -178,6 +179,19 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
       .Key("ground_reach").Value(run.ground.radius)
       .Key("ground_voxels").Value(s.ground_voxels)
       .Key("beyond_ground_carved").Value(s.beyond_ground_carved)
+      .EndObject();
+  const DistantPixels& distant = run.distant;
+  json.Key("distant_pixels").BeginObject()
+      .Key("looked_for").Value(run.distant_reason.empty())
+      .Key("reason").Value(run.distant_reason)
+      .Key("photos").Value(static_cast<int64_t>(distant.masks.size()))
+      .Key("textured_pixels").Value(distant.textured)
+      .Key("distant_pixels").Value(distant.distant)
+      .Key("nearer_pixels").Value(distant.nearer)
+      .Key("plain_region_pixels").Value(distant.grown)
+      .Key("rays").Value(s.distant_rays)
+      .Key("voxels_carved").Value(s.distant_carved)
+      .Key("seconds").Value(distant.seconds)
       .EndObject();
   json.EndObject();
   json.Key("statistics").BeginObject()

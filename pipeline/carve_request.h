@@ -74,6 +74,10 @@ struct CarveRequest {
   // lies under it, where its points are, is held solid (CarveOptions::ground): colour carving
   // through a plain or repeating floor would open it and show the photos the volume under it.
   bool hold_ground = true;
+  // Without masks: photo pixels whose pattern moves between the photos as something beyond the
+  // volume would (sky, clouds, far hills; calib/distant_pixels.h) saw across the volume, and
+  // their rays are carved before colouring (CarveOptions::distant_rays).
+  bool distant_free_space = true;
   // A grid whose voxels span fewer pixels of the photos than this (median at the volume's
   // centre) is refused before the work: there the photos cannot tell a voxel from its
   // neighbours, rays pass between voxels that are never judged, and the carve degrades (the

@@ -130,6 +130,18 @@ std::string CaptureText(const CarveRun& run) {
             " sparse points the photos place in depth to two voxels (the rest too far for the "
             "cameras' baseline)";
   }
+  if (run.distant_reason.empty()) {
+    const DistantPixels& d = run.distant;
+    char line[320];
+    std::snprintf(line, sizeof(line),
+                  "distant: %.1f%% of the photos' textured pixels move as things beyond the "
+                  "volume do (sky, far hills), with %lld pixels of plain regions they bound; "
+                  "their rays carved %lld voxels",
+                  d.textured > 0 ? 100.0 * d.distant / d.textured : 0.0,
+                  static_cast<long long>(d.grown),
+                  static_cast<long long>(run.result->statistics.distant_carved));
+    text += next_line + line;
+  }
   text += next_line + run.plane.Summary();
   if (run.plane.found) {
     text += next_line + "ground: " + run.ground_reason;

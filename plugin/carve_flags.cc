@@ -88,6 +88,11 @@ void AddCarvingFlags(OptionParser* parser, CarveRequest* request, CarveFlagText*
                      "without masks, where the sparse points show a plane the subject stands on "
                      "(a floor, a table top): keep what lies under it, where its points are, "
                      "solid (colour carving never opens the floor)");
+  parser->AddDefault("distant_free_space", &request->distant_free_space,
+                     "without masks, where a photo's pattern moves between the photos as "
+                     "something beyond the volume would (sky, clouds, far hills), its rays saw "
+                     "across the volume: carve them before colouring (stopping short of sparse "
+                     "points seen there)");
   parser->AddDefault("floater_expected_points", &request->options.unsupported_component_points,
                      "carve a piece of the model (26-connected, under a quarter of the largest) "
                      "that holds no reliable sparse point where the points' density on the model "

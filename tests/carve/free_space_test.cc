@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/test_support.h"
+
 namespace raycarve {
 namespace {
 
@@ -133,6 +135,34 @@ TEST(CarveFreeSpace, NoPointsOrAZeroMarginCarveOnlyWhatTheLinesReach) {
   EXPECT_EQ(s.carved, 3);  // z = 7, 8, 9
   for (int z = 0; z < 10; ++z) EXPECT_EQ(volume.IsSolid(Eigen::Vector3i(5, 5, z)), z < 7) << z;
   EXPECT_TRUE(volume.IsSolid(Eigen::Vector3i(4, 5, 9)));
+}
+
+// A distant pixel's ray carves its whole column; where a sparse point the photo saw lies near
+// the pixel, the ray stops two voxels short of it; the voxels to keep stay.
+TEST(CarveDistantRays, CarveTheWholeRayOrStopShortOfTheKnownSurface) {
+  const VoxelGrid grid(Eigen::AlignedBox3d(Eigen::Vector3d::Constant(-0.5), Eigen::Vector3d::Constant(0.5)), 10);
+  const std::vector<uint64_t> all((grid.num_voxels() + 63) / 64, ~uint64_t{0});
+  const std::vector<CalibratedView> views = {
+      testing::PinholeViewLookingAtOrigin(Eigen::Vector3d(0, 0, 5), 100, 100, 100.0)};
+  const Eigen::Vector3d target(0.05, 0.05, 0.05);  // in voxel (5, 5, 5)
+  const DistantRay ray{0, (target - views[0].centre).normalized()};
+  Volume open(grid, all);
+  FreeSpaceStatistics s = CarveDistantRays(views, {ray}, {}, 2.0, {}, &open);
+  EXPECT_EQ(s.sight_lines, 1);
+  EXPECT_EQ(s.carved, 10);
+  for (int z = 0; z < 10; ++z) EXPECT_FALSE(open.IsSolid(Eigen::Vector3i(5, 5, z))) << z;
+  // The point seen there: the ray stops 2 voxels short of it (at z = 0.05 + 0.2, in voxel 7), and
+  // the voxel kept (z = 9) stays.
+  SurfacePoint point;
+  point.xyz = target;
+  point.views = {0};
+  Volume stopped(grid, all);
+  s = CarveDistantRays(views, {ray}, {point}, 2.0, {grid.Index(Eigen::Vector3i(5, 5, 9))}, &stopped);
+  for (int z = 0; z < 10; ++z) EXPECT_EQ(stopped.IsSolid(Eigen::Vector3i(5, 5, z)), z < 7 || z == 9) << z;
+  EXPECT_EQ(s.carved, 2);
+  // A ray pointing away from the photo's axis carves nothing.
+  Volume behind(grid, all);
+  EXPECT_EQ(CarveDistantRays(views, {DistantRay{0, -ray.direction}}, {}, 2.0, {}, &behind).carved, 0);
 }
 
 }  // namespace

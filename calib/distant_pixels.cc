@@ -1,0 +1,439 @@
+#include "calib/distant_pixels.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <thread>
+
+#include <glog/logging.h>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/pixel.h"
+
+namespace raycarve {
+
+bool DistantOptions::IsValid(std::string* reason) const {
+  if (max_side < 32) {
+    *reason = "distant pixels: max_side must be at least 32";
+  } else if (patch_radius < 1 || patch_radius > 8) {
+    *reason = "distant pixels: patch_radius must be 1 to 8";
+  } else if (stride < 1) {
+    *reason = "distant pixels: stride must be at least 1";
+  } else if (!(min_parallax > 0.0)) {
+    *reason = "distant pixels: min_parallax must be positive";
+  } else if (!(min_correlation > 0.0 && min_correlation <= 1.0)) {
+    *reason = "distant pixels: min_correlation must be in (0, 1]";
+  } else if (!(min_advantage >= 0.0)) {
+    *reason = "distant pixels: min_advantage must be at least 0";
+  } else if (min_agreeing_views < 1 || max_partners < min_agreeing_views) {
+    *reason = "distant pixels: need 1 <= min_agreeing_views <= max_partners";
+  } else {
+    return true;
+  }
+  return false;
+}
+
+std::string DistantPixels::Summary() const {
+  std::ostringstream text;
+  text.precision(3);
+  text << "distant pixels: " << distant << " of " << textured << " textured pixels judged in "
+       << masks.size() << " photos show something beyond the volume, and " << grown
+       << " pixels of plain regions bounded by them (" << rays.size() << " rays); " << nearer
+       << " were found inside it; " << seconds << " s";
+  return text.str();
+}
+
+double ImageNoiseSigma(const cv::Mat& grey) {
+  CHECK_EQ(grey.type(), CV_32F);
+  if (grey.rows < 3 || grey.cols < 3) return 0.0;
+  const cv::Mat kernel = (cv::Mat_<float>(3, 3) << 1, -2, 1, -2, 4, -2, 1, -2, 1);
+  cv::Mat response;
+  cv::filter2D(grey, response, CV_32F, kernel, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
+  const cv::Mat inner = cv::abs(response(cv::Rect(1, 1, grey.cols - 2, grey.rows - 2)));
+  const double sum = cv::sum(inner)[0];
+  return std::sqrt(M_PI / 2.0) * sum / (6.0 * (grey.cols - 2) * (grey.rows - 2));
+}
+
+namespace {
+
+// The verdicts in DistantPixels::masks.
+constexpr uint8_t kDistantJudged = 255;
+constexpr uint8_t kGrown = 200;
+constexpr uint8_t kUndecided = 128;
+constexpr uint8_t kNearer = 64;
+// A plain region is distant when at least this many of the judged pixels on its rim, and this
+// share of them, are distant, and those found nearer are at most this share of the distant.
+constexpr int kMinRimVotes = 3;
+constexpr double kMinRimShare = 0.25;
+constexpr double kMaxRimNearShare = 0.05;
+
+// A photo as judged: reduced, in colour and grey, with its geometry in the reduced pixels.
+struct GreyView {
+  cv::Mat rgb;    // CV_32FC3
+  cv::Mat grey;   // CV_32F
+  cv::Mat valid;  // CV_8UC1
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // camera from world
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 3, 4> P = Eigen::Matrix<double, 3, 4>::Zero();
+  int factor = 1;
+  double texture = 0.0;  // the smallest standard deviation of a textured patch
+};
+
+GreyView GreyViewOf(const CalibratedView& view, const DistantOptions& options) {
+  GreyView g;
+  g.factor = std::max(1, (std::max(view.width, view.height) + options.max_side - 1) / options.max_side);
+  g.factor = std::min(g.factor, std::max(1, std::min(view.width, view.height)));
+  const CalibratedView reduced = ReduceView(view, g.factor);
+  reduced.image.convertTo(g.rgb, CV_32FC3);
+  cv::cvtColor(g.rgb, g.grey, cv::COLOR_RGB2GRAY);
+  g.valid = reduced.valid.empty() ? cv::Mat(reduced.image.size(), CV_8UC1, cv::Scalar(255))
+                                  : reduced.valid.clone();
+  g.K = reduced.K;
+  g.R = reduced.cam_from_world.rotation.toRotationMatrix();
+  g.centre = reduced.centre;
+  g.P = reduced.P;
+  g.texture = std::max(options.min_texture, options.texture_noise_factor * ImageNoiseSigma(g.grey));
+  return g;
+}
+
+// Bilinear RGB at a COLMAP pixel position into value[0..2]; false outside the valid pixels.
+bool Sample(const GreyView& g, const Eigen::Vector2d& colmap, float* value) {
+  const Eigen::Vector2d cv = OpenCvFromColmap(colmap);
+  const int x0 = static_cast<int>(std::floor(cv.x())), y0 = static_cast<int>(std::floor(cv.y()));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= g.rgb.cols || y0 + 1 >= g.rgb.rows) return false;
+  if (!g.valid.at<uint8_t>(y0, x0) || !g.valid.at<uint8_t>(y0 + 1, x0 + 1)) return false;
+  const float fx = static_cast<float>(cv.x() - x0), fy = static_cast<float>(cv.y() - y0);
+  const cv::Vec3f* a = g.rgb.ptr<cv::Vec3f>(y0);
+  const cv::Vec3f* b = g.rgb.ptr<cv::Vec3f>(y0 + 1);
+  for (int c = 0; c < 3; ++c) {
+    value[c] = (1 - fy) * ((1 - fx) * a[x0][c] + fx * a[x0 + 1][c]) +
+               fy * ((1 - fx) * b[x0][c] + fx * b[x0 + 1][c]);
+  }
+  return true;
+}
+
+// Removes each channel's mean from a patch of RGB samples (k * 3 + channel); returns the squared
+// norm of what is left.
+double CentrePatch(std::vector<float>* samples) {
+  std::vector<float>& s = *samples;
+  const size_t count = s.size() / 3;
+  double norm = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    double mean = 0.0;
+    for (size_t k = 0; k < count; ++k) mean += s[3 * k + c];
+    mean /= static_cast<double>(count);
+    for (size_t k = 0; k < count; ++k) {
+      s[3 * k + c] = static_cast<float>(s[3 * k + c] - mean);
+      norm += s[3 * k + c] * s[3 * k + c];
+    }
+  }
+  return norm;
+}
+
+// Zero-mean normalised correlation, over the three channels (each less its mean), of the centred
+// patch `a` (with its squared norm) with photo j sampled at `centre` + `offsets`; -1 where a
+// sample falls outside j's valid pixels or j's patch is plain. In colour, an edge between two
+// colours does not match an edge between two others, as it would in grey.
+double Correlation(const std::vector<float>& a, double a_norm, const GreyView& j,
+                   const Eigen::Vector2d& centre, const std::vector<Eigen::Vector2d>& offsets,
+                   std::vector<float>* buffer) {
+  std::vector<float>& b = *buffer;
+  b.resize(3 * offsets.size());
+  for (size_t k = 0; k < offsets.size(); ++k) {
+    if (!Sample(j, centre + offsets[k], &b[3 * k])) return -1.0;
+  }
+  const double norm = CentrePatch(&b);
+  if (!(norm > 1e-6)) return -1.0;
+  double dot = 0.0;
+  for (size_t k = 0; k < b.size(); ++k) dot += a[k] * b[k];
+  return dot / std::sqrt(a_norm * norm);
+}
+
+// The parameters t (X = centre + t * direction) where the ray is inside `box`; false if never.
+bool RayInBox(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+              const Eigen::AlignedBox3d& box, double* t0, double* t1) {
+  double near = 0.0, far = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(direction[a]) < 1e-12) {
+      if (origin[a] < box.min()[a] || origin[a] > box.max()[a]) return false;
+      continue;
+    }
+    double ta = (box.min()[a] - origin[a]) / direction[a];
+    double tb = (box.max()[a] - origin[a]) / direction[a];
+    if (ta > tb) std::swap(ta, tb);
+    near = std::max(near, ta);
+    far = std::min(far, tb);
+  }
+  *t0 = near;
+  *t1 = far;
+  return far > near;
+}
+
+// One pair's geometry for one pixel: where infinity and the volume's segment land in photo j.
+struct PairGeometry {
+  int partner = -1;
+  Eigen::Vector2d at_infinity;
+  std::vector<Eigen::Vector2d> offsets;  // the patch warped by H, around at_infinity
+  std::vector<Eigen::Vector2d> segment;  // samples of the ray inside the volume, projected
+};
+
+bool ProjectInFront(const GreyView& j, const Eigen::Vector3d& x, Eigen::Vector2d* pixel) {
+  const Eigen::Vector3d h = j.P * x.homogeneous();
+  if (!(h.z() > 1e-9)) return false;
+  *pixel = h.hnormalized();
+  return true;
+}
+
+bool PairFor(const GreyView& i, const GreyView& j, int partner, const Eigen::Matrix3d& H,
+             const Eigen::Vector2d& p, const Eigen::Vector3d& direction, double t0, double t1,
+             const std::vector<Eigen::Vector2d>& patch, const DistantOptions& options,
+             PairGeometry* pair) {
+  const Eigen::Vector3d h = H * p.homogeneous();
+  if (!(h.z() > 1e-9)) return false;  // the direction is behind photo j
+  const Eigen::Vector2d q = h.hnormalized();
+  const double margin = options.patch_radius + 2.0;
+  if (q.x() < margin || q.y() < margin || q.x() > j.rgb.cols - margin ||
+      q.y() > j.rgb.rows - margin) {
+    return false;
+  }
+  // The volume's far end must be told apart from infinity.
+  Eigen::Vector2d far;
+  if (!ProjectInFront(j, i.centre + t1 * direction, &far)) return false;
+  if ((far - q).norm() < options.min_parallax) return false;
+  pair->partner = partner;
+  pair->at_infinity = q;
+  pair->offsets.clear();
+  for (const Eigen::Vector2d& o : patch) {
+    pair->offsets.push_back((H * (p + o).homogeneous()).hnormalized() - q);
+  }
+  // Samples uniform in inverse distance (about uniform in the image), about a pixel apart, of the
+  // part of the segment in front of photo j.
+  pair->segment.clear();
+  Eigen::Vector2d near_pixel;
+  double t_near = std::max(t0, 1e-6);
+  while (t_near < t1 && !ProjectInFront(j, i.centre + t_near * direction, &near_pixel)) {
+    t_near = t_near * 2.0 + 1e-6;
+  }
+  if (!(t_near < t1)) return true;
+  const double length = (near_pixel - far).norm();
+  const int count = std::clamp(static_cast<int>(std::ceil(length)) + 1, 2, 128);
+  for (int k = 0; k < count; ++k) {
+    const double s = 1.0 / t1 + (1.0 / t_near - 1.0 / t1) * k / (count - 1);
+    Eigen::Vector2d pixel;
+    if (ProjectInFront(j, i.centre + direction / s, &pixel)) pair->segment.push_back(pixel);
+  }
+  return true;
+}
+
+// The verdict on pixel p of photo i: 1 distant, -1 nearer, 0 neither.
+int Judge(const std::vector<GreyView>& views, int v, const std::vector<int>& partners,
+          const std::vector<Eigen::Matrix3d>& homographies, const Eigen::AlignedBox3d& box,
+          const Eigen::Vector2d& p, const std::vector<float>& a, double a_norm,
+          const std::vector<Eigen::Vector2d>& patch, const DistantOptions& options,
+          std::vector<PairGeometry>* pairs, std::vector<float>* buffer) {
+  const GreyView& i = views[v];
+  const Eigen::Vector3d direction = i.R.transpose() * (i.K.inverse() * p.homogeneous());
+  double t0 = 0.0, t1 = 0.0;
+  if (!RayInBox(i.centre, direction, box, &t0, &t1)) return 0;
+  // First the cheap test at infinity, on up to max_partners photos.
+  pairs->clear();
+  int matched = 0;
+  std::vector<double> at_infinity;
+  for (int partner : partners) {
+    if (static_cast<int>(pairs->size()) >= options.max_partners) break;
+    PairGeometry pair;
+    if (!PairFor(i, views[partner], partner, homographies[partner], p, direction, t0, t1, patch,
+                 options, &pair)) {
+      continue;
+    }
+    const double c = Correlation(a, a_norm, views[partner], pair.at_infinity, pair.offsets, buffer);
+    at_infinity.push_back(c);
+    if (c >= options.min_correlation) ++matched;
+    pairs->push_back(std::move(pair));
+  }
+  if (matched < options.min_agreeing_views) return 0;
+  // Then the volume's segment, in every photo asked: one that matches inside clearly better is a
+  // veto; a match at infinity counts where nothing inside comes near it.
+  int agreeing = 0;
+  for (size_t k = 0; k < pairs->size(); ++k) {
+    const PairGeometry& pair = (*pairs)[k];
+    const GreyView& j = views[pair.partner];
+    double inside = -1.0;
+    for (const Eigen::Vector2d& s : pair.segment) {
+      if ((s - pair.at_infinity).norm() < options.min_parallax) continue;
+      inside = std::max(inside, Correlation(a, a_norm, j, s, pair.offsets, buffer));
+    }
+    if (inside >= options.min_correlation && inside - at_infinity[k] >= options.min_advantage) {
+      return -1;
+    }
+    if (at_infinity[k] >= options.min_correlation && at_infinity[k] - inside >= options.min_advantage) {
+      ++agreeing;
+    }
+  }
+  return agreeing >= options.min_agreeing_views ? 1 : 0;
+}
+
+// The plain regions (connected pixels whose patch is not textured) whose rim is mostly found
+// distant: the inside of a patch of sky whose edges move as the sky does. Marks them kGrown in
+// `mask` (which holds the judged pixels' verdicts), counts their pixels in *grown and returns the
+// pixels (COLMAP coordinates) of their rays, every `stride` pixels.
+std::vector<Eigen::Vector2d> GrowIntoPlainRegions(const GreyView& g, const DistantOptions& options,
+                                                  cv::Mat* mask, int64_t* grown) {
+  const int side = 2 * options.patch_radius + 1;
+  cv::Mat mean, square;
+  cv::boxFilter(g.grey, mean, CV_32F, cv::Size(side, side));
+  cv::boxFilter(g.grey.mul(g.grey), square, CV_32F, cv::Size(side, side));
+  cv::Mat plain(g.grey.size(), CV_8UC1, cv::Scalar(0));
+  const float limit = static_cast<float>(g.texture * g.texture);
+  for (int row = options.patch_radius; row < g.grey.rows - options.patch_radius; ++row) {
+    for (int col = options.patch_radius; col < g.grey.cols - options.patch_radius; ++col) {
+      const float m = mean.at<float>(row, col);
+      if (square.at<float>(row, col) - m * m < limit && g.valid.at<uint8_t>(row, col)) {
+        plain.at<uint8_t>(row, col) = 255;
+      }
+    }
+  }
+  cv::Mat labels;
+  const int count = cv::connectedComponents(plain, labels, 4, CV_32S);
+  // Per region, the verdicts of the judged pixels within reach of it (a patch and a stride).
+  std::vector<int> distant(count, 0), judged(count, 0), nearer(count, 0), size(count, 0);
+  for (int row = 0; row < labels.rows; ++row) {
+    for (int col = 0; col < labels.cols; ++col) ++size[labels.at<int>(row, col)];
+  }
+  const int reach = options.patch_radius + options.stride;
+  std::vector<int> near_labels;
+  for (int row = 0; row < mask->rows; ++row) {
+    for (int col = 0; col < mask->cols; ++col) {
+      const uint8_t verdict = mask->at<uint8_t>(row, col);
+      if (verdict == 0) continue;
+      near_labels.clear();
+      for (int y = std::max(0, row - reach); y <= std::min(labels.rows - 1, row + reach); ++y) {
+        for (int x = std::max(0, col - reach); x <= std::min(labels.cols - 1, col + reach); ++x) {
+          const int label = labels.at<int>(y, x);
+          if (label > 0 && std::find(near_labels.begin(), near_labels.end(), label) == near_labels.end()) {
+            near_labels.push_back(label);
+          }
+        }
+      }
+      for (int label : near_labels) {
+        ++judged[label];
+        if (verdict == kDistantJudged) ++distant[label];
+        if (verdict == kNearer) ++nearer[label];
+      }
+    }
+  }
+  std::vector<uint8_t> is_distant(count, 0);
+  for (int label = 1; label < count; ++label) {
+    is_distant[label] = size[label] >= side * side && distant[label] >= kMinRimVotes &&
+                        distant[label] >= kMinRimShare * judged[label] &&
+                        nearer[label] <= kMaxRimNearShare * distant[label];
+  }
+  std::vector<Eigen::Vector2d> pixels;
+  for (int row = 0; row < labels.rows; ++row) {
+    for (int col = 0; col < labels.cols; ++col) {
+      if (!is_distant[labels.at<int>(row, col)]) continue;
+      ++*grown;
+      if (mask->at<uint8_t>(row, col) == 0) mask->at<uint8_t>(row, col) = kGrown;
+      if (row % options.stride == 0 && col % options.stride == 0) pixels.push_back(PixelCentre(row, col));
+    }
+  }
+  return pixels;
+}
+
+}  // namespace
+
+DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
+                                const Eigen::AlignedBox3d& box,
+                                const DistantOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string reason;
+  CHECK(options.IsValid(&reason)) << reason;
+  DistantPixels result;
+  const int n = static_cast<int>(views.size());
+  std::vector<GreyView> grey(n);
+  for (int v = 0; v < n; ++v) grey[v] = GreyViewOf(views[v], options);
+  const int r = options.patch_radius;
+  std::vector<Eigen::Vector2d> patch;
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) patch.emplace_back(dx, dy);
+  }
+  std::vector<std::vector<DistantRay>> rays(n);
+  std::vector<cv::Mat> masks(n);
+  std::vector<int64_t> textured(n, 0), distant(n, 0), nearer(n, 0), grown(n, 0);
+  std::atomic<int> next{0};
+  auto work = [&] {
+    std::vector<PairGeometry> pairs;
+    std::vector<float> a(3 * patch.size()), buffer;
+    for (int v = next++; v < n; v = next++) {
+      const GreyView& i = grey[v];
+      // Partners: the other photos, farthest first (the most parallax).
+      std::vector<int> partners;
+      std::vector<Eigen::Matrix3d> homographies(n);
+      for (int w = 0; w < n; ++w) {
+        if (w == v) continue;
+        partners.push_back(w);
+        homographies[w] = grey[w].K * grey[w].R * i.R.transpose() * i.K.inverse();
+      }
+      std::stable_sort(partners.begin(), partners.end(), [&](int x, int y) {
+        return (grey[x].centre - i.centre).squaredNorm() > (grey[y].centre - i.centre).squaredNorm();
+      });
+      cv::Mat mask(i.grey.size(), CV_8UC1, cv::Scalar(0));
+      for (int row = r + 1; row < i.grey.rows - r - 1; row += options.stride) {
+        for (int col = r + 1; col < i.grey.cols - r - 1; col += options.stride) {
+          const Eigen::Vector2d p = PixelCentre(row, col);
+          bool ok = true;
+          for (size_t k = 0; k < patch.size() && ok; ++k) ok = Sample(i, p + patch[k], &a[3 * k]);
+          if (!ok) continue;
+          // Textured: the grey patch's standard deviation (the colour patch's is its upper bound).
+          double grey_mean = 0.0, grey_square = 0.0;
+          for (size_t k = 0; k < patch.size(); ++k) {
+            const double grey_value = 0.299 * a[3 * k] + 0.587 * a[3 * k + 1] + 0.114 * a[3 * k + 2];
+            grey_mean += grey_value;
+            grey_square += grey_value * grey_value;
+          }
+          grey_mean /= static_cast<double>(patch.size());
+          const double grey_variance = grey_square / patch.size() - grey_mean * grey_mean;
+          if (!(grey_variance >= i.texture * i.texture)) continue;
+          const double a_norm = CentrePatch(&a);
+          ++textured[v];
+          const int verdict =
+              Judge(grey, v, partners, homographies, box, p, a, a_norm, patch, options, &pairs, &buffer);
+          mask.at<uint8_t>(row, col) = verdict > 0 ? kDistantJudged : verdict < 0 ? kNearer : kUndecided;
+          if (verdict < 0) ++nearer[v];
+          if (verdict <= 0) continue;
+          ++distant[v];
+          const Eigen::Vector3d direction = i.R.transpose() * (i.K.inverse() * p.homogeneous());
+          rays[v].push_back(DistantRay{v, direction.normalized()});
+        }
+      }
+      for (const Eigen::Vector2d& p : GrowIntoPlainRegions(i, options, &mask, &grown[v])) {
+        const Eigen::Vector3d direction = i.R.transpose() * (i.K.inverse() * p.homogeneous());
+        rays[v].push_back(DistantRay{v, direction.normalized()});
+      }
+      masks[v] = mask;
+    }
+  };
+  const int threads = std::max(1, std::min(n, options.num_threads > 0
+                                                  ? options.num_threads
+                                                  : static_cast<int>(std::thread::hardware_concurrency())));
+  std::vector<std::thread> workers;
+  for (int t = 1; t < threads; ++t) workers.emplace_back(work);
+  work();
+  for (std::thread& worker : workers) worker.join();
+  for (int v = 0; v < n; ++v) {
+    result.rays.insert(result.rays.end(), rays[v].begin(), rays[v].end());
+    result.textured += textured[v];
+    result.distant += distant[v];
+    result.nearer += nearer[v];
+    result.grown += grown[v];
+    result.factors.push_back(grey[v].factor);
+  }
+  result.masks = std::move(masks);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace raycarve

@@ -1,0 +1,82 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "calib/calibrated_view.h"
+
+namespace raycarve {
+
+// Photo pixels that show something far beyond the volume: sky, clouds, far hills. Without masks
+// such pixels are the only evidence that the space in front of them is empty where their colours
+// also agree across the photos (a smooth or coarsely patterned sky seen through empty space from
+// nearby cameras shows them the same colour, and voxel colouring keeps what agrees).
+//
+// The test is geometric. Between two photos i and j, what lies at infinity moves by the infinite
+// homography H = K_j R_j R_i^T K_i^-1 (the rotation alone); a point inside the volume moves by
+// its parallax, along the epipolar line, to where the segment of i's ray inside the volume
+// projects in j. A textured patch around pixel p of photo i is distant when it matches photo j at
+// H p (zero-mean normalised correlation, the patch warped by H) clearly better than anywhere on
+// that segment, and the segment's far end lies at least `min_parallax` pixels from H p (the
+// photos resolve the volume's depth there). A pixel is distant when `min_agreeing_views` other
+// photos say so and none finds it clearly nearer. Plain patches say nothing either way and are
+// never judged by themselves: a plain region (connected pixels whose patch is not textured) is
+// distant when the judged pixels on its rim mostly are, and none nearer (the blue between
+// clouds, a patch of a patterned sky, bounded by edges that move as the sky does; a plain wall's
+// rim moves with the wall).
+struct DistantOptions {
+  int max_side = 640;        // photos are judged reduced to at most this many pixels a side
+  int patch_radius = 3;      // patches of (2r + 1)^2 pixels at that size
+  int stride = 2;            // a pixel judged every `stride` pixels along rows and columns
+  double min_parallax = 3.0;  // pixels, at the reduced size
+  double min_correlation = 0.85;  // a patch matches where its correlation reaches this
+  double min_advantage = 0.2;     // and beats the other hypothesis by this much
+  int min_agreeing_views = 2;
+  int max_partners = 4;  // other photos asked per pixel (those farthest from it first)
+  // A patch is textured when its standard deviation reaches this many times the photo's noise
+  // (Immerkaer's estimate) and at least `min_texture` grey levels.
+  double texture_noise_factor = 4.0;
+  double min_texture = 4.0;
+  int num_threads = 1;  // < 1: one per hardware thread
+
+  bool IsValid(std::string* reason) const;
+};
+
+// A distant pixel's ray: `view` indexes the views, `direction` is a unit world direction.
+struct DistantRay {
+  int view = 0;
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+};
+
+struct DistantPixels {
+  std::vector<DistantRay> rays;
+  // Per view, at the reduced size (`factors[v]` times smaller): 255 where a judged pixel was
+  // found distant, 200 inside a plain region grown from them, 128 where judged and undecided, 64
+  // where found nearer, 0 elsewhere.
+  std::vector<cv::Mat> masks;
+  std::vector<int> factors;
+  int64_t textured = 0;  // pixels judged
+  int64_t distant = 0;   // of those, found distant
+  int64_t nearer = 0;    // of those, found inside the volume by some photo
+  int64_t grown = 0;     // pixels of plain regions whose rim is distant
+  double seconds = 0.0;
+  std::string Summary() const;
+};
+
+// The distant pixels of `views` (undistorted, CV_8UC3 RGB) with respect to the volume `box`.
+// Deterministic: the result does not depend on the thread count.
+DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
+                                const Eigen::AlignedBox3d& box,
+                                const DistantOptions& options);
+
+// The noise of a grey image (CV_32F) in grey levels: Immerkaer's estimate, the mean absolute
+// response to the difference of two Laplacians, scaled for a Gaussian. Texture raises it; a
+// plain photo gives its noise. 0 for images under 3x3.
+double ImageNoiseSigma(const cv::Mat& grey);
+
+}  // namespace raycarve

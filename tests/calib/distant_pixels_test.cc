@@ -1,0 +1,180 @@
+#include "calib/distant_pixels.h"
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include "calib/pixel.h"
+#include "tests/test_support.h"
+
+namespace raycarve {
+namespace {
+
+// A colour per cell of a pattern, from a hash of the cell.
+Eigen::Vector3d CellColour(int a, int b, int salt) {
+  uint32_t hash = static_cast<uint32_t>(a * 73856093) ^ static_cast<uint32_t>(b * 19349663) ^
+                  static_cast<uint32_t>(salt * 83492791);
+  hash = (hash ^ (hash >> 13)) * 0x5bd1e995u;
+  hash ^= hash >> 15;
+  return Eigen::Vector3d(40 + (hash & 0xbf), 40 + ((hash >> 8) & 0xbf), 40 + ((hash >> 16) & 0xbf));
+}
+
+// The sky: plain cells of 5 degrees over directions, each a colour of its own.
+Eigen::Vector3d SkyColour(const Eigen::Vector3d& d) {
+  const double cell = 5.0 * M_PI / 180.0;
+  return CellColour(static_cast<int>(std::floor(std::atan2(d.x(), d.z()) / cell)),
+                    static_cast<int>(std::floor(std::asin(std::clamp(d.y(), -1.0, 1.0)) / cell)), 1);
+}
+
+constexpr double kSphereRadius = 0.5;
+// A wall across the volume behind the sphere (seen from the cameras), at z = -kWallDepth.
+constexpr double kWallDepth = 0.9;
+
+// Distance along the unit ray to the sphere at the origin; < 0 when it misses.
+double HitSphere(const Eigen::Vector3d& origin, const Eigen::Vector3d& d) {
+  const double b = origin.dot(d);
+  const double c = origin.squaredNorm() - kSphereRadius * kSphereRadius;
+  const double disc = b * b - c;
+  return disc < 0.0 ? -1.0 : -b - std::sqrt(disc);
+}
+
+// What a pixel shows: the sphere (cells of 15 degrees), else the wall (cells of 0.15) when there
+// is one, else the sky. *near is false only for the sky.
+Eigen::Vector3d Trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& d, bool wall, bool* near) {
+  *near = true;
+  const double t = HitSphere(origin, d);
+  if (t > 0.0) {
+    const Eigen::Vector3d x = origin + t * d;
+    const double cell = 15.0 * M_PI / 180.0;
+    return CellColour(static_cast<int>(std::floor(std::atan2(x.x(), x.z()) / cell)),
+                      static_cast<int>(std::floor(std::asin(x.y() / kSphereRadius) / cell)), 2);
+  }
+  if (wall && d.z() < 0.0) {
+    const Eigen::Vector3d x = origin + ((-kWallDepth - origin.z()) / d.z()) * d;
+    return CellColour(static_cast<int>(std::floor(x.x() / 0.15)), static_cast<int>(std::floor(x.y() / 0.15)), 3);
+  }
+  *near = false;
+  return SkyColour(d);
+}
+
+struct Rendered {
+  std::vector<CalibratedView> views;
+  std::vector<cv::Mat> sky;  // per view, 255 where the pixel's centre ray meets nothing near
+};
+
+// Eight cameras on an arc of 70 degrees, 4 from the origin, looking at it.
+Rendered Render(bool wall) {
+  Rendered rendered;
+  for (int k = 0; k < 8; ++k) {
+    const double a = (-35.0 + 10.0 * k) * M_PI / 180.0;
+    const Eigen::Vector3d centre(4.0 * std::sin(a), 0.6 + 0.1 * (k % 3), 4.0 * std::cos(a));
+    CalibratedView view = testing::PinholeViewLookingAtOrigin(centre, 200, 150, 170.0);
+    view.name = "view" + std::to_string(k);
+    view.image = cv::Mat(view.height, view.width, CV_8UC3);
+    cv::Mat sky(view.height, view.width, CV_8UC1, cv::Scalar(0));
+    const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
+    for (int row = 0; row < view.height; ++row) {
+      for (int col = 0; col < view.width; ++col) {
+        // 3 x 3 rays a pixel, as a camera integrates its pixel's area.
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (int s = 0; s < 9; ++s) {
+          const Eigen::Vector2d at(col + (s % 3 + 0.5) / 3.0, row + (s / 3 + 0.5) / 3.0);
+          bool near = false;
+          sum += Trace(centre, (world_from_pixel * at.homogeneous()).normalized(), wall, &near);
+        }
+        const cv::Vec3b colour(static_cast<uint8_t>(sum.x() / 9), static_cast<uint8_t>(sum.y() / 9),
+                               static_cast<uint8_t>(sum.z() / 9));
+        view.image.at<cv::Vec3b>(row, col) = colour;
+        bool near = false;
+        Trace(centre, (world_from_pixel * PixelCentre(row, col).homogeneous()).normalized(), wall, &near);
+        sky.at<uint8_t>(row, col) = near ? 0 : 255;
+      }
+    }
+    rendered.views.push_back(std::move(view));
+    rendered.sky.push_back(sky);
+  }
+  return rendered;
+}
+
+const Eigen::AlignedBox3d kBox(Eigen::Vector3d::Constant(-1.0), Eigen::Vector3d::Constant(1.0));
+
+TEST(DistantPixels, SkyBehindATexturedSphereIsFoundAndTheSphereNever) {
+  const Rendered scene = Render(/*wall=*/false);
+  DistantOptions options;
+  options.num_threads = 2;
+  const DistantPixels found = FindDistantPixels(scene.views, kBox, options);
+  ASSERT_EQ(found.masks.size(), scene.views.size());
+  // No ray of a distant pixel meets the sphere.
+  int64_t on_sphere = 0;
+  for (const DistantRay& ray : found.rays) {
+    on_sphere += HitSphere(scene.views[ray.view].centre, ray.direction) > 0.0;
+  }
+  EXPECT_EQ(on_sphere, 0) << found.Summary();
+  // Much of the sky that the volume lies in front of is found. Measured: 45% of those pixels (the
+  // rest: sky that no other photo frames, and patches whose rim is not found).
+  int64_t sky = 0, sky_found = 0;
+  for (size_t v = 0; v < scene.views.size(); ++v) {
+    const CalibratedView& view = scene.views[v];
+    const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
+    for (int row = 0; row < view.height; ++row) {
+      for (int col = 0; col < view.width; ++col) {
+        const Eigen::Vector3d d = world_from_pixel * PixelCentre(row, col).homogeneous();
+        double t0 = 0.0, t1 = 0.0;
+        const Eigen::Vector3d inv = d.cwiseInverse();
+        const Eigen::Vector3d ta = (kBox.min() - view.centre).cwiseProduct(inv);
+        const Eigen::Vector3d tb = (kBox.max() - view.centre).cwiseProduct(inv);
+        t0 = ta.cwiseMin(tb).maxCoeff();
+        t1 = ta.cwiseMax(tb).minCoeff();
+        if (!(t1 > t0) || !scene.sky[v].at<uint8_t>(row, col)) continue;
+        ++sky;
+        const uint8_t verdict = found.masks[v].at<uint8_t>(row, col);
+        sky_found += verdict == 255 || verdict == 200;
+      }
+    }
+  }
+  ASSERT_GT(sky, 0);
+  EXPECT_GT(static_cast<double>(sky_found) / sky, 0.4) << sky_found << " of " << sky;
+  EXPECT_GT(found.distant, 0);
+  EXPECT_GT(found.grown, 0);
+}
+
+TEST(DistantPixels, ATexturedWallInsideTheVolumeIsNeverDistant) {
+  // The same cameras, a wall of plain cells behind the sphere inside the volume: every pixel
+  // shows something near, textured edges and plain cells alike.
+  const Rendered scene = Render(/*wall=*/true);
+  DistantOptions options;
+  const DistantPixels found = FindDistantPixels(scene.views, kBox, options);
+  int64_t sky = 0;
+  for (const cv::Mat& mask : scene.sky) sky += cv::countNonZero(mask);
+  // The wall fills the photos but for the corners of some (sky beyond its edge).
+  int64_t wrong = 0;
+  for (const DistantRay& ray : found.rays) {
+    bool near = false;
+    Trace(scene.views[ray.view].centre, ray.direction, true, &near);
+    wrong += near;
+  }
+  EXPECT_EQ(wrong, 0) << found.Summary() << " (" << sky << " sky pixels)";
+  EXPECT_GT(found.textured, 1000);
+}
+
+TEST(DistantPixels, OptionsAreChecked) {
+  std::string reason;
+  DistantOptions options;
+  EXPECT_TRUE(options.IsValid(&reason));
+  options.max_partners = 1;
+  EXPECT_FALSE(options.IsValid(&reason));
+  EXPECT_NE(reason.find("min_agreeing_views"), std::string::npos);
+}
+
+TEST(DistantPixels, NoiseOfAPlainImageIsItsNoise) {
+  cv::Mat grey(200, 200, CV_32F);
+  cv::randn(grey, 100.0, 3.0);
+  EXPECT_NEAR(ImageNoiseSigma(grey), 3.0, 0.3);
+  EXPECT_EQ(ImageNoiseSigma(cv::Mat(2, 2, CV_32F, cv::Scalar(0))), 0.0);
+}
+
+}  // namespace
+}  // namespace raycarve

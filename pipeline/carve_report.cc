@@ -184,13 +184,13 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
   json.Key("distant_pixels").BeginObject()
       .Key("looked_for").Value(run.distant_reason.empty())
       .Key("reason").Value(run.distant_reason)
-      .Key("photos").Value(static_cast<int64_t>(distant.masks.size()))
+      .Key("photos_judged").Value(static_cast<int64_t>(distant.masks.size()))
       .Key("textured_pixels").Value(distant.textured)
-      .Key("distant_pixels").Value(distant.distant)
+      .Key("found_pixels").Value(distant.distant)
       .Key("nearer_pixels").Value(distant.nearer)
       .Key("plain_region_pixels").Value(distant.grown)
-      .Key("rays").Value(s.distant_rays)
-      .Key("voxels_carved").Value(s.distant_carved)
+      .Key("distant_rays").Value(s.distant_rays)
+      .Key("distant_voxels_carved").Value(s.distant_carved)
       .Key("seconds").Value(distant.seconds)
       .EndObject();
   json.EndObject();

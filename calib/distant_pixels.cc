@@ -51,9 +51,18 @@ double ImageNoiseSigma(const cv::Mat& grey) {
   const cv::Mat kernel = (cv::Mat_<float>(3, 3) << 1, -2, 1, -2, 4, -2, 1, -2, 1);
   cv::Mat response;
   cv::filter2D(grey, response, CV_32F, kernel, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
-  const cv::Mat inner = cv::abs(response(cv::Rect(1, 1, grey.cols - 2, grey.rows - 2)));
-  const double sum = cv::sum(inner)[0];
-  return std::sqrt(M_PI / 2.0) * sum / (6.0 * (grey.cols - 2) * (grey.rows - 2));
+  // The median absolute response, not the mean: texture over less than half of the photo (a
+  // field, a facade) leaves it as the plain parts' noise.
+  std::vector<float> values;
+  values.reserve(static_cast<size_t>(grey.rows - 2) * (grey.cols - 2));
+  for (int row = 1; row < grey.rows - 1; ++row) {
+    const float* line = response.ptr<float>(row);
+    for (int col = 1; col < grey.cols - 1; ++col) values.push_back(std::abs(line[col]));
+  }
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  // For Gaussian noise of sigma s the response is Gaussian of sigma 6 s (the kernel's squares
+  // sum to 36), and its median absolute value 0.6745 times that.
+  return values[values.size() / 2] / (0.6745 * 6.0);
 }
 
 namespace {
@@ -68,6 +77,9 @@ constexpr uint8_t kNearer = 64;
 constexpr int kMinRimVotes = 3;
 constexpr double kMinRimShare = 0.25;
 constexpr double kMaxRimNearShare = 0.05;
+// A match's correlation loses this much per standard deviation (of the photo's patch) between the
+// two patches' mean colours.
+constexpr double kMeanPenalty = 0.25;
 
 // A photo as judged: reduced, in colour and grey, with its geometry in the reduced pixels.
 struct GreyView {
@@ -115,9 +127,9 @@ bool Sample(const GreyView& g, const Eigen::Vector2d& colmap, float* value) {
   return true;
 }
 
-// Removes each channel's mean from a patch of RGB samples (k * 3 + channel); returns the squared
-// norm of what is left.
-double CentrePatch(std::vector<float>* samples) {
+// Removes each channel's mean from a patch of RGB samples (k * 3 + channel) into `means`; returns
+// the squared norm of what is left.
+double CentrePatch(std::vector<float>* samples, Eigen::Vector3d* means) {
   std::vector<float>& s = *samples;
   const size_t count = s.size() / 3;
   double norm = 0.0;
@@ -125,6 +137,7 @@ double CentrePatch(std::vector<float>* samples) {
     double mean = 0.0;
     for (size_t k = 0; k < count; ++k) mean += s[3 * k + c];
     mean /= static_cast<double>(count);
+    (*means)[c] = mean;
     for (size_t k = 0; k < count; ++k) {
       s[3 * k + c] = static_cast<float>(s[3 * k + c] - mean);
       norm += s[3 * k + c] * s[3 * k + c];
@@ -133,23 +146,28 @@ double CentrePatch(std::vector<float>* samples) {
   return norm;
 }
 
-// Zero-mean normalised correlation, over the three channels (each less its mean), of the centred
-// patch `a` (with its squared norm) with photo j sampled at `centre` + `offsets`; -1 where a
-// sample falls outside j's valid pixels or j's patch is plain. In colour, an edge between two
-// colours does not match an edge between two others, as it would in grey.
-double Correlation(const std::vector<float>& a, double a_norm, const GreyView& j,
-                   const Eigen::Vector2d& centre, const std::vector<Eigen::Vector2d>& offsets,
-                   std::vector<float>* buffer) {
+// How well photo j sampled at `centre` + `offsets` matches the centred patch `a` (its squared
+// norm, its channels' means): the zero-mean normalised correlation over the three channels (in
+// colour, an edge between two colours does not match an edge between two others, as it would in
+// grey), less kMeanPenalty times the difference of the means in units of a's standard deviation
+// (a smooth ramp, a soft cloud's edge, correlates with itself shifted along it; its mean does
+// not). -1 where a sample falls outside j's valid pixels or j's patch is plain.
+double Correlation(const std::vector<float>& a, double a_norm, const Eigen::Vector3d& a_mean,
+                   const GreyView& j, const Eigen::Vector2d& centre,
+                   const std::vector<Eigen::Vector2d>& offsets, std::vector<float>* buffer) {
   std::vector<float>& b = *buffer;
   b.resize(3 * offsets.size());
   for (size_t k = 0; k < offsets.size(); ++k) {
     if (!Sample(j, centre + offsets[k], &b[3 * k])) return -1.0;
   }
-  const double norm = CentrePatch(&b);
+  Eigen::Vector3d b_mean;
+  const double norm = CentrePatch(&b, &b_mean);
   if (!(norm > 1e-6)) return -1.0;
   double dot = 0.0;
   for (size_t k = 0; k < b.size(); ++k) dot += a[k] * b[k];
-  return dot / std::sqrt(a_norm * norm);
+  const double a_deviation = std::sqrt(a_norm / static_cast<double>(b.size()));
+  const double shift = (b_mean - a_mean).norm() / std::sqrt(3.0);
+  return dot / std::sqrt(a_norm * norm) - kMeanPenalty * shift / a_deviation;
 }
 
 // The parameters t (X = centre + t * direction) where the ray is inside `box`; false if never.
@@ -232,7 +250,7 @@ bool PairFor(const GreyView& i, const GreyView& j, int partner, const Eigen::Mat
 int Judge(const std::vector<GreyView>& views, int v, const std::vector<int>& partners,
           const std::vector<Eigen::Matrix3d>& homographies, const Eigen::AlignedBox3d& box,
           const Eigen::Vector2d& p, const std::vector<float>& a, double a_norm,
-          const std::vector<Eigen::Vector2d>& patch, const DistantOptions& options,
+          const Eigen::Vector3d& a_mean, const std::vector<Eigen::Vector2d>& patch, const DistantOptions& options,
           std::vector<PairGeometry>* pairs, std::vector<float>* buffer) {
   const GreyView& i = views[v];
   const Eigen::Vector3d direction = i.R.transpose() * (i.K.inverse() * p.homogeneous());
@@ -249,7 +267,8 @@ int Judge(const std::vector<GreyView>& views, int v, const std::vector<int>& par
                  options, &pair)) {
       continue;
     }
-    const double c = Correlation(a, a_norm, views[partner], pair.at_infinity, pair.offsets, buffer);
+    const double c =
+        Correlation(a, a_norm, a_mean, views[partner], pair.at_infinity, pair.offsets, buffer);
     at_infinity.push_back(c);
     if (c >= options.min_correlation) ++matched;
     pairs->push_back(std::move(pair));
@@ -264,7 +283,7 @@ int Judge(const std::vector<GreyView>& views, int v, const std::vector<int>& par
     double inside = -1.0;
     for (const Eigen::Vector2d& s : pair.segment) {
       if ((s - pair.at_infinity).norm() < options.min_parallax) continue;
-      inside = std::max(inside, Correlation(a, a_norm, j, s, pair.offsets, buffer));
+      inside = std::max(inside, Correlation(a, a_norm, a_mean, j, s, pair.offsets, buffer));
     }
     if (inside >= options.min_correlation && inside - at_infinity[k] >= options.min_advantage) {
       return -1;
@@ -397,10 +416,11 @@ DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
           grey_mean /= static_cast<double>(patch.size());
           const double grey_variance = grey_square / patch.size() - grey_mean * grey_mean;
           if (!(grey_variance >= i.texture * i.texture)) continue;
-          const double a_norm = CentrePatch(&a);
+          Eigen::Vector3d a_mean;
+          const double a_norm = CentrePatch(&a, &a_mean);
           ++textured[v];
-          const int verdict =
-              Judge(grey, v, partners, homographies, box, p, a, a_norm, patch, options, &pairs, &buffer);
+          const int verdict = Judge(grey, v, partners, homographies, box, p, a, a_norm, a_mean,
+                                    patch, options, &pairs, &buffer);
           mask.at<uint8_t>(row, col) = verdict > 0 ? kDistantJudged : verdict < 0 ? kNearer : kUndecided;
           if (verdict < 0) ++nearer[v];
           if (verdict <= 0) continue;

@@ -74,9 +74,9 @@ DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
                                 const Eigen::AlignedBox3d& box,
                                 const DistantOptions& options);
 
-// The noise of a grey image (CV_32F) in grey levels: Immerkaer's estimate, the mean absolute
-// response to the difference of two Laplacians, scaled for a Gaussian. Texture raises it; a
-// plain photo gives its noise. 0 for images under 3x3.
+// The noise of a grey image (CV_32F) in grey levels: after Immerkaer, the response to the
+// difference of two Laplacians, its median absolute value scaled for a Gaussian (robust to
+// texture over less than half of the image). 0 for images under 3x3.
 double ImageNoiseSigma(const cv::Mat& grey);
 
 }  // namespace raycarve

@@ -26,8 +26,9 @@ int RunSynth(int argc, char** argv) {
   parser.AddDefault("layout", &layout,
                     "where the cameras stand: a ring around the scene, a hemisphere (12 to 72 "
                     "degrees up), an arc (the ring's front 150 degrees), close (a ring at 0.6 "
-                    "of the distance, the ground leaving the frames), or forward (forward-facing: "
-                    "a grid of positions on one side, as in front of a facade)",
+                    "of the distance, the ground leaving the frames), forward (forward-facing: "
+                    "a grid of positions on one side, as in front of a facade), or eye_level "
+                    "(the arc at the objects' height, the sky behind their tops)",
                     CameraLayoutNames());
   parser.AddDefault("width", &options.width, "photo width in pixels");
   parser.AddDefault("height", &options.height, "photo height in pixels");
@@ -49,8 +50,9 @@ int RunSynth(int argc, char** argv) {
   parser.AddDefault("backdrop", &backdrop,
                     "behind the scene: a patchwork sky (a natural scene), or a studio backdrop "
                     "that needs masks: uniform (dark), two_tone (wall and table, with a dark "
-                    "frame), gradient, vignetted, shadowed_table; or a textured room (floor and "
-                    "wall) holding sparse points of its own",
+                    "frame), gradient, vignetted, shadowed_table; a textured room (floor and "
+                    "wall) holding sparse points of its own; or outdoors: a cloudy sky over a "
+                    "field",
                     BackdropNames());
   std::string texture = "plain";
   parser.AddDefault("texture", &texture,

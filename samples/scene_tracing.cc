@@ -143,6 +143,29 @@ bool RoomHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
 // with value noise over both so that every place looks different.
 Eigen::Vector3d RoomColour(const Eigen::Vector3d& point);
 
+// Value noise in [0, 1]; defined below.
+double ValueNoise(const Eigen::Vector3d& point, double scale, uint32_t channel);
+
+// Outdoors (Backdrop::kCloudy): above the horizon a sky at infinity, deep blue overhead and
+// paler towards the horizon, with soft-edged white clouds (fractal value noise over directions);
+// below it a field on the plane z = 0, grass and earth mottled at two scales.
+Eigen::Vector3d CloudyColour(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
+  if (direction.z() < 0.0 && origin.z() > 0.0) {
+    const Eigen::Vector3d on = origin - direction * (origin.z() / direction.z());
+    const double grass = ValueNoise(on, 1.5, 31), fine = ValueNoise(on, 0.2, 32);
+    return (1.0 - grass) * Eigen::Vector3d(70, 110, 45) + grass * Eigen::Vector3d(120, 100, 70) +
+           (fine - 0.5) * Eigen::Vector3d(40, 40, 30);
+  }
+  const Eigen::Vector3d d = direction.normalized();
+  const double up = std::clamp(d.z(), 0.0, 1.0);
+  const Eigen::Vector3d sky = (1.0 - up) * Eigen::Vector3d(180, 205, 235) + up * Eigen::Vector3d(60, 110, 205);
+  const double cloud = 0.6 * ValueNoise(d, 0.18, 33) + 0.3 * ValueNoise(d, 0.07, 34) +
+                       0.1 * ValueNoise(d, 0.03, 35);
+  const double t = std::clamp((cloud - 0.5) / 0.2, 0.0, 1.0);
+  const double cover = t * t * (3.0 - 2.0 * t);
+  return (1.0 - cover) * sky + cover * Eigen::Vector3d(240, 242, 246);
+}
+
 // What a ray that meets no part of the scene shows, for each backdrop. The table is the plane
 // z = 0 around the ground square (out to a radius of 14), the wall everything beyond it.
 Eigen::Vector3d BackdropColour(Backdrop backdrop, const Eigen::Vector3d& origin,
@@ -172,6 +195,8 @@ Eigen::Vector3d BackdropColour(Backdrop backdrop, const Eigen::Vector3d& origin,
       Eigen::Vector3d point;
       return RoomHit(origin, direction, &point) ? RoomColour(point) : SkyColour(direction);
     }
+    case Backdrop::kCloudy:
+      return CloudyColour(origin, direction);
     case Backdrop::kShadowedTable: {
       if (!table) return Eigen::Vector3d(225, 225, 230);
       // A soft shadow cast away from the light (see SurfaceColour), darkest near the objects.

@@ -144,7 +144,7 @@ bool EnumFromName(const std::vector<std::string>& names, const std::string& text
 }  // namespace
 
 std::vector<std::string> CameraLayoutNames() {
-  return {"ring", "hemisphere", "arc", "close", "forward"};
+  return {"ring", "hemisphere", "arc", "close", "forward", "eye_level"};
 }
 
 std::string CameraLayoutToString(CameraLayout layout) {
@@ -171,9 +171,11 @@ std::vector<Eigen::Vector3d> CameraCentres(CameraLayout layout, int num_views) {
                                                    kCameraTarget));
         break;
       }
-      case CameraLayout::kArc: {
+      case CameraLayout::kArc:
+      case CameraLayout::kEyeLevel: {
         angle = 0.3 + (num_views == 1 ? 0.0 : (150.0 / 180.0 * M_PI) * i / (num_views - 1));
-        const double height = 2.6 + 0.6 * std::sin(3.0 * angle);
+        const double height = layout == CameraLayout::kArc ? 2.6 + 0.6 * std::sin(3.0 * angle)
+                                                           : 0.9 + 0.2 * std::sin(3.0 * angle);
         centres.emplace_back(ring_radius * std::cos(angle), ring_radius * std::sin(angle),
                              height);
         break;
@@ -206,7 +208,8 @@ std::vector<Eigen::Vector3d> CameraCentres(CameraLayout layout, int num_views) {
 }
 
 std::vector<std::string> BackdropNames() {
-  return {"patchwork", "uniform", "two_tone", "gradient", "vignetted", "shadowed_table", "room"};
+  return {"patchwork", "uniform", "two_tone", "gradient", "vignetted", "shadowed_table", "room",
+          "cloudy"};
 }
 
 std::string BackdropToString(Backdrop backdrop) {

@@ -41,6 +41,8 @@ enum class Backdrop {
   kRoom,           // a room: a textured floor (z = 0) and a textured round wall (radius kRoomRadius,
                    // up to kRoomHeight) with sky above; it holds sparse points of its own, as a
                    // room behind an object does in a real capture (kRoomPointShare of them)
+  kCloudy,         // outdoors: a blue sky, paler towards the horizon, with soft white clouds
+                   // (both at infinity), over a field of grass and earth (the plane z = 0)
 };
 constexpr double kRoomRadius = 9.0;
 constexpr double kRoomHeight = 5.0;
@@ -57,6 +59,8 @@ enum class CameraLayout {
   kArc,         // the ring's front 150 degrees only, as where a wall stops the photographer
   kClose,       // a ring at 0.6 of the distance: the ground square leaves the frames
   kForward,     // forward-facing: a grid 2 wide and 0.8 high, 5 in front, all looking at the scene
+  kEyeLevel,    // the arc's 150 degrees at the objects' height (0.7 to 1.1 up): what stands
+                // behind their tops from there is the sky, as for a statue photographed on foot
 };
 std::string CameraLayoutToString(CameraLayout layout);
 bool CameraLayoutFromString(const std::string& text, CameraLayout* layout);

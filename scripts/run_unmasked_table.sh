@@ -24,7 +24,8 @@ mkdir -p "$out"
 rows="$out/rows.jsonl"
 : > "$rows"
 for scene in "room ring" "room arc" "room forward" "patchwork ring" "patchwork arc" \
-             "patchwork forward" "room arc clutter" "patchwork ring clutter"; do
+             "patchwork forward" "room arc clutter" "patchwork ring clutter" \
+             "patchwork eye_level" "cloudy eye_level"; do
   set -- $scene
   backdrop=$1 layout=$2 kind=${3:-simple} name="$1_$2${3:+_$3}"
   dir="$out/$name"

@@ -167,21 +167,24 @@ TEST(UnmaskedCapture, ForwardFacingPhotosAreASceneBoxedToTheDepthTheyPlace) {
   EXPECT_EQ(JsonNumber(all_points, "depth_tried_points"), 0);
 }
 
-// A patterned sky behind objects photographed from an arc, its masks kept out: with the colour
-// test off, what the carve removes is the free space the sky's distant pixels show (and the
-// sparse points' sight lines), so the distant rays' share of it is plain to see.
+// Objects photographed on foot (the arc at their height) under a cloudy sky over a field, carved
+// without masks (as where the backdrop rule misses the sky): the blue between the clouds agrees
+// across the photos through the empty space in front of it, which colour alone keeps; the
+// distant pixels (cloud edges moving as the sky does, the plain blue they bound) carve it.
 TEST(UnmaskedCapture, PixelsThatShowTheSkyCarveTheSpaceInFrontOfIt) {
   const std::string root = testing::MakeTemporaryDirectory("unmasked_sky");
   const std::string scene = root + "/scene";
   std::string output;
-  ASSERT_EQ(RunRaycarve("synth --output_path " + scene + " --layout arc --backdrop patchwork "
+  ASSERT_EQ(RunRaycarve("synth --output_path " + scene + " --layout eye_level --backdrop cloudy "
                         "--views 12 --width 320 --height 240",
                         &output),
             0)
       << output;
   fs::rename(scene + "/masks", root + "/truth_masks");
   const auto carve = [&](const std::string& flags) {
-    EXPECT_EQ(RunRaycarve("carve --workspace_path " + scene + " --threshold 1000000" + flags, &output), 0)
+    EXPECT_EQ(RunRaycarve("carve --workspace_path " + scene + " --background_colour none" + flags,
+                          &output),
+              0)
         << output;
     return testing::ReadFileBytes(scene + "/raycarve/report.json");
   };
@@ -193,8 +196,8 @@ TEST(UnmaskedCapture, PixelsThatShowTheSkyCarveTheSpaceInFrontOfIt) {
   EXPECT_GT(JsonNumber(with, "found_pixels"), 100);
   EXPECT_GT(JsonNumber(with, "distant_voxels_carved"), 1000);
   EXPECT_NE(output.find("distant: "), std::string::npos) << output;
-  // Measured: F 82.3% -> 89.9% (scripts/run_unmasked_table.sh's patchwork arc, colour test off).
-  EXPECT_GT(f_with, f_without + 0.04) << f_without << " -> " << f_with;
+  // Measured: F 65.4% -> 79.1%.
+  EXPECT_GT(f_with, f_without + 0.06) << f_without << " -> " << f_with;
 }
 
 }  // namespace

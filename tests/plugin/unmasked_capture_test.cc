@@ -51,16 +51,25 @@ double FScoreInVolume(const std::string& root, const std::string& report) {
   return JsonNumber(testing::ReadFileBytes(root + "/compare.json"), "f_score");
 }
 
-TEST(UnmaskedCapture, TheSubjectIsCarvedInItsOwnBoxWithoutTheBoxsWalls) {
-  const std::string root = testing::MakeTemporaryDirectory("unmasked_capture");
+// A generated scene (raycarve synth with `flags`, 12 photos of 320x240) in <root>/scene, its exact
+// masks moved to <root>/truth_masks, out of the project: what a user without masks has. Returns
+// <root>/scene.
+std::string SceneWithoutMasks(const std::string& root, const std::string& flags) {
   const std::string scene = root + "/scene";
   std::string output;
-  ASSERT_EQ(RunRaycarve("synth --output_path " + scene +
-                            " --backdrop room --views 12 --width 320 --height 240",
+  EXPECT_EQ(RunRaycarve("synth --output_path " + scene + " --views 12 --width 320 --height 240 " +
+                            flags,
                         &output),
             0)
       << output;
   fs::rename(scene + "/masks", root + "/truth_masks");
+  return scene;
+}
+
+TEST(UnmaskedCapture, TheSubjectIsCarvedInItsOwnBoxWithoutTheBoxsWalls) {
+  const std::string root = testing::MakeTemporaryDirectory("unmasked_capture");
+  const std::string scene = SceneWithoutMasks(root, "--backdrop room");
+  std::string output;
   ASSERT_EQ(RunRaycarve("carve --workspace_path " + scene, &output), 0) << output;
   // The cameras stand around the subject: the box goes round their focus, and the summary says
   // what would help (masks).
@@ -97,14 +106,8 @@ TEST(UnmaskedCapture, TheSubjectIsCarvedInItsOwnBoxWithoutTheBoxsWalls) {
 // instead of painting the subject with it.
 TEST(UnmaskedCapture, WhatStandsInFrontOfTheSubjectIsInTheVolume) {
   const std::string root = testing::MakeTemporaryDirectory("unmasked_clutter");
-  const std::string scene = root + "/scene";
+  const std::string scene = SceneWithoutMasks(root, "--scene clutter --backdrop room --layout arc");
   std::string output;
-  ASSERT_EQ(RunRaycarve("synth --output_path " + scene + " --scene clutter --backdrop room "
-                        "--layout arc --views 12 --width 320 --height 240",
-                        &output),
-            0)
-      << output;
-  fs::rename(scene + "/masks", root + "/truth_masks");
   ASSERT_EQ(RunRaycarve("carve --workspace_path " + scene, &output), 0) << output;
   EXPECT_NE(output.find("in front of them that hide some of them from photos"), std::string::npos)
       << output;
@@ -173,14 +176,8 @@ TEST(UnmaskedCapture, ForwardFacingPhotosAreASceneBoxedToTheDepthTheyPlace) {
 // distant pixels (cloud edges moving as the sky does, the plain blue they bound) carve it.
 TEST(UnmaskedCapture, PixelsThatShowTheSkyCarveTheSpaceInFrontOfIt) {
   const std::string root = testing::MakeTemporaryDirectory("unmasked_sky");
-  const std::string scene = root + "/scene";
+  const std::string scene = SceneWithoutMasks(root, "--layout eye_level --backdrop cloudy");
   std::string output;
-  ASSERT_EQ(RunRaycarve("synth --output_path " + scene + " --layout eye_level --backdrop cloudy "
-                        "--views 12 --width 320 --height 240",
-                        &output),
-            0)
-      << output;
-  fs::rename(scene + "/masks", root + "/truth_masks");
   const auto carve = [&](const std::string& flags) {
     EXPECT_EQ(RunRaycarve("carve --workspace_path " + scene + " --background_colour none" + flags,
                           &output),

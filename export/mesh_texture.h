@@ -46,8 +46,26 @@ struct MeshTextureSummary {
   int atlas_height = 0;
   double scale = 1.0;  // photo pixels to atlas pixels (1 unless the atlas had to shrink)
   double seconds = 0.0;
+  // How the charts join (MeasureTextureSeams).
+  int64_t seam_edges = 0;
+  double seam_step = 0.0;
+  double inner_step = 0.0;
   std::string Summary() const;
 };
+
+// How well a textured mesh's charts join. Across every edge two triangles share, the texture is
+// sampled one texel inside each of them at a quarter, half and three quarters along the edge, and
+// the two colours compared (RGB distance over sqrt(3), 0-255): `seam_step` is the mean over edges
+// whose triangles lie in different charts (their corners' texture coordinates differ), `inner_step`
+// over edges inside one chart, the texture's own change over two texels. A seam that shows has a
+// step well above the inner one. Zeros when the mesh has no texture or no such edge.
+struct TextureSeams {
+  int64_t seam_edges = 0;
+  int64_t inner_edges = 0;
+  double seam_step = 0.0;
+  double inner_step = 0.0;
+};
+TextureSeams MeasureTextureSeams(const TriangleMesh& mesh);
 
 // Sets mesh->corner_uvs and mesh->texture. `seen_by` gives per vertex the views (indices into
 // `views`) that see it (ColourMeshFromPhotos); a triangle's candidate photos see all three of its

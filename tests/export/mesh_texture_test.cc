@@ -135,6 +135,42 @@ TEST(TextureMeshFromPhotos, ATriangleNoPhotoSeesWholeKeepsItsVertexColours) {
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(centre[k], 200.0 / 3.0, 25.0) << k;
 }
 
+// Two triangles sharing an edge, textured from a 64 x 32 atlas whose right half is `step` levels
+// brighter: in one chart (both in the left half) the edge is inside it and nothing steps; in two
+// (the second triangle's copy in the right half) the edge is a seam that steps by `step`.
+TEST(MeasureTextureSeams, ASeamStepsByTheChartsDifferenceAndAChartsInsideDoesNot) {
+  constexpr int kStep = 30;
+  TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  mesh.texture = cv::Mat(32, 64, CV_8UC3, cv::Scalar::all(100));
+  mesh.texture(cv::Rect(32, 0, 32, 32)).setTo(cv::Scalar::all(100 + kStep));
+  const Eigen::Vector2f texels[4] = {{4, 4}, {28, 4}, {28, 28}, {4, 28}};
+  const auto set_uvs = [&](float shift) {
+    mesh.corner_uvs.clear();
+    for (int t = 0; t < 2; ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2f at = texels[mesh.triangles[t][k]] + Eigen::Vector2f(t == 1 ? shift : 0.0f, 0.0f);
+        mesh.corner_uvs.push_back(at.cwiseQuotient(Eigen::Vector2f(64, 32)));
+      }
+    }
+  };
+  set_uvs(0.0f);
+  TextureSeams seams = MeasureTextureSeams(mesh);
+  EXPECT_EQ(seams.inner_edges, 1);
+  EXPECT_EQ(seams.seam_edges, 0);
+  EXPECT_NEAR(seams.inner_step, 0.0, 1e-9);
+  set_uvs(32.0f);
+  seams = MeasureTextureSeams(mesh);
+  EXPECT_EQ(seams.inner_edges, 0);
+  EXPECT_EQ(seams.seam_edges, 1);
+  EXPECT_NEAR(seams.seam_step, kStep, 1e-3);
+  // No texture, no figures.
+  mesh.texture.release();
+  seams = MeasureTextureSeams(mesh);
+  EXPECT_EQ(seams.seam_edges + seams.inner_edges, 0);
+}
+
 TEST(WriteTexturedObj, TheFilesReadBack) {
   const std::vector<CalibratedView> views = {PatternView()};
   TriangleMesh mesh = Rectangle(views[0]);

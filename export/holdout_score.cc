@@ -98,6 +98,8 @@ SparseDepthAgreement MeasureSparseDepth(const Rendering& rendering, const Calibr
       ++agreement.at_depth;
     } else if (drawn < depth - tolerance) {
       ++agreement.hidden;
+    } else {
+      ++agreement.behind;
     }
   }
   return agreement;

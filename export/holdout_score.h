@@ -40,13 +40,20 @@ cv::Mat SideBySide(const Rendering& rendering, const CalibratedView& view);
 // volume's walls. Each point inside the view's frame and in front of it is looked up in the
 // rendering's depth buffer at its pixel: `at_depth` where the model is drawn within `tolerance`
 // of the point's depth, `hidden` where it is drawn nearer by more than that (something the
-// photo did not see stands in front), the rest with nothing drawn there or the model behind.
+// photo did not see stands in front), `behind` where it is drawn farther (a hole in the model
+// there), the rest with nothing drawn there.
 struct SparseDepthAgreement {
   int points = 0;
   int at_depth = 0;
   int hidden = 0;
-  double AtDepthShare() const { return points > 0 ? static_cast<double>(at_depth) / points : 0.0; }
-  double HiddenShare() const { return points > 0 ? static_cast<double>(hidden) / points : 0.0; }
+  int behind = 0;
+  double AtDepthShare() const { return Share(at_depth); }
+  double HiddenShare() const { return Share(hidden); }
+  double BehindShare() const { return Share(behind); }
+  double UndrawnShare() const { return Share(points - at_depth - hidden - behind); }
+
+ private:
+  double Share(int count) const { return points > 0 ? static_cast<double>(count) / points : 0.0; }
 };
 SparseDepthAgreement MeasureSparseDepth(const Rendering& rendering, const CalibratedView& view,
                                         const std::vector<Eigen::Vector3d>& points,

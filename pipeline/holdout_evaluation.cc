@@ -157,6 +157,7 @@ void AverageScores(HoldoutEvaluation* evaluation) {
     evaluation->sparse_depth.points += view.sparse_depth.points;
     evaluation->sparse_depth.at_depth += view.sparse_depth.at_depth;
     evaluation->sparse_depth.hidden += view.sparse_depth.hidden;
+    evaluation->sparse_depth.behind += view.sparse_depth.behind;
     psnr += view.score.psnr;
     block += view.block_psnr;
     volume_psnr += view.volume_score.psnr;
@@ -216,6 +217,8 @@ std::string HoldoutJson(const HoldoutOptions& options,
         .Key("sparse_points").Value(view.sparse_depth.points)
         .Key("sparse_at_depth_share").Value(view.sparse_depth.AtDepthShare())
         .Key("sparse_hidden_share").Value(view.sparse_depth.HiddenShare())
+        .Key("sparse_behind_share").Value(view.sparse_depth.BehindShare())
+        .Key("sparse_undrawn_share").Value(view.sparse_depth.UndrawnShare())
         .EndObject();
   }
   json.EndArray();
@@ -227,6 +230,8 @@ std::string HoldoutJson(const HoldoutOptions& options,
       .Key("sparse_points").Value(evaluation.sparse_depth.points)
       .Key("sparse_at_depth_share").Value(evaluation.sparse_depth.AtDepthShare())
       .Key("sparse_hidden_share").Value(evaluation.sparse_depth.HiddenShare())
+      .Key("sparse_behind_share").Value(evaluation.sparse_depth.BehindShare())
+      .Key("sparse_undrawn_share").Value(evaluation.sparse_depth.UndrawnShare())
       .Key("sparse_depth_tolerance_voxels").Value(2.0)
       .EndObject();
   return json.str();

@@ -32,8 +32,10 @@ void PrintEvaluation(const HoldoutEvaluation& evaluation) {
   if (depth.points > 0) {
     std::printf("sparse points the held-out photos saw (%d, triangulated from 2+ other photos, "
                 "inside the volume): %.1f%% drawn at their depth (within 2 voxels), %.1f%% hidden "
-                "behind something nearer\n",
-                depth.points, 100.0 * depth.AtDepthShare(), 100.0 * depth.HiddenShare());
+                "behind something nearer, %.1f%% in front of the model (a hole there), %.1f%% "
+                "where nothing is drawn\n",
+                depth.points, 100.0 * depth.AtDepthShare(), 100.0 * depth.HiddenShare(),
+                100.0 * depth.BehindShare(), 100.0 * depth.UndrawnShare());
   }
   if (evaluation.wrote_mesh) {
     std::printf("the voxel volume drawn into the same views: PSNR %.2f dB, silhouette IoU %s "

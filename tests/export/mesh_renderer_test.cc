@@ -65,8 +65,11 @@ TEST(MeasureSparseDepth, PointsAtTheDrawnDepthBehindItInFrontOfItAndOutside) {
   EXPECT_EQ(agreement.points, 5);
   EXPECT_EQ(agreement.at_depth, 2);
   EXPECT_EQ(agreement.hidden, 1);
+  EXPECT_EQ(agreement.behind, 1);
   EXPECT_DOUBLE_EQ(agreement.AtDepthShare(), 0.4);
   EXPECT_DOUBLE_EQ(agreement.HiddenShare(), 0.2);
+  EXPECT_DOUBLE_EQ(agreement.BehindShare(), 0.2);
+  EXPECT_DOUBLE_EQ(agreement.UndrawnShare(), 0.2);
 }
 
 TEST(RenderMesh, TheNearestTriangleWinsAndColoursBlendPerspectiveCorrectly) {

@@ -80,6 +80,11 @@ constexpr double kMaxRimNearShare = 0.05;
 // A match's correlation loses this much per standard deviation (of the photo's patch) between the
 // two patches' mean colours.
 constexpr double kMeanPenalty = 0.25;
+// The volume's segment is searched with samples about this many pixels apart, first with every
+// other row and column of the patch; the best sample and its two neighbours are then judged with
+// the whole patch. (Where the search costs most: it ran 8.5 s of a 26 s carve of 25 photos of
+// 1600 x 1200 judged whole and a pixel apart.)
+constexpr double kSegmentStep = 1.5;
 
 // A photo as judged: reduced, with its geometry in the reduced pixels. Eight bits a channel: a
 // photo of 640 x 480 holds 1.2 MB here, 200 of them 240 MB.
@@ -244,7 +249,7 @@ bool PairFor(const ReducedView& i, const ReducedView& j, int partner, const Eige
   }
   if (!(t_near < t1)) return true;
   const double length = (near_pixel - far).norm();
-  const int count = std::clamp(static_cast<int>(std::ceil(length)) + 1, 2, 128);
+  const int count = std::clamp(static_cast<int>(std::ceil(length / kSegmentStep)) + 1, 2, 128);
   for (int k = 0; k < count; ++k) {
     const double s = 1.0 / t1 + (1.0 / t_near - 1.0 / t1) * k / (count - 1);
     Eigen::Vector2d pixel;
@@ -282,15 +287,42 @@ int Judge(const std::vector<ReducedView>& views, int v, const std::vector<int>& 
   }
   if (matched < options.min_agreeing_views) return 0;
   // Then the volume's segment, in every photo asked: one that matches inside clearly better is a
-  // veto; a match at infinity counts where nothing inside comes near it.
+  // veto; a match at infinity counts where nothing inside comes near it. The search: every other
+  // row and column of the patch (centred on its own), then the whole patch around the best.
+  std::vector<float> coarse;
+  std::vector<size_t> kept;
+  const int side = static_cast<int>(std::lround(std::sqrt(static_cast<double>(patch.size()))));
+  for (size_t k = 0; k < patch.size(); ++k) {
+    if ((k % side) % 2 == 0 && (k / side) % 2 == 0) kept.push_back(k);
+  }
+  for (size_t k : kept) coarse.insert(coarse.end(), {a[3 * k], a[3 * k + 1], a[3 * k + 2]});
+  Eigen::Vector3d coarse_mean;
+  const double coarse_norm = CentrePatch(&coarse, &coarse_mean);
+  coarse_mean += a_mean;
+  std::vector<Eigen::Vector2d> coarse_offsets;
   int agreeing = 0;
   for (size_t k = 0; k < pairs->size(); ++k) {
     const PairGeometry& pair = (*pairs)[k];
     const ReducedView& j = views[pair.partner];
+    coarse_offsets.clear();
+    for (size_t kk : kept) coarse_offsets.push_back(pair.offsets[kk]);
+    double best = -2.0;
+    int best_sample = -1;
+    for (size_t s = 0; s < pair.segment.size(); ++s) {
+      if ((pair.segment[s] - pair.at_infinity).norm() < options.min_parallax) continue;
+      const double c = coarse_norm > 1e-6 ? Correlation(coarse, coarse_norm, coarse_mean, j,
+                                                        pair.segment[s], coarse_offsets, buffer)
+                                          : -1.0;
+      if (c > best) {
+        best = c;
+        best_sample = static_cast<int>(s);
+      }
+    }
     double inside = -1.0;
-    for (const Eigen::Vector2d& s : pair.segment) {
-      if ((s - pair.at_infinity).norm() < options.min_parallax) continue;
-      inside = std::max(inside, Correlation(a, a_norm, a_mean, j, s, pair.offsets, buffer));
+    for (int s = best_sample - 1; best_sample >= 0 && s <= best_sample + 1; ++s) {
+      if (s < 0 || s >= static_cast<int>(pair.segment.size())) continue;
+      if ((pair.segment[s] - pair.at_infinity).norm() < options.min_parallax) continue;
+      inside = std::max(inside, Correlation(a, a_norm, a_mean, j, pair.segment[s], pair.offsets, buffer));
     }
     if (inside >= options.min_correlation && inside - at_infinity[k] >= options.min_advantage) {
       return -1;

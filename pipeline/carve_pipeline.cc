@@ -233,6 +233,8 @@ void CarvePipeline::FindDistant() {
     run_.distant_reason.clear();
     DistantOptions options;
     options.num_threads = request_.options.num_threads;
+    LOG(INFO) << "looking for pixels that show what lies beyond the volume (sky, far hills) in "
+              << carved_.size() << " photos ...";
     run_.distant = FindDistantPixels(carved_, project_.bounds.box, options);
     LOG(INFO) << run_.distant.Summary();
     distant_rays_ = std::move(run_.distant.rays);

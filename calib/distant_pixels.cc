@@ -337,8 +337,11 @@ int Judge(const std::vector<ReducedView>& views, int v, const std::vector<int>& 
 // The plain regions (connected pixels whose patch is not textured) whose rim is mostly found
 // distant: the inside of a patch of sky whose edges move as the sky does. Marks them kGrown in
 // `mask` (which holds the judged pixels' verdicts), counts their pixels in *grown and returns the
-// pixels (COLMAP coordinates) of their rays, every `stride` pixels.
+// pixels (COLMAP coordinates) of their rays, every `stride` pixels. A region holding one of
+// `seen` (the photo's own pixels of sparse points inside the volume) is never distant: a plain
+// object that runs into a sky of its colour without an edge has points where it has detail.
 std::vector<Eigen::Vector2d> GrowIntoPlainRegions(const ReducedView& g, const DistantOptions& options,
+                                                  const std::vector<Eigen::Vector2d>& seen,
                                                   cv::Mat* mask, int64_t* grown) {
   const int side = 2 * options.patch_radius + 1;
   cv::Mat mean, square;
@@ -384,9 +387,15 @@ std::vector<Eigen::Vector2d> GrowIntoPlainRegions(const ReducedView& g, const Di
       }
     }
   }
+  std::vector<uint8_t> holds_point(count, 0);
+  for (const Eigen::Vector2d& pixel : seen) {
+    const Eigen::Vector2d at = OpenCvFromColmap(pixel / g.factor);
+    const int col = static_cast<int>(std::lround(at.x())), row = static_cast<int>(std::lround(at.y()));
+    if (col >= 0 && row >= 0 && col < labels.cols && row < labels.rows) holds_point[labels.at<int>(row, col)] = 1;
+  }
   std::vector<uint8_t> is_distant(count, 0);
   for (int label = 1; label < count; ++label) {
-    is_distant[label] = size[label] >= side * side && distant[label] >= kMinRimVotes &&
+    is_distant[label] = !holds_point[label] && size[label] >= side * side && distant[label] >= kMinRimVotes &&
                         distant[label] >= kMinRimShare * judged[label] &&
                         nearer[label] <= kMaxRimNearShare * distant[label];
   }
@@ -406,7 +415,8 @@ std::vector<Eigen::Vector2d> GrowIntoPlainRegions(const ReducedView& g, const Di
 
 DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
                                 const Eigen::AlignedBox3d& box,
-                                const DistantOptions& options) {
+                                const DistantOptions& options,
+                                const std::vector<std::vector<Eigen::Vector2d>>& observations) {
   const auto start = std::chrono::steady_clock::now();
   std::string reason;
   CHECK(options.IsValid(&reason)) << reason;
@@ -469,7 +479,9 @@ DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
           rays[v].push_back(DistantRay{v, direction.normalized()});
         }
       }
-      for (const Eigen::Vector2d& p : GrowIntoPlainRegions(i, options, &mask, &grown[v])) {
+      static const std::vector<Eigen::Vector2d> kNone;
+      const std::vector<Eigen::Vector2d>& seen = v < static_cast<int>(observations.size()) ? observations[v] : kNone;
+      for (const Eigen::Vector2d& p : GrowIntoPlainRegions(i, options, seen, &mask, &grown[v])) {
         const Eigen::Vector3d direction = i.R.transpose() * (i.K.inverse() * p.homogeneous());
         rays[v].push_back(DistantRay{v, direction.normalized()});
       }

@@ -69,10 +69,13 @@ struct DistantPixels {
 };
 
 // The distant pixels of `views` (undistorted, CV_8UC3 RGB) with respect to the volume `box`.
-// Deterministic: the result does not depend on the thread count.
+// `observations` (optional): per view, its pixels (COLMAP coordinates) of sparse points inside
+// the volume; a plain region holding one is never distant. Deterministic: the result does not
+// depend on the thread count.
 DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
                                 const Eigen::AlignedBox3d& box,
-                                const DistantOptions& options);
+                                const DistantOptions& options,
+                                const std::vector<std::vector<Eigen::Vector2d>>& observations = {});
 
 // The noise of a grey image (CV_32F) in grey levels: after Immerkaer, the response to the
 // difference of two Laplacians, its median absolute value scaled for a Gaussian (robust to

@@ -235,7 +235,15 @@ void CarvePipeline::FindDistant() {
     options.num_threads = request_.options.num_threads;
     LOG(INFO) << "looking for pixels that show what lies beyond the volume (sky, far hills) in "
               << carved_.size() << " photos ...";
-    run_.distant = FindDistantPixels(carved_, project_.bounds.box, options);
+    // The photos' own pixels of the sparse points in the volume: plain regions holding one are
+    // surfaces, not sky.
+    std::vector<std::vector<Eigen::Vector2d>> observations(carved_.size());
+    for (const SurfacePoint& point : surface_points_) {
+      for (int v : point.views) {
+        if (carved_[v].Depth(point.xyz) > 0.0) observations[v].push_back(carved_[v].Project(point.xyz));
+      }
+    }
+    run_.distant = FindDistantPixels(carved_, project_.bounds.box, options, observations);
     LOG(INFO) << run_.distant.Summary();
     distant_rays_ = std::move(run_.distant.rays);
     run_.distant.rays.clear();

@@ -139,6 +139,23 @@ TEST(DistantPixels, SkyBehindATexturedSphereIsFoundAndTheSphereNever) {
   EXPECT_GT(static_cast<double>(sky_found) / sky, 0.4) << sky_found << " of " << sky;
   EXPECT_GT(found.distant, 0);
   EXPECT_GT(found.grown, 0);
+  // A sparse point seen inside a plain region found distant: the region is not distant then.
+  int row = -1, col = -1;
+  for (int r = 0; r < found.masks[0].rows && row < 0; ++r) {
+    for (int c = 0; c < found.masks[0].cols; ++c) {
+      if (found.masks[0].at<uint8_t>(r, c) == 200) {
+        row = r;
+        col = c;
+        break;
+      }
+    }
+  }
+  ASSERT_GE(row, 0);
+  std::vector<std::vector<Eigen::Vector2d>> observations(scene.views.size());
+  observations[0].push_back(PixelCentre(row, col));
+  const DistantPixels held = FindDistantPixels(scene.views, kBox, options, observations);
+  EXPECT_NE(held.masks[0].at<uint8_t>(row, col), 200);
+  EXPECT_LT(held.grown, found.grown);
 }
 
 TEST(DistantPixels, ATexturedWallInsideTheVolumeIsNeverDistant) {

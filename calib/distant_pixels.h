@@ -26,9 +26,10 @@ namespace raycarve {
 // photos resolve the volume's depth there). A pixel is distant when `min_agreeing_views` other
 // photos say so and none finds it clearly nearer. Plain patches say nothing either way and are
 // never judged by themselves: a plain region (connected pixels whose patch is not textured) is
-// distant when the judged pixels on its rim mostly are, and none nearer (the blue between
-// clouds, a patch of a patterned sky, bounded by edges that move as the sky does; a plain wall's
-// rim moves with the wall).
+// distant when a quarter or more of the judged pixels on its rim (and three at least) are, few
+// are nearer, and it holds none of the photo's sparse points (the blue between clouds, a patch of
+// a patterned sky, bounded by edges that move as the sky does; a plain wall's rim moves with the
+// wall, and the detail on it holds points).
 struct DistantOptions {
   int max_side = 640;        // photos are judged reduced to at most this many pixels a side
   int patch_radius = 3;      // patches of (2r + 1)^2 pixels at that size
@@ -38,8 +39,8 @@ struct DistantOptions {
   double min_advantage = 0.2;     // and beats the other hypothesis by this much
   int min_agreeing_views = 2;
   int max_partners = 4;  // other photos asked per pixel (those farthest from it first)
-  // A patch is textured when its standard deviation reaches this many times the photo's noise
-  // (Immerkaer's estimate) and at least `min_texture` grey levels.
+  // A patch is textured when its grey standard deviation reaches this many times the photo's
+  // noise (ImageNoiseSigma) and at least `min_texture` grey levels.
   double texture_noise_factor = 4.0;
   double min_texture = 4.0;
   int num_threads = 1;  // < 1: one per hardware thread

@@ -139,47 +139,49 @@ bool Sample(const ReducedView& g, const Eigen::Vector2d& colmap, float* value) {
   return true;
 }
 
-// Removes each channel's mean from a patch of RGB samples (k * 3 + channel) into `means`; returns
-// the squared norm of what is left.
-double CentrePatch(std::vector<float>* samples, Eigen::Vector3d* means) {
-  std::vector<float>& s = *samples;
-  const size_t count = s.size() / 3;
+// A patch of RGB samples (k * 3 + channel), each channel less its mean: the means and the
+// squared norm of what is left.
+struct CentredPatch {
+  std::vector<float> values;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   double norm = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    double mean = 0.0;
-    for (size_t k = 0; k < count; ++k) mean += s[3 * k + c];
-    mean /= static_cast<double>(count);
-    (*means)[c] = mean;
-    for (size_t k = 0; k < count; ++k) {
-      s[3 * k + c] = static_cast<float>(s[3 * k + c] - mean);
-      norm += s[3 * k + c] * s[3 * k + c];
+
+  // Takes the samples' means out (values as sampled in, centred out).
+  void Centre() {
+    const size_t count = values.size() / 3;
+    norm = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0.0;
+      for (size_t k = 0; k < count; ++k) sum += values[3 * k + c];
+      mean[c] = sum / static_cast<double>(count);
+      for (size_t k = 0; k < count; ++k) {
+        values[3 * k + c] = static_cast<float>(values[3 * k + c] - mean[c]);
+        norm += values[3 * k + c] * values[3 * k + c];
+      }
     }
   }
-  return norm;
-}
+};
 
-// How well photo j sampled at `centre` + `offsets` matches the centred patch `a` (its squared
-// norm, its channels' means): the zero-mean normalised correlation over the three channels (in
-// colour, an edge between two colours does not match an edge between two others, as it would in
-// grey), less kMeanPenalty times the difference of the means in units of a's standard deviation
-// (a smooth ramp, a soft cloud's edge, correlates with itself shifted along it; its mean does
-// not). -1 where a sample falls outside j's valid pixels or j's patch is plain.
-double Correlation(const std::vector<float>& a, double a_norm, const Eigen::Vector3d& a_mean,
-                   const ReducedView& j, const Eigen::Vector2d& centre,
-                   const std::vector<Eigen::Vector2d>& offsets, std::vector<float>* buffer) {
-  std::vector<float>& b = *buffer;
-  b.resize(3 * offsets.size());
+// How well photo j sampled at `centre` + `offsets` matches the centred patch `a`: the zero-mean
+// normalised correlation over the three channels (in colour, an edge between two colours does not
+// match an edge between two others, as it would in grey), less kMeanPenalty times the difference
+// of the means in units of a's standard deviation (a smooth ramp, a soft cloud's edge, correlates
+// with itself shifted along it; its mean does not). -1 where a sample falls outside j's valid
+// pixels or either patch is plain. `b` is the caller's buffer.
+double Correlation(const CentredPatch& a, const ReducedView& j, const Eigen::Vector2d& centre,
+                   const std::vector<Eigen::Vector2d>& offsets, CentredPatch* b) {
+  if (!(a.norm > 1e-6)) return -1.0;
+  b->values.resize(3 * offsets.size());
   for (size_t k = 0; k < offsets.size(); ++k) {
-    if (!Sample(j, centre + offsets[k], &b[3 * k])) return -1.0;
+    if (!Sample(j, centre + offsets[k], &b->values[3 * k])) return -1.0;
   }
-  Eigen::Vector3d b_mean;
-  const double norm = CentrePatch(&b, &b_mean);
-  if (!(norm > 1e-6)) return -1.0;
+  b->Centre();
+  if (!(b->norm > 1e-6)) return -1.0;
   double dot = 0.0;
-  for (size_t k = 0; k < b.size(); ++k) dot += a[k] * b[k];
-  const double a_deviation = std::sqrt(a_norm / static_cast<double>(b.size()));
-  const double shift = (b_mean - a_mean).norm() / std::sqrt(3.0);
-  return dot / std::sqrt(a_norm * norm) - kMeanPenalty * shift / a_deviation;
+  for (size_t k = 0; k < b->values.size(); ++k) dot += a.values[k] * b->values[k];
+  const double a_deviation = std::sqrt(a.norm / static_cast<double>(b->values.size()));
+  const double shift = (b->mean - a.mean).norm() / std::sqrt(3.0);
+  return dot / std::sqrt(a.norm * b->norm) - kMeanPenalty * shift / a_deviation;
 }
 
 // The parameters t (X = centre + t * direction) where the ray is inside `box`; false if never.
@@ -242,7 +244,7 @@ bool PairFor(const ReducedView& i, const ReducedView& j, int partner, const Eige
   // Samples uniform in inverse distance (about uniform in the image), about a pixel apart, of the
   // part of the segment in front of photo j.
   pair->segment.clear();
-  Eigen::Vector2d near_pixel;
+  Eigen::Vector2d near_pixel = Eigen::Vector2d::Zero();
   double t_near = std::max(t0, 1e-6);
   while (t_near < t1 && !ProjectInFront(j, i.centre + t_near * direction, &near_pixel)) {
     t_near = t_near * 2.0 + 1e-6;
@@ -258,81 +260,115 @@ bool PairFor(const ReducedView& i, const ReducedView& j, int partner, const Eige
   return true;
 }
 
-// The verdict on pixel p of photo i: 1 distant, -1 nearer, 0 neither.
-int Judge(const std::vector<ReducedView>& views, int v, const std::vector<int>& partners,
-          const std::vector<Eigen::Matrix3d>& homographies, const Eigen::AlignedBox3d& box,
-          const Eigen::Vector2d& p, const std::vector<float>& a, double a_norm,
-          const Eigen::Vector3d& a_mean, const std::vector<Eigen::Vector2d>& patch, const DistantOptions& options,
-          std::vector<PairGeometry>* pairs, std::vector<float>* buffer) {
-  const ReducedView& i = views[v];
-  const Eigen::Vector3d direction = i.R.transpose() * (i.K.inverse() * p.homogeneous());
-  double t0 = 0.0, t1 = 0.0;
-  if (!RayInBox(i.centre, direction, box, &t0, &t1)) return 0;
-  // First the cheap test at infinity, on up to max_partners photos.
-  pairs->clear();
-  int matched = 0;
-  std::vector<double> at_infinity;
-  for (int partner : partners) {
-    if (static_cast<int>(pairs->size()) >= options.max_partners) break;
-    PairGeometry pair;
-    if (!PairFor(i, views[partner], partner, homographies[partner], p, direction, t0, t1, patch,
-                 options, &pair)) {
-      continue;
+// Judges the textured pixels of one photo against the others (one per thread at a time).
+class PhotoJudge {
+ public:
+  PhotoJudge(const std::vector<ReducedView>& views, int v, const Eigen::AlignedBox3d& box,
+             const std::vector<Eigen::Vector2d>& patch, const DistantOptions& options)
+      : views_(views), i_(views[v]), box_(box), patch_(patch), options_(options) {
+    // Partners: the other photos, farthest first (the most parallax).
+    homographies_.resize(views.size());
+    for (int w = 0; w < static_cast<int>(views.size()); ++w) {
+      if (w == v) continue;
+      partners_.push_back(w);
+      homographies_[w] = views[w].K * views[w].R * i_.R.transpose() * i_.K.inverse();
     }
-    const double c =
-        Correlation(a, a_norm, a_mean, views[partner], pair.at_infinity, pair.offsets, buffer);
-    at_infinity.push_back(c);
-    if (c >= options.min_correlation) ++matched;
-    pairs->push_back(std::move(pair));
+    std::stable_sort(partners_.begin(), partners_.end(), [&](int x, int y) {
+      return (views[x].centre - i_.centre).squaredNorm() > (views[y].centre - i_.centre).squaredNorm();
+    });
+    // The coarse search's samples: every other row and column of the patch.
+    const int side = 2 * options.patch_radius + 1;
+    for (size_t k = 0; k < patch.size(); ++k) {
+      if ((k % side) % 2 == 0 && (k / side) % 2 == 0) kept_.push_back(k);
+    }
   }
-  if (matched < options.min_agreeing_views) return 0;
-  // Then the volume's segment, in every photo asked: one that matches inside clearly better is a
-  // veto; a match at infinity counts where nothing inside comes near it. The search: every other
-  // row and column of the patch (centred on its own), then the whole patch around the best.
-  std::vector<float> coarse;
-  std::vector<size_t> kept;
-  const int side = static_cast<int>(std::lround(std::sqrt(static_cast<double>(patch.size()))));
-  for (size_t k = 0; k < patch.size(); ++k) {
-    if ((k % side) % 2 == 0 && (k / side) % 2 == 0) kept.push_back(k);
+
+  // The verdict on pixel p, whose centred patch is `a`: 1 distant, -1 nearer, 0 neither.
+  int Verdict(const Eigen::Vector2d& p, const CentredPatch& a) {
+    const Eigen::Vector3d direction = i_.R.transpose() * (i_.K.inverse() * p.homogeneous());
+    double t0 = 0.0, t1 = 0.0;
+    if (!RayInBox(i_.centre, direction, box_, &t0, &t1)) return 0;
+    // First the cheap test at infinity, on up to max_partners photos.
+    pairs_.clear();
+    at_infinity_.clear();
+    int matched = 0;
+    for (int partner : partners_) {
+      if (static_cast<int>(pairs_.size()) >= options_.max_partners) break;
+      PairGeometry pair;
+      if (!PairFor(i_, views_[partner], partner, homographies_[partner], p, direction, t0, t1,
+                   patch_, options_, &pair)) {
+        continue;
+      }
+      const double c = Correlation(a, views_[partner], pair.at_infinity, pair.offsets, &buffer_);
+      at_infinity_.push_back(c);
+      if (c >= options_.min_correlation) ++matched;
+      pairs_.push_back(std::move(pair));
+    }
+    if (matched < options_.min_agreeing_views) return 0;
+    // Then the volume's segment, in every photo asked: one that matches inside clearly better is
+    // a veto; a match at infinity counts where nothing inside comes near it.
+    coarse_.values.clear();
+    for (size_t k : kept_) {
+      coarse_.values.insert(coarse_.values.end(), {a.values[3 * k], a.values[3 * k + 1], a.values[3 * k + 2]});
+    }
+    coarse_.Centre();
+    coarse_.mean += a.mean;  // a's values were centred already
+    int agreeing = 0;
+    for (size_t k = 0; k < pairs_.size(); ++k) {
+      const double inside = BestInside(a, pairs_[k]);
+      if (inside >= options_.min_correlation && inside - at_infinity_[k] >= options_.min_advantage) {
+        return -1;
+      }
+      if (at_infinity_[k] >= options_.min_correlation &&
+          at_infinity_[k] - inside >= options_.min_advantage) {
+        ++agreeing;
+      }
+    }
+    return agreeing >= options_.min_agreeing_views ? 1 : 0;
   }
-  for (size_t k : kept) coarse.insert(coarse.end(), {a[3 * k], a[3 * k + 1], a[3 * k + 2]});
-  Eigen::Vector3d coarse_mean;
-  const double coarse_norm = CentrePatch(&coarse, &coarse_mean);
-  coarse_mean += a_mean;
-  std::vector<Eigen::Vector2d> coarse_offsets;
-  int agreeing = 0;
-  for (size_t k = 0; k < pairs->size(); ++k) {
-    const PairGeometry& pair = (*pairs)[k];
-    const ReducedView& j = views[pair.partner];
-    coarse_offsets.clear();
-    for (size_t kk : kept) coarse_offsets.push_back(pair.offsets[kk]);
+
+ private:
+  // The best match on the pair's segment: searched with the coarse patch, then the whole patch
+  // at the best sample and its two neighbours. -1 where none can be judged.
+  double BestInside(const CentredPatch& a, const PairGeometry& pair) {
+    const ReducedView& j = views_[pair.partner];
+    coarse_offsets_.clear();
+    for (size_t k : kept_) coarse_offsets_.push_back(pair.offsets[k]);
+    const auto away = [&](int s) {
+      return s >= 0 && s < static_cast<int>(pair.segment.size()) &&
+             (pair.segment[s] - pair.at_infinity).norm() >= options_.min_parallax;
+    };
     double best = -2.0;
     int best_sample = -1;
-    for (size_t s = 0; s < pair.segment.size(); ++s) {
-      if ((pair.segment[s] - pair.at_infinity).norm() < options.min_parallax) continue;
-      const double c = coarse_norm > 1e-6 ? Correlation(coarse, coarse_norm, coarse_mean, j,
-                                                        pair.segment[s], coarse_offsets, buffer)
-                                          : -1.0;
+    for (int s = 0; s < static_cast<int>(pair.segment.size()); ++s) {
+      if (!away(s)) continue;
+      const double c = Correlation(coarse_, j, pair.segment[s], coarse_offsets_, &buffer_);
       if (c > best) {
         best = c;
-        best_sample = static_cast<int>(s);
+        best_sample = s;
       }
     }
     double inside = -1.0;
     for (int s = best_sample - 1; best_sample >= 0 && s <= best_sample + 1; ++s) {
-      if (s < 0 || s >= static_cast<int>(pair.segment.size())) continue;
-      if ((pair.segment[s] - pair.at_infinity).norm() < options.min_parallax) continue;
-      inside = std::max(inside, Correlation(a, a_norm, a_mean, j, pair.segment[s], pair.offsets, buffer));
+      if (away(s)) inside = std::max(inside, Correlation(a, j, pair.segment[s], pair.offsets, &buffer_));
     }
-    if (inside >= options.min_correlation && inside - at_infinity[k] >= options.min_advantage) {
-      return -1;
-    }
-    if (at_infinity[k] >= options.min_correlation && at_infinity[k] - inside >= options.min_advantage) {
-      ++agreeing;
-    }
+    return inside;
   }
-  return agreeing >= options.min_agreeing_views ? 1 : 0;
-}
+
+  const std::vector<ReducedView>& views_;
+  const ReducedView& i_;
+  const Eigen::AlignedBox3d& box_;
+  const std::vector<Eigen::Vector2d>& patch_;
+  const DistantOptions& options_;
+  std::vector<int> partners_;
+  std::vector<Eigen::Matrix3d> homographies_;
+  std::vector<size_t> kept_;
+  // Scratch, kept between pixels.
+  std::vector<PairGeometry> pairs_;
+  std::vector<double> at_infinity_;
+  CentredPatch coarse_, buffer_;
+  std::vector<Eigen::Vector2d> coarse_offsets_;
+};
 
 // The plain regions (connected pixels whose patch is not textured) whose rim is mostly found
 // distant: the inside of a patch of sky whose edges move as the sky does. Marks them kGrown in
@@ -434,43 +470,32 @@ DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
   std::vector<int64_t> textured(n, 0), distant(n, 0), nearer(n, 0), grown(n, 0);
   std::atomic<int> next{0};
   auto work = [&] {
-    std::vector<PairGeometry> pairs;
-    std::vector<float> a(3 * patch.size()), buffer;
+    CentredPatch a;
+    a.values.resize(3 * patch.size());
     for (int v = next++; v < n; v = next++) {
       const ReducedView& i = reduced[v];
-      // Partners: the other photos, farthest first (the most parallax).
-      std::vector<int> partners;
-      std::vector<Eigen::Matrix3d> homographies(n);
-      for (int w = 0; w < n; ++w) {
-        if (w == v) continue;
-        partners.push_back(w);
-        homographies[w] = reduced[w].K * reduced[w].R * i.R.transpose() * i.K.inverse();
-      }
-      std::stable_sort(partners.begin(), partners.end(), [&](int x, int y) {
-        return (reduced[x].centre - i.centre).squaredNorm() > (reduced[y].centre - i.centre).squaredNorm();
-      });
+      PhotoJudge judge(reduced, v, box, patch, options);
       cv::Mat mask(i.rgb.size(), CV_8UC1, cv::Scalar(0));
       for (int row = r + 1; row < i.rgb.rows - r - 1; row += options.stride) {
         for (int col = r + 1; col < i.rgb.cols - r - 1; col += options.stride) {
           const Eigen::Vector2d p = PixelCentre(row, col);
           bool ok = true;
-          for (size_t k = 0; k < patch.size() && ok; ++k) ok = Sample(i, p + patch[k], &a[3 * k]);
+          for (size_t k = 0; k < patch.size() && ok; ++k) ok = Sample(i, p + patch[k], &a.values[3 * k]);
           if (!ok) continue;
           // Textured: the grey patch's standard deviation (the colour patch's is its upper bound).
           double grey_mean = 0.0, grey_square = 0.0;
           for (size_t k = 0; k < patch.size(); ++k) {
-            const double grey_value = 0.299 * a[3 * k] + 0.587 * a[3 * k + 1] + 0.114 * a[3 * k + 2];
+            const double grey_value =
+                0.299 * a.values[3 * k] + 0.587 * a.values[3 * k + 1] + 0.114 * a.values[3 * k + 2];
             grey_mean += grey_value;
             grey_square += grey_value * grey_value;
           }
           grey_mean /= static_cast<double>(patch.size());
           const double grey_variance = grey_square / patch.size() - grey_mean * grey_mean;
           if (!(grey_variance >= i.texture * i.texture)) continue;
-          Eigen::Vector3d a_mean;
-          const double a_norm = CentrePatch(&a, &a_mean);
+          a.Centre();
           ++textured[v];
-          const int verdict = Judge(reduced, v, partners, homographies, box, p, a, a_norm, a_mean,
-                                    patch, options, &pairs, &buffer);
+          const int verdict = judge.Verdict(p, a);
           mask.at<uint8_t>(row, col) = verdict > 0 ? kDistantJudged : verdict < 0 ? kNearer : kUndecided;
           if (verdict < 0) ++nearer[v];
           if (verdict <= 0) continue;
@@ -480,7 +505,8 @@ DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
         }
       }
       static const std::vector<Eigen::Vector2d> kNone;
-      const std::vector<Eigen::Vector2d>& seen = v < static_cast<int>(observations.size()) ? observations[v] : kNone;
+      const std::vector<Eigen::Vector2d>& seen =
+          v < static_cast<int>(observations.size()) ? observations[v] : kNone;
       for (const Eigen::Vector2d& p : GrowIntoPlainRegions(i, options, seen, &mask, &grown[v])) {
         const Eigen::Vector3d direction = i.R.transpose() * (i.K.inverse() * p.homogeneous());
         rays[v].push_back(DistantRay{v, direction.normalized()});

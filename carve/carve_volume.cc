@@ -159,6 +159,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     level_options.correct_view_count = correct_view_count;
     level_options.resolution = resolutions[level];
     level_options.lod_levels = 1;
+    if (level + 1 < num_levels) level_options.distant_rays.clear();  // see CarveOptions
     level_options.threshold =
         options.threshold * std::pow(options.lod_threshold_scale, num_levels - 1 - level);
     const int factor = options.lod_reduce_images ? ImageFactor(views, resolutions[level],

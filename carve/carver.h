@@ -184,7 +184,9 @@ struct CarveOptions {
   double free_space_margin_voxels = 0.0;
   // Free space from distant pixels (calib/distant_pixels.h; `view` indexes the carve's views): each
   // ray's voxels are carved before colouring, up to the known surface where one lies on it
-  // (CarveDistantRays). Empty: none.
+  // (CarveDistantRays), at the final level of detail only: a ray a pixel wide would take a coarse
+  // voxel whole, the object's part of it too (measured over the unmasked table: patchwork forward
+  // F 89.6% carving at every level, 90.2% at the final one; the other rows within 0.1). Empty: none.
   std::vector<DistantRay> distant_rays;
   // The mean-colour error corrected for the number of views (MeanColourDifference). CarveVolume
   // sets it where no view has a mask and the threshold is auto (a number given is on the seed
@@ -234,8 +236,8 @@ struct CarveStatistics {
   int64_t free_space_level0_carved = 0;
   int64_t free_space_sight_lines = 0;
   double free_space_seconds = 0.0;
-  // Voxels removed by the distant pixels' rays (CarveOptions::distant_rays), summed over the
-  // levels; the rays that crossed the grid (at the final level).
+  // Voxels removed by the distant pixels' rays (CarveOptions::distant_rays, final level); the rays
+  // that crossed the grid.
   int64_t distant_carved = 0;
   int64_t distant_rays = 0;
   std::string FreeSpaceSummary() const;  // one line for the log

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "calib/pixel.h"
+#include "calib/ray_box.h"
 
 namespace raycarve {
 
@@ -184,26 +185,6 @@ double Correlation(const CentredPatch& a, const ReducedView& j, const Eigen::Vec
   return dot / std::sqrt(a.norm * b->norm) - kMeanPenalty * shift / a_deviation;
 }
 
-// The parameters t (X = centre + t * direction) where the ray is inside `box`; false if never.
-bool RayInBox(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-              const Eigen::AlignedBox3d& box, double* t0, double* t1) {
-  double near = 0.0, far = std::numeric_limits<double>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    if (std::abs(direction[a]) < 1e-12) {
-      if (origin[a] < box.min()[a] || origin[a] > box.max()[a]) return false;
-      continue;
-    }
-    double ta = (box.min()[a] - origin[a]) / direction[a];
-    double tb = (box.max()[a] - origin[a]) / direction[a];
-    if (ta > tb) std::swap(ta, tb);
-    near = std::max(near, ta);
-    far = std::min(far, tb);
-  }
-  *t0 = near;
-  *t1 = far;
-  return far > near;
-}
-
 // One pair's geometry for one pixel: where infinity and the volume's segment land in photo j.
 struct PairGeometry {
   int partner = -1;
@@ -287,7 +268,7 @@ class PhotoJudge {
   int Verdict(const Eigen::Vector2d& p, const CentredPatch& a) {
     const Eigen::Vector3d direction = i_.R.transpose() * (i_.K.inverse() * p.homogeneous());
     double t0 = 0.0, t1 = 0.0;
-    if (!RayInBox(i_.centre, direction, box_, &t0, &t1)) return 0;
+    if (!ClipRayToBox(i_.centre, direction, box_, &t0, &t1)) return 0;
     // First the cheap test at infinity, on up to max_partners photos.
     pairs_.clear();
     at_infinity_.clear();

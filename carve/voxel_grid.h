@@ -6,6 +6,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "calib/ray_box.h"  // ClipRayToBox, for the grid's users
+
 namespace raycarve {
 
 // A regular grid of cubic voxels over a world-space box.
@@ -51,14 +53,6 @@ class VoxelGrid {
   double voxel_size_;
   Eigen::Vector3i dimensions_;
 };
-
-// The part of the ray origin + t * direction (t >= 0) inside `box` (slab test): true, with the
-// interval in [*t_near, *t_far], when the ray meets the box with t_near <= t_far; false otherwise.
-bool ClipRayToBox(const Eigen::Vector3d& origin,
-                  const Eigen::Vector3d& direction,
-                  const Eigen::AlignedBox3d& box,
-                  double* t_near,
-                  double* t_far);
 
 // Checks a requested grid before any allocation: false, with a reason giving the numbers, when
 // the resolution is below 1 or above 4096, or when `bytes_per_voxel` x the voxel count exceeds

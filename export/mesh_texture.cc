@@ -106,7 +106,7 @@ bool EdgeStep(const TriangleMesh& mesh, int t, int u, int a, int b, double* step
     *inward = normal;
     return true;
   };
-  Eigen::Vector2d ta, tb, tn, ua, ub, un;
+  Eigen::Vector2d ta = Eigen::Vector2d::Zero(), tb = ta, tn = ta, ua = ta, ub = ta, un = ta;
   if (!corners(t, &ta, &tb, &tn) || !corners(u, &ua, &ub, &un)) return false;
   double sum = 0.0;
   for (const double f : {0.25, 0.5, 0.75}) {

@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "calib/pixel.h"
+#include "calib/ray_box.h"
 #include "tests/test_support.h"
 
 namespace raycarve {
@@ -123,12 +124,7 @@ TEST(DistantPixels, SkyBehindATexturedSphereIsFoundAndTheSphereNever) {
       for (int col = 0; col < view.width; ++col) {
         const Eigen::Vector3d d = world_from_pixel * PixelCentre(row, col).homogeneous();
         double t0 = 0.0, t1 = 0.0;
-        const Eigen::Vector3d inv = d.cwiseInverse();
-        const Eigen::Vector3d ta = (kBox.min() - view.centre).cwiseProduct(inv);
-        const Eigen::Vector3d tb = (kBox.max() - view.centre).cwiseProduct(inv);
-        t0 = ta.cwiseMin(tb).maxCoeff();
-        t1 = ta.cwiseMax(tb).minCoeff();
-        if (!(t1 > t0) || !scene.sky[v].at<uint8_t>(row, col)) continue;
+        if (!ClipRayToBox(view.centre, d, kBox, &t0, &t1) || !scene.sky[v].at<uint8_t>(row, col)) continue;
         ++sky;
         const uint8_t verdict = found.masks[v].at<uint8_t>(row, col);
         sky_found += verdict == 255 || verdict == 200;

@@ -209,4 +209,15 @@ std::vector<int64_t> SurfacePointVoxels(const VoxelGrid& grid,
   return voxels;
 }
 
+std::vector<std::vector<Eigen::Vector2d>> SurfacePointPixels(const std::vector<CalibratedView>& views,
+                                                             const std::vector<SurfacePoint>& points) {
+  std::vector<std::vector<Eigen::Vector2d>> pixels(views.size());
+  for (const SurfacePoint& point : points) {
+    for (int v : point.views) {
+      if (views[v].Depth(point.xyz) > 0.0) pixels[v].push_back(views[v].Project(point.xyz));
+    }
+  }
+  return pixels;
+}
+
 }  // namespace raycarve

@@ -114,4 +114,9 @@ void GatherVoxelPixels(const CalibratedView& view,
 std::vector<int64_t> SurfacePointVoxels(const VoxelGrid& grid,
                                         const std::vector<SurfacePoint>& points);
 
+// Per view (of `views`, which the points' views index), its pixels of the points it saw that lie
+// in front of it (COLMAP coordinates).
+std::vector<std::vector<Eigen::Vector2d>> SurfacePointPixels(const std::vector<CalibratedView>& views,
+                                                             const std::vector<SurfacePoint>& points);
+
 }  // namespace raycarve

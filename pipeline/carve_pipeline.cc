@@ -237,13 +237,8 @@ void CarvePipeline::FindDistant() {
               << carved_.size() << " photos ...";
     // The photos' own pixels of the sparse points in the volume: plain regions holding one are
     // surfaces, not sky.
-    std::vector<std::vector<Eigen::Vector2d>> observations(carved_.size());
-    for (const SurfacePoint& point : surface_points_) {
-      for (int v : point.views) {
-        if (carved_[v].Depth(point.xyz) > 0.0) observations[v].push_back(carved_[v].Project(point.xyz));
-      }
-    }
-    run_.distant = FindDistantPixels(carved_, project_.bounds.box, options, observations);
+    run_.distant = FindDistantPixels(carved_, project_.bounds.box, options,
+                                     SurfacePointPixels(carved_, surface_points_));
     LOG(INFO) << run_.distant.Summary();
     distant_rays_ = std::move(run_.distant.rays);
     run_.distant.rays.clear();

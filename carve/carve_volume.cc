@@ -116,9 +116,11 @@ void RepairSilhouettesAndRecolour(const std::vector<CalibratedView>& views,
 
 // The levels of detail in one function: they share the carver (a level starts from the one
 // before), the curve's clock and the progress schedule; what stands alone is in the helpers above.
-CarveResult CarveVolume(const std::vector<CalibratedView>& views,
+// `stages` says which levels run (CarveVolume: all) and what the last one does after carving.
+CarveResult CarveLevels(const std::vector<CalibratedView>& views,
                         const Eigen::AlignedBox3d& box,
                         const CarveOptions& options,
+                        CarveStages stages,
                         const std::function<void(const CarveProgress&)>& progress,
                         double progress_interval_seconds) {
   std::string reason;
@@ -126,6 +128,10 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
   std::vector<int> resolutions;
   CHECK(LevelResolutions(options.resolution, options.lod_levels, &resolutions, &reason)) << reason;
   const int num_levels = static_cast<int>(resolutions.size());
+  const int first_level = stages.first_level;
+  const int last_level = stages.last_level < 0 ? num_levels - 1 : stages.last_level;
+  CHECK(first_level >= 0 && first_level <= last_level && last_level < num_levels);
+  CHECK(first_level == 0 || stages.start) << "a later level needs its start volume";
   const VoxelGrid final_grid(box, options.resolution);
 
   CarveStatistics statistics;
@@ -153,8 +159,9 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       options.auto_threshold &&
       std::none_of(views.begin(), views.end(),
                    [](const CalibratedView& view) { return !view.mask.empty(); });
-  for (int level = 0; level < num_levels; ++level) {
+  for (int level = first_level; level <= last_level; ++level) {
     const Clock::time_point level_start = Clock::now();
+    const bool final_level = level + 1 == num_levels;
     CarveOptions level_options = options;
     level_options.correct_view_count = correct_view_count;
     level_options.resolution = resolutions[level];
@@ -166,7 +173,9 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
                                                                options.resolution)
                                                  : 1;
     std::unique_ptr<Volume> start_volume;
-    if (level > 0) {
+    if (level == first_level && level > 0) {
+      start_volume = std::move(stages.start);
+    } else if (level > 0) {
       start_volume = std::make_unique<Volume>(
           RefineVolume(carver->volume(), VoxelGrid(box, resolutions[level]), options.lod_band));
       carver.reset();  // the coarse level's rays and queue go before the fine level's come
@@ -176,10 +185,19 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
       reduced_views.resize(views.size());
       for (size_t v = 0; v < views.size(); ++v) reduced_views[v] = ReduceView(views[v], factor);
     }
-    const std::vector<CalibratedView>& level_views = factor > 1 ? reduced_views : views;
+    const std::vector<CalibratedView>& level_views =
+        factor > 1 ? reduced_views
+                   : (final_level && stages.final_views ? *stages.final_views : views);
     LevelStatistics level_statistics;
-    ChooseLevelThresholds(level_views, VoxelGrid(box, resolutions[level]), options, &level_options,
-                          &level_statistics);
+    if (final_level && stages.final_thresholds_given) {
+      level_options.threshold = stages.final_threshold;
+      level_options.pattern_threshold = stages.final_pattern_threshold;
+      level_statistics.threshold_given = true;
+    } else {
+      ChooseLevelThresholds(level_views, VoxelGrid(box, resolutions[level]), options,
+                            &level_options, &level_statistics);
+    }
+    if (final_level && !stages.final_visual_hull) level_options.visual_hull = false;
     if (level == 0) {
       carver = std::make_unique<IncrementalCarver>(level_views, box, level_options);
     } else {
@@ -195,7 +213,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     level_statistics.dimensions = carver->volume().grid().dimensions();
     level_statistics.start_solid = carver->volume().num_solid();
     level_statistics.setup_seconds = SecondsSince(level_start);
-    if (level == 0) {
+    if (level == first_level) {
       statistics.visibility = carver->visibility().Name();
       if (options.method == CarveMethod::kRay) {
         statistics.visibility += " (" + VisLookupToString(options.vis_lookup) + ")";
@@ -236,7 +254,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
         next_report = seconds + progress_interval_seconds;
       }
     }
-    if (level + 1 == num_levels) RemoveComponents(options, carver.get(), &statistics);
+    if (final_level && stages.finish) RemoveComponents(options, carver.get(), &statistics);
     sample(SecondsSince(start));
     level_statistics.carved =
         carver->carved() + carver->visual_hull().carved + carver->free_space().carved +
@@ -258,9 +276,11 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
     statistics.passes = std::max(statistics.passes, carver->passes());
     statistics.threads = carver->threads();
     statistics.peak_memory_bytes = std::max(statistics.peak_memory_bytes, carver->MemoryBytes());
-    if (level + 1 < num_levels) add_worker_times(*carver);
+    if (level < last_level || !stages.finish) add_worker_times(*carver);
   }
-  RepairSilhouettesAndRecolour(views, options, add_worker_times, &carver, &statistics);
+  if (stages.finish) {
+    RepairSilhouettesAndRecolour(views, options, add_worker_times, &carver, &statistics);
+  }
   statistics.carve_seconds = SecondsSince(start);
   statistics.dimensions = carver->volume().grid().dimensions();
   statistics.voxel_size = carver->volume().grid().voxel_size();
@@ -269,22 +289,49 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
 
   const Clock::time_point colour_start = Clock::now();
   CarveResult result{carver->volume().grid()};
-  result.surface = carver->ColourSurface();
-  statistics.reprojection_error_after = carver->surface_reprojection_error();
-  for (const ColouredVoxel& voxel : result.surface) {
-    if (voxel.num_pixels > 0) ++statistics.visible_surface;
+  if (stages.finish) {
+    result.surface = carver->ColourSurface();
+    statistics.reprojection_error_after = carver->surface_reprojection_error();
+    for (const ColouredVoxel& voxel : result.surface) {
+      if (voxel.num_pixels > 0) ++statistics.visible_surface;
+    }
+    statistics.colour_seconds = SecondsSince(colour_start);
+    add_worker_times(*carver);
   }
-  statistics.colour_seconds = SecondsSince(colour_start);
-  add_worker_times(*carver);
   statistics.final_surface = carver->volume().num_surface();
   statistics.final_solid = carver->volume().num_solid();
   result.volume = std::move(*carver->mutable_volume());
   result.statistics = std::move(statistics);
   if (progress) {
-    progress({num_levels - 1, num_levels, result.statistics.evaluated, result.statistics.carved,
+    progress({last_level, num_levels, result.statistics.evaluated, result.statistics.carved,
               0, result.statistics.carve_seconds});
   }
   return result;
+}
+
+CarveResult CarveVolume(const std::vector<CalibratedView>& views,
+                        const Eigen::AlignedBox3d& box,
+                        const CarveOptions& options,
+                        const std::function<void(const CarveProgress&)>& progress,
+                        double progress_interval_seconds) {
+  return CarveLevels(views, box, options, CarveStages(), progress, progress_interval_seconds);
+}
+
+void FinalLevelThresholds(const std::vector<CalibratedView>& views,
+                          const Eigen::AlignedBox3d& box,
+                          const CarveOptions& options,
+                          double* threshold,
+                          double* pattern_threshold) {
+  CarveOptions level_options = options;
+  level_options.correct_view_count =
+      options.auto_threshold &&
+      std::none_of(views.begin(), views.end(),
+                   [](const CalibratedView& view) { return !view.mask.empty(); });
+  LevelStatistics ignored;
+  ChooseLevelThresholds(views, VoxelGrid(box, options.resolution), options, &level_options,
+                        &ignored);
+  *threshold = level_options.threshold;
+  *pattern_threshold = level_options.pattern_threshold;
 }
 
 }  // namespace raycarve

@@ -14,7 +14,6 @@ std::vector<cv::Mat> KnownSurfaceDepths(const std::vector<CalibratedView>& views
   // Per view, the projections (x, y, depth) of the points it saw.
   std::vector<std::vector<Eigen::Vector3d>> seen(views.size());
   for (const SurfacePoint& point : points) {
-    if (!grid.Contains(grid.VoxelOf(point.xyz))) continue;
     for (int v : point.views) {
       const Eigen::Vector3d pixel = views[v].P * point.xyz.homogeneous();
       if (pixel.z() > 0.0) seen[v].emplace_back(pixel.x() / pixel.z(), pixel.y() / pixel.z(), pixel.z());

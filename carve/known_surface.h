@@ -14,7 +14,9 @@ namespace raycarve {
 // Per view, the depth of the known surface near each pixel: around each surface point's
 // projection, within kKnownSurfaceRadiusVoxels of its projected voxel width or
 // kKnownSurfaceRadiusSpacings of the view's observation spacing, whichever is wider, the farthest
-// depth of the points there (0: no point near). Empty for views no point names.
+// depth of the points there (0: no point near). Empty for views no point names. Every point
+// counts, inside the grid or not: the carve's points are those of its volume, and a tile of the
+// volume (carve/tiling.h) is protected by the points beyond its edge as the whole grid is.
 std::vector<cv::Mat> KnownSurfaceDepths(const std::vector<CalibratedView>& views,
                                         const VoxelGrid& grid,
                                         const std::vector<SurfacePoint>& points);

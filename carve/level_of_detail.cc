@@ -64,27 +64,48 @@ bool LevelResolutions(int resolution, int levels, std::vector<int>* resolutions,
 }
 
 Volume RefineVolume(const Volume& coarse, const VoxelGrid& fine, int band) {
+  return RefineRegion(coarse, fine, Eigen::Vector3i::Zero(), band);
+}
+
+Volume RefineRegion(const Volume& coarse, const VoxelGrid& fine, const Eigen::Vector3i& offset,
+                    int band) {
   const VoxelGrid& grid = coarse.grid();
   const Eigen::Vector3i& n = grid.dimensions();
+  const Eigen::Vector3i& m = fine.dimensions();
   CHECK_NEAR(fine.voxel_size() * 2.0, grid.voxel_size(), 1e-12 * grid.voxel_size());
-  CHECK((fine.origin() - grid.origin()).norm() <= 1e-9 * grid.voxel_size());
-  CHECK((fine.dimensions().array() <= 2 * n.array()).all());
+  CHECK((fine.origin() - fine.voxel_size() * offset.cast<double>() - grid.origin()).norm() <=
+        1e-9 * grid.voxel_size());
+  CHECK((offset.array() >= 0).all() && ((offset + m).array() <= 2 * n.array()).all());
   std::vector<uint8_t> keep(grid.num_voxels());
   for (int64_t index = 0; index < grid.num_voxels(); ++index) keep[index] = coarse.IsSolid(index);
   for (int step = 0; step < band; ++step) Dilate(n, &keep);
 
-  const Eigen::Vector3i& m = fine.dimensions();
   std::vector<uint64_t> solid((fine.num_voxels() + 63) / 64, 0);
   for (int z = 0; z < m.z(); ++z) {
     for (int y = 0; y < m.y(); ++y) {
-      const int64_t parent_row = grid.Index(Eigen::Vector3i(0, y / 2, z / 2));
+      const int64_t parent_row =
+          grid.Index(Eigen::Vector3i(0, (y + offset.y()) / 2, (z + offset.z()) / 2));
       const int64_t row = fine.Index(Eigen::Vector3i(0, y, z));
       for (int x = 0; x < m.x(); ++x) {
-        if (keep[parent_row + x / 2]) solid[(row + x) >> 6] |= uint64_t{1} << ((row + x) & 63);
+        if (keep[parent_row + (x + offset.x()) / 2]) {
+          solid[(row + x) >> 6] |= uint64_t{1} << ((row + x) & 63);
+        }
       }
     }
   }
   return Volume(fine, std::move(solid));
+}
+
+Volume DilateSolid(const Volume& volume, int band) {
+  const VoxelGrid& grid = volume.grid();
+  std::vector<uint8_t> keep(grid.num_voxels());
+  for (int64_t index = 0; index < grid.num_voxels(); ++index) keep[index] = volume.IsSolid(index);
+  for (int step = 0; step < band; ++step) Dilate(grid.dimensions(), &keep);
+  std::vector<uint64_t> solid((grid.num_voxels() + 63) / 64, 0);
+  for (int64_t index = 0; index < grid.num_voxels(); ++index) {
+    if (keep[index]) solid[index >> 6] |= uint64_t{1} << (index & 63);
+  }
+  return Volume(grid, std::move(solid));
 }
 
 }  // namespace raycarve

@@ -24,6 +24,9 @@ struct LevelStatistics {
   // too few could be judged, and the fallback was used); `estimate` holds what it came from.
   bool threshold_from_data = false;
   ThresholdEstimate estimate;
+  // The threshold was estimated before, over the whole volume, and given (a carve in tiles:
+  // carve/tiling.h); `estimate` is then empty.
+  bool threshold_given = false;
   int64_t protected_kept = 0;  // evaluations that kept a protected voxel found inconsistent
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   int64_t start_solid = 0;  // solid voxels when the level began (after refinement and hull)
@@ -55,5 +58,14 @@ bool LevelResolutions(int resolution, int levels, std::vector<int>* resolutions,
 // voxel size, with at most twice its voxels along each axis (CHECKed; VoxelGrid gives this for
 // resolutions r and 2r over one box).
 Volume RefineVolume(const Volume& coarse, const VoxelGrid& fine, int band = 1);
+
+// RefineVolume for part of the finer grid: `fine` is the region of it that starts at voxel
+// `offset` (VoxelGrid::Region), and gets the same voxels as that part of RefineVolume's volume.
+Volume RefineRegion(const Volume& coarse, const VoxelGrid& fine, const Eigen::Vector3i& offset,
+                    int band = 1);
+
+// `volume` with every voxel within `band` voxels (26-neighbourhood, band steps) of a solid one
+// solid: what RefineVolume starts a finer level from, at the coarse level's voxels.
+Volume DilateSolid(const Volume& volume, int band);
 
 }  // namespace raycarve

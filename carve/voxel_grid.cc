@@ -37,6 +37,17 @@ Eigen::AlignedBox3d VoxelGrid::Box() const {
   return Eigen::AlignedBox3d(origin_, origin_ + voxel_size_ * dimensions_.cast<double>());
 }
 
+VoxelGrid VoxelGrid::Region(const Eigen::Vector3i& lo, const Eigen::Vector3i& hi) const {
+  CHECK((lo.array() >= 0).all() && (lo.array() < hi.array()).all() &&
+        (hi.array() <= dimensions_.array()).all())
+      << "region " << lo.transpose() << " .. " << hi.transpose() << " of a grid of "
+      << dimensions_.transpose();
+  VoxelGrid region = *this;
+  region.origin_ = origin_ + voxel_size_ * lo.cast<double>();
+  region.dimensions_ = hi - lo;
+  return region;
+}
+
 Eigen::Vector3i VoxelGrid::Voxel(int64_t index) const {
   const int64_t nx = dimensions_.x(), ny = dimensions_.y();
   return Eigen::Vector3i(static_cast<int>(index % nx),

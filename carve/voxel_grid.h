@@ -28,6 +28,9 @@ class VoxelGrid {
   }
   // The box the voxels cover (contains the requested box).
   Eigen::AlignedBox3d Box() const;
+  // The grid of this grid's voxels [lo, hi) (per axis; non-empty and inside, CHECKed): the same
+  // voxel size, its voxel v being this grid's voxel lo + v. A tile of a carve (carve/tiling.h).
+  VoxelGrid Region(const Eigen::Vector3i& lo, const Eigen::Vector3i& hi) const;
 
   bool Contains(const Eigen::Vector3i& voxel) const {
     return (voxel.array() >= 0).all() && (voxel.array() < dimensions_.array()).all();

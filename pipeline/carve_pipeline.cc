@@ -69,7 +69,10 @@ void LogCarve(const CarveOptions& options, const CarveStatistics& s) {
   if (s.silhouette_repair.views > 0) LOG(INFO) << s.silhouette_repair.Summary();
   for (const LevelStatistics& level : s.levels) {
     if (!options.auto_threshold) break;
-    if (level.threshold_from_data) {
+    if (level.threshold_given) {
+      LOG(INFO) << "level " << level.resolution << ": threshold " << level.threshold
+                << " (estimated over the whole volume by the tile plan)";
+    } else if (level.threshold_from_data) {
       LOG(INFO) << "level " << level.resolution << ": " << level.estimate.Summary();
     } else {
       LOG(WARNING) << "level " << level.resolution << ": only " << level.estimate.points_judged
@@ -379,6 +382,10 @@ void CarvePipeline::Carve() {
   LogSurfacePointUses(request_.options, surface_points_.size());
   run_.result = std::make_unique<CarveResult>(
       CarveWith(request_.options, scope_.progress, request_.progress_seconds));
+  RecordCarve();
+}
+
+void CarvePipeline::RecordCarve() {
   if (scope_.progress_end) scope_.progress_end();
   LogCarve(request_.options, run_.result->statistics);
   RecordSeconds("carve_setup", run_.result->statistics.setup_seconds);
@@ -395,10 +402,60 @@ CarveResult CarvePipeline::CarveWith(CarveOptions options,
     throw InputError("raycarve " + scope_.command + ": " + CarveMethodToString(options.method) +
                      ": " + reason);
   }
+  return CarveVolume(carved_, project_.bounds.box, FilledOptions(std::move(options)), progress,
+                     progress_interval_seconds);
+}
+
+CarveOptions CarvePipeline::FilledOptions(CarveOptions options) const {
   options.surface_points = surface_points_;
   options.ground = run_.ground;
   options.distant_rays = distant_rays_;
-  return CarveVolume(carved_, project_.bounds.box, options, progress, progress_interval_seconds);
+  return options;
+}
+
+const CarveRun& CarvePipeline::RunFromTiles(const std::function<Volume(const VoxelGrid&)>& join,
+                                            double final_threshold,
+                                            double final_pattern_threshold) {
+  LockOutputs();
+  LoadViews();
+  AgreeMasks();
+  CheckVolume();
+  PlanOutputs();
+  CarveFromTiles(join(VoxelGrid(project_.bounds.box, request_.options.resolution)),
+                 final_threshold, final_pattern_threshold);
+  MakeSurface();
+  SampleCloud();
+  MeasureCloud();
+  WriteOutputs();
+  return run_;
+}
+
+CoarseCarve CarvePipeline::CarveCoarse() const {
+  CHECK(loaded_);
+  LOG(INFO) << "carving the coarse levels of detail over the whole volume ...";
+  CoarseCarve coarse = CarveCoarseLevels(carved_, project_.bounds.box,
+                                         FilledOptions(request_.options), scope_.progress,
+                                         request_.progress_seconds);
+  if (scope_.progress_end) scope_.progress_end();
+  return coarse;
+}
+
+TileCarve CarvePipeline::CarveTileOf(const CoarseCarve& coarse, const TileRegion& tile) const {
+  CHECK(loaded_);
+  TileCarve carved = CarveTile(carved_, project_.bounds.box, FilledOptions(request_.options),
+                               coarse, tile, scope_.progress, request_.progress_seconds);
+  if (scope_.progress_end) scope_.progress_end();
+  return carved;
+}
+
+void CarvePipeline::CarveFromTiles(Volume joined, double final_threshold,
+                                   double final_pattern_threshold) {
+  CHECK(loaded_);
+  LOG(INFO) << "carving on from the tiles' joined volume with the whole volume's visibility ...";
+  run_.result = std::make_unique<CarveResult>(FinishTiledCarve(
+      carved_, project_.bounds.box, FilledOptions(request_.options), std::move(joined),
+      final_threshold, final_pattern_threshold, scope_.progress, request_.progress_seconds));
+  RecordCarve();
 }
 
 void CarvePipeline::MakeSurface() {

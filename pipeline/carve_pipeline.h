@@ -12,6 +12,7 @@
 #include "calib/atomic_file.h"
 #include "calib/distant_pixels.h"
 #include "carve/carver.h"
+#include "carve/tiling.h"
 #include "export/supporting_plane.h"
 #include "carve/mask_agreement.h"
 #include "export/carve_export.h"
@@ -135,6 +136,18 @@ class CarvePipeline {
   void MeasureCloud();  // how far the model's sparse points lie from the cloud
   void WriteOutputs();  // every file into the staging folder, then moved into place
 
+  // Every stage as Run does, with the carve from the tiles' joined cores (CarveFromTiles): `join`
+  // makes them, for the grid of the project as loaded (it throws InputError where they do not
+  // fit it).
+  const CarveRun& RunFromTiles(const std::function<Volume(const VoxelGrid&)>& join,
+                               double final_threshold, double final_pattern_threshold);
+
+  // A carve split into tiles (carve/tiling.h; `raycarve tile`), after CheckVolume: the coarse
+  // levels, one tile, and the carve stage from the tiles' joined cores (in place of Carve).
+  CoarseCarve CarveCoarse() const;
+  TileCarve CarveTileOf(const CoarseCarve& coarse, const TileRegion& tile) const;
+  void CarveFromTiles(Volume joined, double final_threshold, double final_pattern_threshold);
+
   // A carve of the carved views with other options (their surface points filled in), without
   // touching run(): benchmark's methods. Throws InputError when the carve does not fit.
   CarveResult CarveWith(CarveOptions options,
@@ -154,6 +167,10 @@ class CarvePipeline {
   const CarveRun& run() const { return run_; }
 
  private:
+  // `options` with what the carve takes from the project: its sparse points, ground and
+  // distant rays.
+  CarveOptions FilledOptions(CarveOptions options) const;
+  void RecordCarve();  // the log lines and stage times of run_.result's carve
   void DecideMasks();
   void DecideGround();  // run_.ground, once the masks are decided
   void FindDistant();   // distant_rays_ and run_.distant, once the masks are decided

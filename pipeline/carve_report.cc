@@ -260,7 +260,9 @@ void WriteLevels(const CarveRequest& request, const CarveRun& run, JsonWriter& j
         .Key("threshold").Value(level.threshold);
     const bool patterns = request.options.consistency == ConsistencyMethod::kPatchCorrelation;
     if (patterns) json.Key("pattern_threshold").Value(level.pattern_threshold);
-    if (request.options.auto_threshold || (patterns && request.options.auto_pattern_threshold)) {
+    if (level.threshold_given) json.Key("threshold_from_tile_plan").Value(true);
+    if (!level.threshold_given &&
+        (request.options.auto_threshold || (patterns && request.options.auto_pattern_threshold))) {
       const ThresholdEstimate& e = level.estimate;
       std::vector<double> surface, front;
       for (int q = 0; q <= 20; ++q) {

@@ -23,6 +23,7 @@ int RunHoldout(int argc, char** argv);
 int RunBenchmark(int argc, char** argv);
 int RunSfm(int argc, char** argv);
 int RunRender(int argc, char** argv);
+int RunTile(int argc, char** argv);
 
 // model_info: a text and a JSON description of a model and the bounds it would carve; with
 // `bounds_error`, why its points bound no volume instead.

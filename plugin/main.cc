@@ -43,6 +43,8 @@ const Command kCommands[] = {
      "the seed paper's Table 1 and Figure 6: ray casting against GVC and GVC-LDI"},
     {"render", raycarve::RunRender,
      "draw a coloured cloud into the cameras of a COLMAP model (render and silhouette)"},
+    {"tile", raycarve::RunTile,
+     "a carve split into tiles for separate processes or a cluster: plan, run, merge"},
     {"synth", raycarve::RunSynth, "generate a synthetic COLMAP project with ground truth"},
 };
 

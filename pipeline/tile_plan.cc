@@ -1,0 +1,407 @@
+#include "pipeline/tile_plan.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include <glog/logging.h>
+#include <nlohmann/json.hpp>
+
+#include "calib/input_error.h"
+#include "pipeline/output_files.h"
+
+namespace raycarve {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr char kMagic[8] = {'R', 'C', 'V', 'O', 'X', 'E', 'L', '1'};
+constexpr int kMaxDimension = 4096;
+
+// The fixed header of a voxel block file.
+struct BlockHeader {
+  char magic[8];
+  char plan_id[16];
+  int32_t job;  // -1: the coarse volume
+  int32_t lo[3];
+  int32_t hi[3];
+  uint64_t words;
+};
+
+json Vector(const Eigen::Vector3i& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+int64_t Voxels(const Eigen::Vector3i& lo, const Eigen::Vector3i& hi) {
+  const Eigen::Vector3i n = hi - lo;
+  return static_cast<int64_t>(n.x()) * n.y() * n.z();
+}
+
+void WriteBlock(const std::string& path, const std::string& plan_id, int job,
+                const Eigen::Vector3i& lo, const Eigen::Vector3i& hi,
+                const std::vector<uint64_t>& bits) {
+  BlockHeader header{};
+  std::memcpy(header.magic, kMagic, sizeof(kMagic));
+  std::memcpy(header.plan_id, plan_id.data(), std::min<size_t>(16, plan_id.size()));
+  header.job = job;
+  for (int axis = 0; axis < 3; ++axis) {
+    header.lo[axis] = lo[axis];
+    header.hi[axis] = hi[axis];
+  }
+  header.words = bits.size();
+  std::string bytes(reinterpret_cast<const char*>(&header), sizeof(header));
+  bytes.append(reinterpret_cast<const char*>(bits.data()), bits.size() * sizeof(uint64_t));
+  WriteTextFileAtomically(path, bytes);
+}
+
+std::vector<uint64_t> ReadBlock(const std::string& path, const std::string& what,
+                                const std::string& plan_id, int job,
+                                const Eigen::Vector3i& lo, const Eigen::Vector3i& hi) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError(path + ": cannot read " + what + " (" +
+                     (fs::exists(path) ? "not readable" : "missing") + ")");
+  }
+  BlockHeader header{};
+  in.read(reinterpret_cast<char*>(&header), sizeof(header));
+  if (!in || std::memcmp(header.magic, kMagic, sizeof(kMagic)) != 0) {
+    throw InputError(path + ": not a raycarve voxel file (" + what + ")");
+  }
+  if (std::string(header.plan_id, 16) != plan_id) {
+    throw InputError(path + ": plan_id " + std::string(header.plan_id, 16) + " is not the plan's " +
+                     plan_id + ": " + what + " from another plan (plan again or run the job again)");
+  }
+  if (header.job != job) {
+    throw InputError(path + ": job " + std::to_string(header.job) + ", expected " +
+                     std::to_string(job));
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    if (header.lo[axis] != lo[axis] || header.hi[axis] != hi[axis]) {
+      throw InputError(path + ": its block of voxels does not match the plan's (" + what + ")");
+    }
+  }
+  const uint64_t words = (static_cast<uint64_t>(Voxels(lo, hi)) + 63) / 64;
+  if (header.words != words) {
+    throw InputError(path + ": words " + std::to_string(header.words) + ", expected " +
+                     std::to_string(words));
+  }
+  std::vector<uint64_t> bits(words);
+  in.read(reinterpret_cast<char*>(bits.data()), static_cast<std::streamsize>(words * 8));
+  if (!in || in.peek() != std::char_traits<char>::eof()) {
+    throw InputError(path + ": " + (in ? "longer" : "shorter") + " than its header says (" +
+                     what + ")");
+  }
+  return bits;
+}
+
+// The field `key` of `object` (in `path`), which must exist: InputError naming both otherwise.
+const json& Field(const json& object, const char* key, const std::string& path) {
+  if (!object.is_object() || !object.contains(key)) {
+    throw InputError(path + ": field " + key + " is missing");
+  }
+  return object.at(key);
+}
+
+Eigen::Vector3i ReadVector(const json& object, const char* key, const std::string& path,
+                           int min_value, int max_value) {
+  const json& value = Field(object, key, path);
+  if (!value.is_array() || value.size() != 3) {
+    throw InputError(path + ": field " + key + " must be an array of 3 integers");
+  }
+  Eigen::Vector3i v;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!value[axis].is_number_integer() || value[axis].get<int64_t>() < min_value ||
+        value[axis].get<int64_t>() > max_value) {
+      throw InputError(path + ": field " + key + " must hold integers in [" +
+                       std::to_string(min_value) + ", " + std::to_string(max_value) + "]");
+    }
+    v[axis] = value[axis].get<int>();
+  }
+  return v;
+}
+
+template <typename T>
+T ReadNumber(const json& object, const char* key, const std::string& path) {
+  const json& value = Field(object, key, path);
+  if (!value.is_number()) throw InputError(path + ": field " + key + " must be a number");
+  return value.get<T>();
+}
+
+std::string ReadString(const json& object, const char* key, const std::string& path) {
+  const json& value = Field(object, key, path);
+  if (!value.is_string()) throw InputError(path + ": field " + key + " must be a string");
+  return value.get<std::string>();
+}
+
+std::string Quoted(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string SlurmTime(double minutes) {
+  const int total = static_cast<int>(std::ceil(std::max(minutes, 1.0)));
+  char text[32];
+  std::snprintf(text, sizeof(text), "%d:%02d:00", total / 60, total % 60);
+  return text;
+}
+
+int MemoryMiB(double gib) { return static_cast<int>(std::ceil(gib * 1024.0 / 256.0)) * 256; }
+
+}  // namespace
+
+const TilePlan::Tile* TilePlan::TileOfJob(int job) const {
+  for (const Tile& tile : tiles) {
+    if (tile.job == job) return &tile;
+  }
+  return nullptr;
+}
+
+std::string HexDigest(const std::string& bytes) {
+  uint64_t hash = 1469598103934665603ull;
+  for (unsigned char c : bytes) {
+    hash ^= c;
+    hash *= 1099511628211ull;
+  }
+  char text[17];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+std::string TilePlanJson(const TilePlan& plan) {
+  json root;
+  root["schema"] = TilePlan::kSchema;
+  root["kind"] = "raycarve tile plan";
+  root["plan_id"] = plan.plan_id;
+  root["working_directory"] = plan.working_directory;
+  root["arguments"] = plan.arguments;
+  root["resolution"] = plan.resolution;
+  root["dimensions"] = Vector(plan.dimensions);
+  root["coarse_dimensions"] = Vector(plan.coarse_dimensions);
+  root["tiles_per_axis"] = Vector(plan.tiles_per_axis);
+  root["overlap_voxels"] = plan.overlap;
+  root["final_threshold"] = plan.final_threshold;
+  root["final_pattern_threshold"] = plan.final_pattern_threshold;
+  root["coarse_file"] = "coarse.bin";
+  root["jobs"] = plan.jobs;
+  root["merge"] = {{"memory_gib", plan.merge_memory_gib}, {"minutes", plan.merge_minutes}};
+  json tiles = json::array();
+  for (const TilePlan::Tile& tile : plan.tiles) {
+    json t;
+    t["index"] = tile.region.index;
+    t["job"] = tile.job;
+    t["core_lo"] = Vector(tile.region.core_lo);
+    t["core_hi"] = Vector(tile.region.core_hi);
+    t["lo"] = Vector(tile.region.lo);
+    t["hi"] = Vector(tile.region.hi);
+    t["coarse_solid_voxels"] = tile.coarse_solid;
+    t["memory_gib"] = tile.memory_gib;
+    t["minutes"] = tile.minutes;
+    t["part"] = tile.job >= 0 ? TilePartPath("", tile.job) : "";
+    tiles.push_back(t);
+  }
+  root["tiles"] = tiles;
+  return root.dump(2) + "\n";
+}
+
+TilePlan ReadTilePlan(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw InputError(path + ": cannot read the tile plan (" +
+                     (fs::exists(path) ? "not readable" : "missing: run raycarve tile plan") + ")");
+  }
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const json root = json::parse(text, nullptr, false);
+  if (root.is_discarded() || !root.is_object()) {
+    throw InputError(path + ": not a JSON object (a tile plan is written by raycarve tile plan)");
+  }
+  TilePlan plan;
+  if (ReadNumber<int>(root, "schema", path) != TilePlan::kSchema) {
+    throw InputError(path + ": field schema is not " + std::to_string(TilePlan::kSchema));
+  }
+  plan.plan_id = ReadString(root, "plan_id", path);
+  if (plan.plan_id.size() != 16) throw InputError(path + ": field plan_id must be 16 hex digits");
+  plan.working_directory = ReadString(root, "working_directory", path);
+  const json& arguments = Field(root, "arguments", path);
+  if (!arguments.is_array()) throw InputError(path + ": field arguments must be an array");
+  for (const json& argument : arguments) {
+    if (!argument.is_string()) throw InputError(path + ": field arguments must hold strings");
+    plan.arguments.push_back(argument.get<std::string>());
+  }
+  plan.resolution = ReadNumber<int>(root, "resolution", path);
+  plan.dimensions = ReadVector(root, "dimensions", path, 1, kMaxDimension);
+  plan.coarse_dimensions = ReadVector(root, "coarse_dimensions", path, 1, kMaxDimension);
+  plan.tiles_per_axis = ReadVector(root, "tiles_per_axis", path, 1, 64);
+  plan.overlap = ReadNumber<int>(root, "overlap_voxels", path);
+  plan.final_threshold = ReadNumber<double>(root, "final_threshold", path);
+  plan.final_pattern_threshold = ReadNumber<double>(root, "final_pattern_threshold", path);
+  plan.jobs = ReadNumber<int>(root, "jobs", path);
+  const json& merge = Field(root, "merge", path);
+  plan.merge_memory_gib = ReadNumber<double>(merge, "memory_gib", path);
+  plan.merge_minutes = ReadNumber<double>(merge, "minutes", path);
+  const json& tiles = Field(root, "tiles", path);
+  const int64_t expected = static_cast<int64_t>(plan.tiles_per_axis.x()) *
+                           plan.tiles_per_axis.y() * plan.tiles_per_axis.z();
+  if (!tiles.is_array() || static_cast<int64_t>(tiles.size()) != expected) {
+    throw InputError(path + ": field tiles must list " + std::to_string(expected) + " tiles");
+  }
+  std::vector<int> seen_jobs(plan.jobs, 0);
+  if (plan.jobs < 0 || plan.jobs > expected) throw InputError(path + ": field jobs out of range");
+  for (const json& t : tiles) {
+    TilePlan::Tile tile;
+    tile.region.index = ReadNumber<int>(t, "index", path);
+    tile.job = ReadNumber<int>(t, "job", path);
+    tile.region.core_lo = ReadVector(t, "core_lo", path, 0, kMaxDimension);
+    tile.region.core_hi = ReadVector(t, "core_hi", path, 0, kMaxDimension);
+    tile.region.lo = ReadVector(t, "lo", path, 0, kMaxDimension);
+    tile.region.hi = ReadVector(t, "hi", path, 0, kMaxDimension);
+    tile.coarse_solid = ReadNumber<int64_t>(t, "coarse_solid_voxels", path);
+    tile.memory_gib = ReadNumber<double>(t, "memory_gib", path);
+    tile.minutes = ReadNumber<double>(t, "minutes", path);
+    const TileRegion& r = tile.region;
+    if (!((r.lo.array() <= r.core_lo.array()).all() && (r.core_lo.array() < r.core_hi.array()).all() &&
+          (r.core_hi.array() <= r.hi.array()).all() &&
+          (r.hi.array() <= plan.dimensions.array()).all())) {
+      throw InputError(path + ": tile " + std::to_string(r.index) +
+                       ": its region does not lie in the grid");
+    }
+    if (tile.job < -1 || tile.job >= plan.jobs) {
+      throw InputError(path + ": tile " + std::to_string(r.index) + ": field job out of range");
+    }
+    if (tile.job >= 0 && seen_jobs[tile.job]++ > 0) {
+      throw InputError(path + ": job " + std::to_string(tile.job) + " is listed twice");
+    }
+    plan.tiles.push_back(tile);
+  }
+  return plan;
+}
+
+void WriteCoarseVolume(const std::string& path, const std::string& plan_id, const Volume& volume) {
+  WriteBlock(path, plan_id, -1, Eigen::Vector3i::Zero(), volume.grid().dimensions(),
+             volume.solid_bits());
+}
+
+std::vector<uint64_t> ReadCoarseVolume(const std::string& path, const TilePlan& plan) {
+  return ReadBlock(path, "the coarse volume", plan.plan_id, -1, Eigen::Vector3i::Zero(),
+                   plan.coarse_dimensions);
+}
+
+void WriteTilePart(const std::string& path, const TilePlan& plan, int job,
+                   const std::vector<uint64_t>& core_bits) {
+  const TilePlan::Tile* tile = plan.TileOfJob(job);
+  CHECK(tile != nullptr);
+  WriteBlock(path, plan.plan_id, job, tile->region.core_lo, tile->region.core_hi, core_bits);
+}
+
+std::vector<uint64_t> ReadTilePart(const std::string& path, const TilePlan& plan, int job) {
+  const TilePlan::Tile* tile = plan.TileOfJob(job);
+  CHECK(tile != nullptr);
+  return ReadBlock(path, "job " + std::to_string(job) + "'s part", plan.plan_id, job,
+                   tile->region.core_lo, tile->region.core_hi);
+}
+
+std::string TilePartPath(const std::string& folder, int job) {
+  const std::string name = "tile_" + std::to_string(job) + ".bin";
+  return folder.empty() ? name : (fs::path(folder) / name).string();
+}
+
+void WriteTileJobScripts(const std::string& folder, const TilePlan& plan,
+                         const std::string& raycarve, const std::string& plan_path) {
+  double memory = 0.0, minutes = 0.0;
+  for (const TilePlan::Tile& tile : plan.tiles) {
+    if (tile.job < 0) continue;
+    memory = std::max(memory, tile.memory_gib);
+    minutes = std::max(minutes, tile.minutes);
+  }
+  const std::string logs = (fs::path(folder) / "logs").string();
+  const std::string run = Quoted(raycarve) + " tile run --plan " + Quoted(plan_path);
+  const std::string merge = Quoted(raycarve) + " tile merge --plan " + Quoted(plan_path);
+  std::ostringstream tiles;
+  tiles << "#!/bin/bash\n"
+        << "# raycarve tile jobs of plan " << plan.plan_id << ": one array task per tile with work.\n"
+        << "# Memory and time: the largest tile's estimate (plan.json lists each tile's).\n"
+        << "#SBATCH --job-name=raycarve-tiles\n"
+        << "#SBATCH --array=0-" << std::max(0, plan.jobs - 1) << "\n"
+        << "#SBATCH --cpus-per-task=2\n"
+        << "#SBATCH --mem=" << MemoryMiB(memory) << "M\n"
+        << "#SBATCH --time=" << SlurmTime(minutes) << "\n"
+        << "#SBATCH --output=" << logs << "/tile_%a.log\n"
+        << "cd " << Quoted(plan.working_directory) << "\n"
+        << "exec " << run << " --index \"$SLURM_ARRAY_TASK_ID\"\n";
+  WriteTextFileAtomically((fs::path(folder) / "tiles.sbatch").string(), tiles.str());
+  std::ostringstream merge_job;
+  merge_job << "#!/bin/bash\n"
+            << "# raycarve: joins the tiles of plan " << plan.plan_id << " and writes the model.\n"
+            << "#SBATCH --job-name=raycarve-merge\n"
+            << "#SBATCH --cpus-per-task=2\n"
+            << "#SBATCH --mem=" << MemoryMiB(plan.merge_memory_gib) << "M\n"
+            << "#SBATCH --time=" << SlurmTime(plan.merge_minutes) << "\n"
+            << "#SBATCH --output=" << logs << "/merge.log\n"
+            << "cd " << Quoted(plan.working_directory) << "\n"
+            << "exec " << merge << "\n";
+  WriteTextFileAtomically((fs::path(folder) / "merge.sbatch").string(), merge_job.str());
+  std::ostringstream submit;
+  submit << "#!/bin/bash\n"
+         << "# Submits the tile array, then the merge once every task has succeeded.\n"
+         << "set -euo pipefail\n"
+         << "cd " << Quoted(folder) << "\n"
+         << "mkdir -p logs\n"
+         << "array=$(sbatch --parsable tiles.sbatch)\n"
+         << "merge=$(sbatch --parsable --dependency=afterok:\"${array%%;*}\" merge.sbatch)\n"
+         << "echo \"tiles: job $array, merge: job $merge\"\n";
+  WriteTextFileAtomically((fs::path(folder) / "submit_slurm.sh").string(), submit.str());
+  fs::permissions(fs::path(folder) / "submit_slurm.sh", fs::perms::owner_exec | fs::perms::group_exec,
+                  fs::perm_options::add);
+
+  // Kubernetes: an indexed Job (the index in JOB_COMPLETION_INDEX), then the merge as its own Job.
+  // The workspace must be mounted at the same path in the pods (a volume the user names).
+  const auto k8s_job = [&](const std::string& name, bool indexed, double gib, double job_minutes,
+                           const std::string& command) {
+    std::ostringstream y;
+    y << "# raycarve plan " << plan.plan_id << ". The image must hold raycarve at " << raycarve
+      << ",\n# and the workspace must be mounted at " << plan.working_directory
+      << " (edit the volume below).\n"
+      << "apiVersion: batch/v1\nkind: Job\nmetadata:\n  name: " << name << "\nspec:\n";
+    if (indexed) {
+      y << "  completionMode: Indexed\n  completions: " << plan.jobs
+        << "\n  parallelism: " << plan.jobs << "\n";
+    }
+    y << "  backoffLimit: 2\n  activeDeadlineSeconds: "
+      << static_cast<int>(std::ceil(std::max(job_minutes, 1.0) * 60.0) * (indexed ? 2 : 1)) << "\n"
+      << "  template:\n    spec:\n      restartPolicy: Never\n      containers:\n"
+      << "        - name: raycarve\n          image: raycarve:latest\n"
+      << "          workingDir: " << plan.working_directory << "\n"
+      << "          command: [\"/bin/sh\", \"-c\", " << json(command).dump() << "]\n"
+      << "          resources:\n            requests:\n              cpu: \"2\"\n"
+      << "              memory: " << MemoryMiB(gib) << "Mi\n            limits:\n"
+      << "              memory: " << MemoryMiB(gib) << "Mi\n"
+      << "          volumeMounts:\n            - name: workspace\n              mountPath: "
+      << plan.working_directory << "\n      volumes:\n        - name: workspace\n"
+      << "          persistentVolumeClaim:\n            claimName: raycarve-workspace\n";
+    return y.str();
+  };
+  WriteTextFileAtomically((fs::path(folder) / "tiles.k8s.yaml").string(),
+                          k8s_job("raycarve-tiles", true, memory, minutes,
+                                  run + " --index \"$JOB_COMPLETION_INDEX\""));
+  WriteTextFileAtomically(
+      (fs::path(folder) / "merge.k8s.yaml").string(),
+      "# Apply once the tiles' Job has completed:\n"
+      "#   kubectl wait --for=condition=complete job/raycarve-tiles --timeout=24h\n" +
+          k8s_job("raycarve-merge", false, plan.merge_memory_gib, plan.merge_minutes, merge));
+
+  std::ostringstream local;
+  local << "#!/bin/bash\n"
+        << "# The tile jobs as processes on this machine, JOBS at a time (default 1), then the merge.\n"
+        << "set -euo pipefail\n"
+        << "cd " << Quoted(plan.working_directory) << "\n"
+        << "seq 0 " << plan.jobs - 1 << " | xargs -P \"${JOBS:-1}\" -I{} " << run << " --index {}\n"
+        << merge << "\n";
+  WriteTextFileAtomically((fs::path(folder) / "run_local.sh").string(), local.str());
+  fs::permissions(fs::path(folder) / "run_local.sh", fs::perms::owner_exec | fs::perms::group_exec,
+                  fs::perm_options::add);
+}
+
+}  // namespace raycarve

@@ -154,6 +154,7 @@ int MemoryMiB(double gib) { return static_cast<int>(std::ceil(gib * 1024.0 / 256
 }  // namespace
 
 const TilePlan::Tile* TilePlan::TileOfJob(int job) const {
+  if (job < 0) return nullptr;
   for (const Tile& tile : tiles) {
     if (tile.job == job) return &tile;
   }
@@ -198,6 +199,7 @@ std::string TilePlanJson(const TilePlan& plan) {
     t["lo"] = Vector(tile.region.lo);
     t["hi"] = Vector(tile.region.hi);
     t["coarse_solid_voxels"] = tile.coarse_solid;
+    t["views"] = tile.views;
     t["memory_gib"] = tile.memory_gib;
     t["minutes"] = tile.minutes;
     t["part"] = tile.job >= 0 ? TilePartPath("", tile.job) : "";
@@ -259,6 +261,7 @@ TilePlan ReadTilePlan(const std::string& path) {
     tile.region.lo = ReadVector(t, "lo", path, 0, kMaxDimension);
     tile.region.hi = ReadVector(t, "hi", path, 0, kMaxDimension);
     tile.coarse_solid = ReadNumber<int64_t>(t, "coarse_solid_voxels", path);
+    tile.views = ReadNumber<int>(t, "views", path);
     tile.memory_gib = ReadNumber<double>(t, "memory_gib", path);
     tile.minutes = ReadNumber<double>(t, "minutes", path);
     const TileRegion& r = tile.region;

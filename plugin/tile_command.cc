@@ -140,6 +140,27 @@ int64_t CoarseSolidIn(const Volume& volume, const TileRegion& tile) {
   return count;
 }
 
+// Views whose frame the box reaches: the bounding box of its corners' projections overlaps the
+// photo (every corner in front of the camera; a box reaching behind it counts as seen).
+int ViewsSeeing(const std::vector<CalibratedView>& views, const Eigen::AlignedBox3d& box) {
+  int count = 0;
+  for (const CalibratedView& view : views) {
+    Eigen::AlignedBox2d frame;
+    bool behind = false;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c));
+      if (!(view.Depth(corner) > 0.0)) {
+        behind = true;
+        break;
+      }
+      frame.extend(view.Project(corner));
+    }
+    count += behind || (frame.max().x() >= 0.0 && frame.max().y() >= 0.0 &&
+                        frame.min().x() < view.width && frame.min().y() < view.height);
+  }
+  return count;
+}
+
 int64_t PixelsOf(const std::vector<CalibratedView>& views) {
   int64_t pixels = 0;
   for (const CalibratedView& view : views) pixels += static_cast<int64_t>(view.width) * view.height;
@@ -241,6 +262,8 @@ int RunTilePlan(int argc, char** argv) {
     TilePlan::Tile tile;
     tile.region = region;
     tile.coarse_solid = CoarseSolidIn(band, region);
+    tile.views = ViewsSeeing(pipeline.carved_views(),
+                             VoxelGrid(box, options.resolution).Region(region.lo, region.hi).Box());
     if (tile.coarse_solid > 0) tile.job = plan.jobs++;
     const Eigen::Vector3i n = region.hi - region.lo;
     const double voxels = static_cast<double>(n.x()) * n.y() * n.z();
@@ -288,7 +311,9 @@ int RunTileRun(int argc, char** argv) {
                       "tile_<index>.bin, beside the plan. Jobs are independent: run them in any "
                       "order, anywhere the plan's paths are, and again after a failure.");
   parser.AddRequired("plan", &plan_path, "the plan.json that raycarve tile plan wrote");
-  parser.AddDefault("index", &job, "the job's index, 0 .. jobs - 1 (Slurm: $SLURM_ARRAY_TASK_ID)");
+  parser.AddDefault("index", &job,
+                    "the job's index, 0 .. jobs - 1 (Slurm: $SLURM_ARRAY_TASK_ID; Kubernetes: "
+                    "$JOB_COMPLETION_INDEX); required");
   if (!parser.Parse(argc, argv, 3)) return 0;
   const TilePlan plan = ReadTilePlan(plan_path);
   const std::string folder = PlanFolder(plan_path);

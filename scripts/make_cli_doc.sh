@@ -20,6 +20,10 @@ generate() {
     echo
     "$raycarve" "$command" --help_markdown
   done
+  for step in plan run merge; do
+    echo
+    "$raycarve" tile "$step" --help_markdown
+  done
 }
 if [ $check -eq 1 ]; then
   if ! diff <(generate) "$output"; then

@@ -97,6 +97,32 @@ std::vector<TileRegion> SplitIntoTiles(const Eigen::Vector3i& dimensions,
   return result;
 }
 
+bool BoxInView(const CalibratedView& view, const Eigen::AlignedBox3d& box) {
+  Eigen::Vector3d corners[8];
+  for (int c = 0; c < 8; ++c) {
+    corners[c] = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)) - view.centre;
+  }
+  const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
+  const Eigen::Vector3d axis = world_from_pixel * Eigen::Vector3d(0.5 * view.width, 0.5 * view.height, 1.0);
+  const Eigen::Vector3d rays[4] = {world_from_pixel * Eigen::Vector3d(0, 0, 1),
+                                   world_from_pixel * Eigen::Vector3d(view.width, 0, 1),
+                                   world_from_pixel * Eigen::Vector3d(view.width, view.height, 1),
+                                   world_from_pixel * Eigen::Vector3d(0, view.height, 1)};
+  // Inward normals: the four sides, then the camera's plane (the optical axis).
+  Eigen::Vector3d normals[5];
+  for (int i = 0; i < 4; ++i) {
+    normals[i] = rays[i].cross(rays[(i + 1) % 4]);
+    if (normals[i].dot(axis) < 0.0) normals[i] = -normals[i];
+  }
+  normals[4] = view.cam_from_world.rotation.conjugate() * Eigen::Vector3d::UnitZ();
+  for (const Eigen::Vector3d& normal : normals) {
+    bool any_inside = false;
+    for (const Eigen::Vector3d& corner : corners) any_inside = any_inside || normal.dot(corner) >= 0.0;
+    if (!any_inside) return false;
+  }
+  return true;
+}
+
 CoarseCarve CarveCoarseLevels(const std::vector<CalibratedView>& views,
                               const Eigen::AlignedBox3d& box,
                               const CarveOptions& options,

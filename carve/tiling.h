@@ -62,6 +62,11 @@ std::vector<TileRegion> SplitIntoTiles(const Eigen::Vector3i& dimensions,
                                        const Eigen::Vector3i& tiles,
                                        int overlap);
 
+// Whether any part of `box` may be in view: no side of the view's frustum (the four planes
+// through the camera centre and the photo's edges, and the camera's own plane) has every corner of
+// the box outside it. Conservative: a box near a frustum's edge may pass without being seen.
+bool BoxInView(const CalibratedView& view, const Eigen::AlignedBox3d& box);
+
 // Step 1's result.
 struct CoarseCarve {
   explicit CoarseCarve(const VoxelGrid& grid) : volume(grid) {}

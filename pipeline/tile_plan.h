@@ -43,7 +43,7 @@ struct TilePlan {
     TileRegion region;
     int job = -1;  // its job's index (0 .. jobs - 1), or -1 when the coarse volume is empty there
     int64_t coarse_solid = 0;  // coarse voxels of its region that are solid
-    // Photos whose frame the region's box reaches (in front of the camera): those its job needs.
+    // Photos whose view the region's box reaches (BoxInView): those its job needs.
     int views = 0;
     double memory_gib = 0.0;   // what its job should ask for
     double minutes = 0.0;

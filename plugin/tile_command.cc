@@ -140,27 +140,6 @@ int64_t CoarseSolidIn(const Volume& volume, const TileRegion& tile) {
   return count;
 }
 
-// Views whose frame the box reaches: the bounding box of its corners' projections overlaps the
-// photo (every corner in front of the camera; a box reaching behind it counts as seen).
-int ViewsSeeing(const std::vector<CalibratedView>& views, const Eigen::AlignedBox3d& box) {
-  int count = 0;
-  for (const CalibratedView& view : views) {
-    Eigen::AlignedBox2d frame;
-    bool behind = false;
-    for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3d corner = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c));
-      if (!(view.Depth(corner) > 0.0)) {
-        behind = true;
-        break;
-      }
-      frame.extend(view.Project(corner));
-    }
-    count += behind || (frame.max().x() >= 0.0 && frame.max().y() >= 0.0 &&
-                        frame.min().x() < view.width && frame.min().y() < view.height);
-  }
-  return count;
-}
-
 int64_t PixelsOf(const std::vector<CalibratedView>& views) {
   int64_t pixels = 0;
   for (const CalibratedView& view : views) pixels += static_cast<int64_t>(view.width) * view.height;
@@ -172,6 +151,15 @@ double StageSeconds(const CarveRun& run, const std::string& stage) {
     if (name == stage) return seconds;
   }
   return 0.0;
+}
+
+// The pipeline's scope for a step, with its progress on `display`.
+PipelineScope ScopeOf(const std::string& command, ProgressDisplay* display) {
+  PipelineScope scope;
+  scope.command = command;
+  scope.progress = [display](const CarveProgress& p) { display->Update(p); };
+  scope.progress_end = [display] { display->Finish(); };
+  return scope;
 }
 
 std::string PlanFolder(const std::string& plan_path) {
@@ -207,10 +195,7 @@ int RunTilePlan(int argc, char** argv) {
   const Eigen::Vector3i tiles = ParseTiles(tiles_text);
 
   ProgressDisplay display;
-  PipelineScope scope;
-  scope.command = "tile plan";
-  scope.progress = [&display](const CarveProgress& p) { display.Update(p); };
-  scope.progress_end = [&display] { display.Finish(); };
+  const PipelineScope scope = ScopeOf("tile plan", &display);
   CarvePipeline pipeline(request, scope);
   pipeline.LoadViews();
   pipeline.AgreeMasks();
@@ -262,8 +247,11 @@ int RunTilePlan(int argc, char** argv) {
     TilePlan::Tile tile;
     tile.region = region;
     tile.coarse_solid = CoarseSolidIn(band, region);
-    tile.views = ViewsSeeing(pipeline.carved_views(),
-                             VoxelGrid(box, options.resolution).Region(region.lo, region.hi).Box());
+    const Eigen::AlignedBox3d region_box =
+        VoxelGrid(box, options.resolution).Region(region.lo, region.hi).Box();
+    for (const CalibratedView& view : pipeline.carved_views()) {
+      tile.views += BoxInView(view, region_box);
+    }
     if (tile.coarse_solid > 0) tile.job = plan.jobs++;
     const Eigen::Vector3i n = region.hi - region.lo;
     const double voxels = static_cast<double>(n.x()) * n.y() * n.z();
@@ -324,10 +312,7 @@ int RunTileRun(int argc, char** argv) {
   }
   EnterWorkingDirectory(plan, plan_path);
   ProgressDisplay display;
-  PipelineScope scope;
-  scope.command = "tile run";
-  scope.progress = [&display](const CarveProgress& p) { display.Update(p); };
-  scope.progress_end = [&display] { display.Finish(); };
+  const PipelineScope scope = ScopeOf("tile run", &display);
   CarvePipeline pipeline(RequestOfPlan(plan, "tile run"), scope);
   pipeline.LoadViews();
   pipeline.AgreeMasks();
@@ -388,10 +373,7 @@ int RunTileMerge(int argc, char** argv) {
   }
   EnterWorkingDirectory(plan, plan_path);
   ProgressDisplay display;
-  PipelineScope scope;
-  scope.command = "tile merge";
-  scope.progress = [&display](const CarveProgress& p) { display.Update(p); };
-  scope.progress_end = [&display] { display.Finish(); };
+  const PipelineScope scope = ScopeOf("tile merge", &display);
   const CarveRequest request = RequestOfPlan(plan, "tile merge");
   CarvePipeline pipeline(request, scope);
   const CarveRun& run = pipeline.RunFromTiles(

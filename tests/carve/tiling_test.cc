@@ -1,5 +1,6 @@
 #include "carve/tiling.h"
 
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -142,6 +143,45 @@ TEST(TileViews, APixelWhoseRayMeetsTheOutsideFirstIsNoLongerValid) {
   }
   EXPECT_GT(expected, 0);
   EXPECT_LT(expected, checked);
+}
+
+TEST(BoxInView, IsTrueForEveryBoxAPointOfWhichProjectsIntoThePhoto) {
+  const SyntheticScene scene = Scene(4, 120, 90);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  const Eigen::Vector3d centre = scene.object_box.center();
+  const double size = scene.object_box.sizes().maxCoeff();
+  int seen = 0, unseen = 0;
+  for (int b = 0; b < 400; ++b) {
+    // Boxes of assorted sizes around the scene, some behind or beside the cameras.
+    const Eigen::Vector3d at = centre + 3.0 * size * Eigen::Vector3d(std::sin(b * 1.3), std::cos(b * 0.7),
+                                                                       0.5 * std::sin(b * 2.1));
+    const Eigen::AlignedBox3d box(at, at + Eigen::Vector3d::Constant(0.05 * size * (1 + b % 5)));
+    for (const CalibratedView& view : views) {
+      bool projects = false;
+      for (int i = 0; i <= 8 && !projects; ++i) {
+        for (int j = 0; j <= 8 && !projects; ++j) {
+          for (int k = 0; k <= 8 && !projects; ++k) {
+            const Eigen::Vector3d p = box.min() + box.sizes().cwiseProduct(Eigen::Vector3d(i, j, k) / 8.0);
+            const Eigen::Vector2d pixel = view.Project(p);
+            projects = view.Depth(p) > 0.0 && pixel.x() >= 0 && pixel.y() >= 0 &&
+                       pixel.x() <= view.width && pixel.y() <= view.height;
+          }
+        }
+      }
+      const bool in_view = BoxInView(view, box);
+      if (projects) EXPECT_TRUE(in_view) << "box " << b;
+      seen += in_view;
+      unseen += !in_view;
+    }
+  }
+  // Both answers occur: the test is not passed by answering true.
+  EXPECT_GT(seen, 100);
+  EXPECT_GT(unseen, 100);
+  // A box behind a camera is not in its view.
+  const CalibratedView& view = views[0];
+  const Eigen::Vector3d behind = view.centre - 2.0 * (view.cam_from_world.rotation.conjugate() *
+                                                      Eigen::Vector3d::UnitZ());
+  EXPECT_FALSE(BoxInView(view, Eigen::AlignedBox3d(behind, behind + Eigen::Vector3d::Constant(0.1))));
 }
 
 // The three steps against one carve, on a generated scene at 64 voxels in two levels.

@@ -174,9 +174,12 @@ FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
                                      double margin_voxels,
                                      const std::vector<int64_t>& keep,
                                      Volume* volume,
-                                     int num_threads) {
+                                     int num_threads,
+                                     const std::vector<cv::Mat>* known_depth) {
   const VoxelGrid& grid = volume->grid();
-  const std::vector<cv::Mat> known = KnownSurfaceDepths(views, grid, points);
+  std::vector<cv::Mat> made;
+  if (known_depth == nullptr) made = KnownSurfaceDepths(views, grid, points);
+  const std::vector<cv::Mat>& known = known_depth != nullptr ? *known_depth : made;
   const Eigen::AlignedBox3d box = grid.Box();
   const double beyond = box.diagonal().norm();
   const auto draw = [&](size_t index, std::vector<int64_t>* voxels) {

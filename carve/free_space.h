@@ -38,14 +38,16 @@ FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
 // pixel) lies on the ray, the ray stops `margin_voxels` voxel widths in front of it: a window
 // that mirrors the sky shows it at infinity, and the wall's points around it say where the window
 // is. A voxel holding a surface point, and the voxels in `keep` (the held ground), are never
-// carved. `rays`' views index `views`. Same threads and order as CarveFreeSpace.
+// carved. `rays`' views index `views`. Same threads and order as CarveFreeSpace. `known_depth`:
+// KnownSurfaceDepths of the views, grid and points when already made (null: made here).
 FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
                                      const std::vector<DistantRay>& rays,
                                      const std::vector<SurfacePoint>& points,
                                      double margin_voxels,
                                      const std::vector<int64_t>& keep,
                                      Volume* volume,
-                                     int num_threads = 1);
+                                     int num_threads = 1,
+                                     const std::vector<cv::Mat>* known_depth = nullptr);
 
 // The voxels of `grid` that the segment from `from` to `to` passes through, in order (a voxel
 // whose closed cube the segment only touches at an edge or corner may or may not be listed),

@@ -68,7 +68,8 @@ Volume PreCarved(const std::vector<CalibratedView>& views,
                  FreeSpaceStatistics* free_space,
                  FreeSpaceStatistics* distant,
                  std::vector<int64_t>* ground_held,
-                 int64_t* beyond_ground) {
+                 int64_t* beyond_ground,
+                 std::vector<cv::Mat>* known_depth) {
   if (options.visual_hull) *hull = CarveVisualHull(views, &volume, options.num_threads);
   BelowGround below = SplitBelowGround(volume.grid(), options.ground);
   std::vector<int64_t> exposed;
@@ -83,11 +84,14 @@ Volume PreCarved(const std::vector<CalibratedView>& views,
     *free_space = CarveFreeSpace(views, options.surface_points, options.free_space_margin_voxels,
                                  &volume, options.num_threads);
   }
+  if (options.protect_surface_points || !options.distant_rays.empty()) {
+    *known_depth = KnownSurfaceDepths(views, volume.grid(), options.surface_points);
+  }
   if (!options.distant_rays.empty()) {
     const double margin = options.free_space_margin_voxels > 0.0 ? options.free_space_margin_voxels
                                                                  : kKnownSurfaceMarginVoxels;
     *distant = CarveDistantRays(views, options.distant_rays, options.surface_points, margin,
-                                *ground_held, &volume, options.num_threads);
+                                *ground_held, &volume, options.num_threads, known_depth);
   }
   return volume;
 }
@@ -122,7 +126,7 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
                                      const VisibilityFactory& factory)
     : views_(views),
       volume_(PreCarved(views, std::move(start), options, &visual_hull_, &free_space_,
-                        &distant_, &ground_held_, &beyond_ground_carved_)),
+                        &distant_, &ground_held_, &beyond_ground_carved_, &known_depth_)),
       workers_(static_cast<int>(views.size()),
                options.method == CarveMethod::kRay ? options.num_threads : 1),
       visibility_(factory ? factory(views, volume_)
@@ -145,6 +149,8 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
     usable_pixels_ += usable.empty() ? static_cast<int64_t>(view.width) * view.height
                                      : cv::countNonZero(usable);
   }
+  // Made for the distant rays alone: the known surface protects only when asked.
+  if (!options.protect_surface_points) std::vector<cv::Mat>().swap(known_depth_);
   if (options.protect_surface_points || !options.ground.empty()) {
     protected_.assign((volume_.grid().num_voxels() + 63) / 64, 0);
   }
@@ -152,7 +158,6 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
     for (int64_t voxel : SurfacePointVoxels(volume_.grid(), options.surface_points)) {
       protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
     }
-    known_depth_ = KnownSurfaceDepths(views, volume_.grid(), options.surface_points);
   }
   for (int64_t voxel : ground_held_) protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
   ground_voxels_ = static_cast<int64_t>(ground_held_.size());

@@ -167,6 +167,9 @@ class IncrementalCarver {
   FreeSpaceStatistics distant_;       // likewise
   int64_t beyond_ground_carved_ = 0;  // likewise
   std::vector<int64_t> ground_held_;   // likewise: the voxels under the ground, until protected
+  // Per view, KnownSurfaceDepths: with protection, or for the distant rays (made with the volume,
+  // which is declared after it, by PreCarved); empty otherwise.
+  std::vector<cv::Mat> known_depth_;
   Volume volume_;
   ViewWorkers workers_;  // declared before visibility_, which uses it to set up rays
   std::unique_ptr<Visibility> visibility_;
@@ -323,7 +326,6 @@ class IncrementalCarver {
   std::priority_queue<std::pair<int64_t, int64_t>> heap_;  // (|Vis|, voxel), most first
   std::vector<uint64_t> queued_;
   std::vector<uint64_t> protected_;  // a bit per voxel; empty without protection
-  std::vector<cv::Mat> known_depth_;  // per view, KnownSurfaceDepths; empty without protection
   int64_t protected_kept_ = 0;
   int64_t ground_voxels_ = 0;
   size_t max_queue_ = 0;

@@ -25,12 +25,25 @@ std::vector<cv::Mat> KnownSurfaceDepths(const std::vector<CalibratedView>& views
     const CalibratedView& view = views[v];
     if (seen[v].empty()) continue;
     // The spacing of the known surface in this view: the median distance from an observation to
-    // its nearest neighbour (brute force; a few thousand points a view at most).
+    // its nearest neighbour (exact; observations sorted by x, each searched outwards until the x
+    // gap alone exceeds the nearest found).
     nearest.clear();
-    for (size_t i = 0; i < seen[v].size(); ++i) {
+    std::vector<Eigen::Vector2d> sorted;
+    sorted.reserve(seen[v].size());
+    for (const Eigen::Vector3d& at : seen[v]) sorted.push_back(at.head<2>());
+    std::sort(sorted.begin(), sorted.end(),
+              [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() < b.x(); });
+    for (size_t i = 0; i < sorted.size(); ++i) {
       double best = std::numeric_limits<double>::infinity();
-      for (size_t j = 0; j < seen[v].size(); ++j) {
-        if (i != j) best = std::min(best, (seen[v][i].head<2>() - seen[v][j].head<2>()).squaredNorm());
+      for (size_t j = i + 1; j < sorted.size(); ++j) {
+        const double dx = sorted[j].x() - sorted[i].x();
+        if (dx * dx >= best) break;
+        best = std::min(best, (sorted[j] - sorted[i]).squaredNorm());
+      }
+      for (size_t j = i; j-- > 0;) {
+        const double dx = sorted[i].x() - sorted[j].x();
+        if (dx * dx >= best) break;
+        best = std::min(best, (sorted[j] - sorted[i]).squaredNorm());
       }
       if (std::isfinite(best)) nearest.push_back(std::sqrt(best));
     }
@@ -46,14 +59,18 @@ std::vector<cv::Mat> KnownSurfaceDepths(const std::vector<CalibratedView>& views
       const double radius = std::max(kKnownSurfaceRadiusVoxels * focal * grid.voxel_size() / at.z(),
                                      kKnownSurfaceRadiusSpacings * spacing);
       const int r = static_cast<int>(std::ceil(radius));
-      const int c0 = static_cast<int>(std::floor(x)), r0 = static_cast<int>(std::floor(y));
+      const int r0 = static_cast<int>(std::floor(y));
+      const float depth = static_cast<float>(at.z());
       for (int row = std::max(0, r0 - r); row <= std::min(view.height - 1, r0 + r); ++row) {
+        // The row's pixels whose centres lie within the radius: |col + 0.5 - x| <= half.
+        const double dy = row + 0.5 - y;
+        const double half_squared = radius * radius - dy * dy;
+        if (half_squared < 0.0) continue;
+        const double half = std::sqrt(half_squared);
+        const int first = std::max(0, static_cast<int>(std::ceil(x - half - 0.5)));
+        const int last = std::min(view.width - 1, static_cast<int>(std::floor(x + half - 0.5)));
         float* line = depths[v].ptr<float>(row);
-        for (int col = std::max(0, c0 - r); col <= std::min(view.width - 1, c0 + r); ++col) {
-          const double dx = col + 0.5 - x, dy = row + 0.5 - y;
-          if (dx * dx + dy * dy > radius * radius) continue;
-          line[col] = std::max(line[col], static_cast<float>(at.z()));
-        }
+        for (int col = first; col <= last; ++col) line[col] = std::max(line[col], depth);
       }
     }
   }

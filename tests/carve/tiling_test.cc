@@ -44,8 +44,12 @@ TEST(SplitIntoTiles, CoresPartitionTheGridAndRegionsGrowThemByTheOverlap) {
   for (const TileRegion& tile : tiles) {
     for (int axis = 0; axis < 3; ++axis) {
       // Cuts are even except at the grid's end; the region is the core and 4 more, in the grid.
-      if (tile.core_lo[axis] > 0) EXPECT_EQ(tile.core_lo[axis] % 2, 0);
-      if (tile.core_hi[axis] < n[axis]) EXPECT_EQ(tile.core_hi[axis] % 2, 0);
+      if (tile.core_lo[axis] > 0) {
+        EXPECT_EQ(tile.core_lo[axis] % 2, 0);
+      }
+      if (tile.core_hi[axis] < n[axis]) {
+        EXPECT_EQ(tile.core_hi[axis] % 2, 0);
+      }
       EXPECT_EQ(tile.lo[axis], std::max(0, tile.core_lo[axis] - 4));
       EXPECT_EQ(tile.hi[axis], std::min(n[axis], tile.core_hi[axis] + 4));
     }
@@ -169,7 +173,9 @@ TEST(BoxInView, IsTrueForEveryBoxAPointOfWhichProjectsIntoThePhoto) {
         }
       }
       const bool in_view = BoxInView(view, box);
-      if (projects) EXPECT_TRUE(in_view) << "box " << b;
+      if (projects) {
+        EXPECT_TRUE(in_view) << "box " << b;
+      }
       seen += in_view;
       unseen += !in_view;
     }

@@ -414,15 +414,13 @@ CarveOptions CarvePipeline::FilledOptions(CarveOptions options) const {
 }
 
 const CarveRun& CarvePipeline::RunFromTiles(const std::function<Volume(const VoxelGrid&)>& join,
-                                            double final_threshold,
-                                            double final_pattern_threshold) {
+                                            const TiledCarveInfo& tiled) {
   LockOutputs();
   LoadViews();
   AgreeMasks();
   CheckVolume();
   PlanOutputs();
-  CarveFromTiles(join(VoxelGrid(project_.bounds.box, request_.options.resolution)),
-                 final_threshold, final_pattern_threshold);
+  CarveFromTiles(join(VoxelGrid(project_.bounds.box, request_.options.resolution)), tiled);
   MakeSurface();
   SampleCloud();
   MeasureCloud();
@@ -448,13 +446,14 @@ TileCarve CarvePipeline::CarveTileOf(const CoarseCarve& coarse, const TileRegion
   return carved;
 }
 
-void CarvePipeline::CarveFromTiles(Volume joined, double final_threshold,
-                                   double final_pattern_threshold) {
+void CarvePipeline::CarveFromTiles(Volume joined, const TiledCarveInfo& tiled) {
   CHECK(loaded_);
+  run_.tiled = tiled;
   LOG(INFO) << "carving on from the tiles' joined volume with the whole volume's visibility ...";
   run_.result = std::make_unique<CarveResult>(FinishTiledCarve(
       carved_, project_.bounds.box, FilledOptions(request_.options), std::move(joined),
-      final_threshold, final_pattern_threshold, scope_.progress, request_.progress_seconds));
+      tiled.final_threshold, tiled.final_pattern_threshold, scope_.progress,
+      request_.progress_seconds));
   RecordCarve();
 }
 

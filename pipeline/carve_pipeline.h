@@ -37,6 +37,17 @@ struct PipelineScope {
   std::function<void()> progress_end;  // after the carve stage (optional: ends a progress bar)
 };
 
+// A carve joined from tiles (`raycarve tile merge`): the plan it came from, and the final
+// threshold its tiles judged with.
+struct TiledCarveInfo {
+  std::string plan_id;
+  int jobs = 0;  // 0: not a tiled carve
+  Eigen::Vector3i tiles_per_axis = Eigen::Vector3i::Ones();
+  int overlap = 0;
+  double final_threshold = 0.0;
+  double final_pattern_threshold = 0.0;
+};
+
 // What the stages produced, for the report and the summary. Filled stage by stage.
 struct CarveRun {
   // Load views (and masks).
@@ -73,6 +84,7 @@ struct CarveRun {
   MaskAgreementStatistics mask_agreement;
   // Carve.
   std::unique_ptr<CarveResult> result;
+  TiledCarveInfo tiled;  // jobs > 0: joined from tiles
   // Surface and colour.
   size_t num_mesh_triangles = 0;
   size_t num_mesh_vertices = 0;
@@ -140,13 +152,13 @@ class CarvePipeline {
   // makes them, for the grid of the project as loaded (it throws InputError where they do not
   // fit it).
   const CarveRun& RunFromTiles(const std::function<Volume(const VoxelGrid&)>& join,
-                               double final_threshold, double final_pattern_threshold);
+                               const TiledCarveInfo& tiled);
 
   // A carve split into tiles (carve/tiling.h; `raycarve tile`), after CheckVolume: the coarse
   // levels, one tile, and the carve stage from the tiles' joined cores (in place of Carve).
   CoarseCarve CarveCoarse() const;
   TileCarve CarveTileOf(const CoarseCarve& coarse, const TileRegion& tile) const;
-  void CarveFromTiles(Volume joined, double final_threshold, double final_pattern_threshold);
+  void CarveFromTiles(Volume joined, const TiledCarveInfo& tiled);
 
   // A carve of the carved views with other options (their surface points filled in), without
   // touching run(): benchmark's methods. Throws InputError when the carve does not fit.

@@ -304,6 +304,16 @@ void WriteOutputs(const CarveRequest& request, const CarveRun& run, JsonWriter& 
         .Key("reliable_ones_kept_by_known_surface").Value(request.options.protect_surface_points)
         .EndObject();
   }
+  if (run.tiled.jobs > 0) {
+    const Eigen::Vector3i& t = run.tiled.tiles_per_axis;
+    json.Key("tiles").BeginObject()
+        .Key("plan_id").Value(run.tiled.plan_id)
+        .Key("jobs").Value(run.tiled.jobs)
+        .Key("tiles_per_axis").Value(std::vector<double>{double(t.x()), double(t.y()), double(t.z())})
+        .Key("overlap_voxels").Value(run.tiled.overlap)
+        .Key("merge_evaluated").Value(run.result->statistics.evaluated)
+        .EndObject();
+  }
   json.Key("stage_seconds").BeginObject();
   for (const auto& [name, seconds] : run.stage_seconds) json.Key(name).Value(seconds);
   json.EndObject();

@@ -180,6 +180,16 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
                       " object pixels of the masks had lost the model to carving; " +
                       std::to_string(s.silhouette_repair.restored_voxels) + " voxels restored\n";
   }
+  if (run.tiled.jobs > 0) {
+    char tiles[240];
+    std::snprintf(tiles, sizeof(tiles),
+                  "  tiles           joined from %d jobs of plan %s (%dx%dx%d tiles, overlap %d "
+                  "voxels), carved on with the whole volume's visibility: %lld evaluations\n",
+                  run.tiled.jobs, run.tiled.plan_id.c_str(), run.tiled.tiles_per_axis.x(),
+                  run.tiled.tiles_per_axis.y(), run.tiled.tiles_per_axis.z(), run.tiled.overlap,
+                  static_cast<long long>(s.evaluated));
+    silhouette_line = tiles + silhouette_line;
+  }
   size_t judged_voxels = 0;
   for (const ColouredVoxel& voxel : run.result->surface) {
     judged_voxels += voxel.num_views >= request.options.min_views;

@@ -375,6 +375,13 @@ int RunTileMerge(int argc, char** argv) {
   ProgressDisplay display;
   const PipelineScope scope = ScopeOf("tile merge", &display);
   const CarveRequest request = RequestOfPlan(plan, "tile merge");
+  TiledCarveInfo tiled;
+  tiled.plan_id = plan.plan_id;
+  tiled.jobs = plan.jobs;
+  tiled.tiles_per_axis = plan.tiles_per_axis;
+  tiled.overlap = plan.overlap;
+  tiled.final_threshold = plan.final_threshold;
+  tiled.final_pattern_threshold = plan.final_pattern_threshold;
   CarvePipeline pipeline(request, scope);
   const CarveRun& run = pipeline.RunFromTiles(
       [&](const VoxelGrid& grid) {
@@ -384,7 +391,7 @@ int RunTileMerge(int argc, char** argv) {
         }
         return JoinTileCores(grid, regions, cores);
       },
-      plan.final_threshold, plan.final_pattern_threshold);
+      tiled);
   std::fputs(CarveSummaryText(request, run).c_str(), stdout);
   return 0;
 }

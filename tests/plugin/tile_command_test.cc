@@ -66,6 +66,10 @@ TEST_F(TileCommand, JobsInSeparateProcessesMergeToWhatOneCarveGives) {
   for (const char* name : {"cloud.ply", "mesh.ply", "mesh.glb", "report.json", "fused.ply"}) {
     EXPECT_TRUE(fs::is_regular_file(tiled + "/" + name)) << name;
   }
+  const std::string tiled_report = ReadFileBytes(tiled + "/report.json");
+  EXPECT_EQ(JsonNumber(tiled_report, "jobs"), jobs);
+  EXPECT_GT(JsonNumber(tiled_report, "merge_evaluated"), 0);
+  EXPECT_NE(output.find("joined from " + std::to_string(jobs) + " jobs"), std::string::npos) << output;
   // Against the truth as good as the single carve, and the two models within a voxel.
   const std::string report = ReadFileBytes(single + "/report.json");
   const double voxel = JsonNumber(report, "voxel_size");

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
+#include <type_traits>
 #include <sstream>
 
 #include <glog/logging.h>
@@ -127,6 +129,15 @@ template <typename T>
 T ReadNumber(const json& object, const char* key, const std::string& path) {
   const json& value = Field(object, key, path);
   if (!value.is_number()) throw InputError(path + ": field " + key + " must be a number");
+  if constexpr (std::is_integral_v<T>) {
+    const double number = value.get<double>();
+    if (!value.is_number_integer() || number < static_cast<double>(std::numeric_limits<T>::min()) ||
+        number > static_cast<double>(std::numeric_limits<T>::max())) {
+      throw InputError(path + ": field " + key + " must be an integer in range");
+    }
+  } else if (!std::isfinite(value.get<double>())) {
+    throw InputError(path + ": field " + key + " must be finite");
+  }
   return value.get<T>();
 }
 

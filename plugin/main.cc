@@ -147,9 +147,13 @@ int main(int original_argc, char** original_argv) {
     std::cout << raycarve::VersionLine() << "\n";
     return 0;
   }
-  const std::string name = argv[1];
+  const std::string command_name = argv[1];
   for (const Command& command : kCommands) {
-    if (name != command.name) continue;
+    if (command_name != command.name) continue;
+    // Messages name a command with steps by its step too ("raycarve tile plan: ...").
+    const std::string name = command_name == "tile" && argc > 2 && argv[2][0] != '-'
+                                 ? command_name + " " + argv[2]
+                                 : command_name;
     try {
       return command.run(argc, argv);
     } catch (const raycarve::InputError& error) {
@@ -172,7 +176,7 @@ int main(int original_argc, char** original_argv) {
       return 2;
     }
   }
-  std::cerr << "raycarve: unknown command '" << name << "' (raycarve help lists them)"
+  std::cerr << "raycarve: unknown command '" << command_name << "' (raycarve help lists them)"
             << std::endl;
   return 1;
 }

@@ -413,7 +413,7 @@ int RunTile(int argc, char** argv) {
     std::cout << usage;
     return 0;
   }
-  throw InputError("raycarve tile: unknown step '" + step + "' (plan, run or merge)");
+  throw InputError("unknown step '" + step + "' (plan, run or merge)");
 }
 
 }  // namespace raycarve

@@ -195,5 +195,16 @@ mkdir -p "$work/one"; echo "1 PINHOLE 640 480 500 500 320 240" > "$work/one/came
 printf '1 1 0 0 0 0 0 5 1 view001.png\n\n' > "$work/one/images.txt"; : > "$work/one/points3D.txt"
 want="unused"; run_case "model_info of a one-image model" ok "$work/one" -- "$rc" model_info --input_path "$work/one"
 
+# A carve in tiles.
+want="lies in the input"; run_case "tile plan into the photo folder" error "$work/base" -- \
+  "$rc" tile plan --workspace_path "$work/base" --resolution 128 --min_voxel_pixels 0 --tile_path "$work/base/images/tiles"
+echo '[1, 2' > "$work/not_a_plan.json"
+want="not_a_plan.json"; run_case "tile run of a plan that is not JSON" error "$work/base" -- \
+  "$rc" tile run --plan "$work/not_a_plan.json" --index 0
+fresh tp
+"$rc" tile plan --workspace_path "$work/tp" --resolution 128 --min_voxel_pixels 0 --tile_path "$work/tp_tiles" > /dev/null 2>&1
+want="tile_0.bin"; run_case "tile merge before any tile ran" error "$work/tp" -- \
+  "$rc" tile merge --plan "$work/tp_tiles/plan.json"
+
 echo
 echo "clear ${count[clear]:-0}, unclear ${count[unclear]:-0}, wrong ${count[wrong]:-0}, lost ${count[LOST]:-0}"

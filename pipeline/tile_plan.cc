@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "calib/input_error.h"
+#include "carve/level_of_detail.h"
 #include "pipeline/output_files.h"
 
 namespace raycarve {
@@ -162,7 +163,81 @@ std::string SlurmTime(double minutes) {
 
 int MemoryMiB(double gib) { return static_cast<int>(std::ceil(gib * 1024.0 / 256.0)) * 256; }
 
+// Solid voxels of `volume` (a coarse grid) in the coarse voxels that hold the final grid's
+// [lo, hi) of `tile`.
+int64_t CoarseSolidIn(const Volume& volume, const TileRegion& tile) {
+  const VoxelGrid& grid = volume.grid();
+  const Eigen::Vector3i lo = tile.lo / 2;
+  const Eigen::Vector3i hi = ((tile.hi.array() + 1) / 2).matrix().cwiseMin(grid.dimensions());
+  int64_t count = 0;
+  for (int z = lo.z(); z < hi.z(); ++z) {
+    for (int y = lo.y(); y < hi.y(); ++y) {
+      for (int x = lo.x(); x < hi.x(); ++x) {
+        count += volume.IsSolid(grid.Index(Eigen::Vector3i(x, y, z)));
+      }
+    }
+  }
+  return count;
+}
+
 }  // namespace
+
+TilePlan MakeTilePlan(const std::vector<CalibratedView>& views,
+                      const Eigen::AlignedBox3d& box,
+                      const CarveOptions& options,
+                      const CoarseCarve& coarse,
+                      const Eigen::Vector3i& tiles,
+                      int overlap,
+                      double load_seconds,
+                      std::vector<std::string> arguments,
+                      std::string working_directory) {
+  const VoxelGrid grid(box, options.resolution);
+  const Volume band = DilateSolid(coarse.volume, options.lod_band);
+  TilePlan plan;
+  plan.working_directory = std::move(working_directory);
+  plan.arguments = std::move(arguments);
+  plan.resolution = options.resolution;
+  plan.dimensions = grid.dimensions();
+  plan.coarse_dimensions = coarse.volume.grid().dimensions();
+  plan.tiles_per_axis = tiles;
+  plan.overlap = overlap;
+  plan.final_threshold = coarse.final_threshold;
+  plan.final_pattern_threshold = coarse.final_pattern_threshold;
+  // Estimates for the jobs' requests, from what the plan's process measured: the photos as loaded
+  // (about 14 bytes a pixel, README), a ray and a valid byte a pixel, a few bytes a voxel; the
+  // time of loading, and of the coarse carve shared out by the tiles' solid coarse voxels (a
+  // finer level costs about 4 times its coarser one), three times over.
+  const double gib = 1024.0 * 1024.0 * 1024.0;
+  double pixels = 0.0;
+  for (const CalibratedView& view : views) pixels += static_cast<double>(view.width) * view.height;
+  const double coarse_seconds = coarse.statistics.carve_seconds + coarse.statistics.setup_seconds;
+  const double total_solid = std::max<double>(1.0, band.num_solid());
+  const double coarse_bytes = 2.0 * coarse.volume.grid().num_voxels();
+  for (const TileRegion& region : SplitIntoTiles(plan.dimensions, tiles, overlap)) {
+    TilePlan::Tile tile;
+    tile.region = region;
+    tile.coarse_solid = CoarseSolidIn(band, region);
+    const Eigen::AlignedBox3d region_box = grid.Region(region.lo, region.hi).Box();
+    for (const CalibratedView& view : views) tile.views += BoxInView(view, region_box);
+    if (tile.coarse_solid > 0) tile.job = plan.jobs++;
+    const Eigen::Vector3i n = region.hi - region.lo;
+    const double voxels = static_cast<double>(n.x()) * n.y() * n.z();
+    tile.memory_gib = 0.5 + (pixels * 19.0 + voxels * 3.0 + coarse_bytes) / gib;
+    tile.minutes = std::max(
+        5.0, 3.0 * (load_seconds + 4.0 * coarse_seconds * tile.coarse_solid / total_solid) / 60.0);
+    plan.tiles.push_back(tile);
+  }
+  plan.merge_memory_gib = 1.0 + (pixels * 18.0 + grid.num_voxels() * 3.0) / gib;
+  plan.merge_minutes = std::max(10.0, 3.0 * (load_seconds + 8.0 * coarse_seconds) / 60.0);
+  std::string identity;
+  for (const std::string& argument : plan.arguments) identity += argument + '\0';
+  identity += std::to_string(plan.resolution) + "," + std::to_string(plan.dimensions.x()) + "," +
+              std::to_string(plan.dimensions.y()) + "," + std::to_string(plan.dimensions.z());
+  const std::vector<uint64_t>& bits = coarse.volume.solid_bits();
+  identity.append(reinterpret_cast<const char*>(bits.data()), bits.size() * sizeof(uint64_t));
+  plan.plan_id = HexDigest(identity);
+  return plan;
+}
 
 const TilePlan::Tile* TilePlan::TileOfJob(int job) const {
   if (job < 0) return nullptr;
@@ -322,17 +397,24 @@ std::string TilePartPath(const std::string& folder, int job) {
   return folder.empty() ? name : (fs::path(folder) / name).string();
 }
 
-void WriteTileJobScripts(const std::string& folder, const TilePlan& plan,
-                         const std::string& raycarve, const std::string& plan_path) {
-  double memory = 0.0, minutes = 0.0;
-  for (const TilePlan::Tile& tile : plan.tiles) {
-    if (tile.job < 0) continue;
-    memory = std::max(memory, tile.memory_gib);
-    minutes = std::max(minutes, tile.minutes);
-  }
-  const std::string logs = (fs::path(folder) / "logs").string();
-  const std::string run = Quoted(raycarve) + " tile run --plan " + Quoted(plan_path);
-  const std::string merge = Quoted(raycarve) + " tile merge --plan " + Quoted(plan_path);
+namespace {
+
+// The jobs' commands: a tile job (its index appended) and the merge.
+struct JobCommands {
+  std::string run;
+  std::string merge;
+  std::string logs;  // the folder of Slurm's logs
+  double memory_gib = 0.0;  // the largest tile's estimate
+  double minutes = 0.0;
+};
+
+void MakeExecutable(const fs::path& path) {
+  fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
+}
+
+// tiles.sbatch (an array over the jobs), merge.sbatch and submit_slurm.sh (the merge after every
+// task of the array succeeded).
+void WriteSlurmJobs(const fs::path& folder, const TilePlan& plan, const JobCommands& jobs) {
   std::ostringstream tiles;
   tiles << "#!/bin/bash\n"
         << "# raycarve tile jobs of plan " << plan.plan_id << ": one array task per tile with work.\n"
@@ -340,82 +422,95 @@ void WriteTileJobScripts(const std::string& folder, const TilePlan& plan,
         << "#SBATCH --job-name=raycarve-tiles\n"
         << "#SBATCH --array=0-" << std::max(0, plan.jobs - 1) << "\n"
         << "#SBATCH --cpus-per-task=2\n"
-        << "#SBATCH --mem=" << MemoryMiB(memory) << "M\n"
-        << "#SBATCH --time=" << SlurmTime(minutes) << "\n"
-        << "#SBATCH --output=" << logs << "/tile_%a.log\n"
+        << "#SBATCH --mem=" << MemoryMiB(jobs.memory_gib) << "M\n"
+        << "#SBATCH --time=" << SlurmTime(jobs.minutes) << "\n"
+        << "#SBATCH --output=" << jobs.logs << "/tile_%a.log\n"
         << "cd " << Quoted(plan.working_directory) << "\n"
-        << "exec " << run << " --index \"$SLURM_ARRAY_TASK_ID\"\n";
-  WriteTextFileAtomically((fs::path(folder) / "tiles.sbatch").string(), tiles.str());
-  std::ostringstream merge_job;
-  merge_job << "#!/bin/bash\n"
-            << "# raycarve: joins the tiles of plan " << plan.plan_id << " and writes the model.\n"
-            << "#SBATCH --job-name=raycarve-merge\n"
-            << "#SBATCH --cpus-per-task=2\n"
-            << "#SBATCH --mem=" << MemoryMiB(plan.merge_memory_gib) << "M\n"
-            << "#SBATCH --time=" << SlurmTime(plan.merge_minutes) << "\n"
-            << "#SBATCH --output=" << logs << "/merge.log\n"
-            << "cd " << Quoted(plan.working_directory) << "\n"
-            << "exec " << merge << "\n";
-  WriteTextFileAtomically((fs::path(folder) / "merge.sbatch").string(), merge_job.str());
+        << "exec " << jobs.run << " --index \"$SLURM_ARRAY_TASK_ID\"\n";
+  WriteTextFileAtomically((folder / "tiles.sbatch").string(), tiles.str());
+  std::ostringstream merge;
+  merge << "#!/bin/bash\n"
+        << "# raycarve: joins the tiles of plan " << plan.plan_id << " and writes the model.\n"
+        << "#SBATCH --job-name=raycarve-merge\n"
+        << "#SBATCH --cpus-per-task=2\n"
+        << "#SBATCH --mem=" << MemoryMiB(plan.merge_memory_gib) << "M\n"
+        << "#SBATCH --time=" << SlurmTime(plan.merge_minutes) << "\n"
+        << "#SBATCH --output=" << jobs.logs << "/merge.log\n"
+        << "cd " << Quoted(plan.working_directory) << "\n"
+        << "exec " << jobs.merge << "\n";
+  WriteTextFileAtomically((folder / "merge.sbatch").string(), merge.str());
   std::ostringstream submit;
   submit << "#!/bin/bash\n"
          << "# Submits the tile array, then the merge once every task has succeeded.\n"
          << "set -euo pipefail\n"
-         << "cd " << Quoted(folder) << "\n"
+         << "cd " << Quoted(folder.string()) << "\n"
          << "mkdir -p logs\n"
          << "array=$(sbatch --parsable tiles.sbatch)\n"
          << "merge=$(sbatch --parsable --dependency=afterok:\"${array%%;*}\" merge.sbatch)\n"
          << "echo \"tiles: job $array, merge: job $merge\"\n";
-  WriteTextFileAtomically((fs::path(folder) / "submit_slurm.sh").string(), submit.str());
-  fs::permissions(fs::path(folder) / "submit_slurm.sh", fs::perms::owner_exec | fs::perms::group_exec,
-                  fs::perm_options::add);
+  WriteTextFileAtomically((folder / "submit_slurm.sh").string(), submit.str());
+  MakeExecutable(folder / "submit_slurm.sh");
+}
 
-  // Kubernetes: an indexed Job (the index in JOB_COMPLETION_INDEX), then the merge as its own Job.
-  // The workspace must be mounted at the same path in the pods (a volume the user names).
-  const auto k8s_job = [&](const std::string& name, bool indexed, double gib, double job_minutes,
-                           const std::string& command) {
-    std::ostringstream y;
-    y << "# raycarve plan " << plan.plan_id << ". The image must hold raycarve at " << raycarve
-      << ",\n# and the workspace must be mounted at " << plan.working_directory
-      << " (edit the volume below).\n"
-      << "apiVersion: batch/v1\nkind: Job\nmetadata:\n  name: " << name << "\nspec:\n";
-    if (indexed) {
-      y << "  completionMode: Indexed\n  completions: " << plan.jobs
-        << "\n  parallelism: " << plan.jobs << "\n";
-    }
-    y << "  backoffLimit: 2\n  activeDeadlineSeconds: "
-      << static_cast<int>(std::ceil(std::max(job_minutes, 1.0) * 60.0) * (indexed ? 2 : 1)) << "\n"
-      << "  template:\n    spec:\n      restartPolicy: Never\n      containers:\n"
-      << "        - name: raycarve\n          image: raycarve:latest\n"
-      << "          workingDir: " << plan.working_directory << "\n"
-      << "          command: [\"/bin/sh\", \"-c\", " << json(command).dump() << "]\n"
-      << "          resources:\n            requests:\n              cpu: \"2\"\n"
-      << "              memory: " << MemoryMiB(gib) << "Mi\n            limits:\n"
-      << "              memory: " << MemoryMiB(gib) << "Mi\n"
-      << "          volumeMounts:\n            - name: workspace\n              mountPath: "
-      << plan.working_directory << "\n      volumes:\n        - name: workspace\n"
-      << "          persistentVolumeClaim:\n            claimName: raycarve-workspace\n";
-    return y.str();
-  };
+// One Kubernetes Job: `indexed`, one completion per tile job (the index in JOB_COMPLETION_INDEX).
+// The workspace must be mounted at the same path in the pods (a volume the user names).
+std::string KubernetesJob(const TilePlan& plan, const std::string& raycarve, const std::string& name,
+                          bool indexed, double gib, double minutes, const std::string& command) {
+  std::ostringstream y;
+  y << "# raycarve plan " << plan.plan_id << ". The image must hold raycarve at " << raycarve
+    << ",\n# and the workspace must be mounted at " << plan.working_directory
+    << " (edit the volume below).\n"
+    << "apiVersion: batch/v1\nkind: Job\nmetadata:\n  name: " << name << "\nspec:\n";
+  if (indexed) {
+    y << "  completionMode: Indexed\n  completions: " << plan.jobs << "\n  parallelism: " << plan.jobs
+      << "\n";
+  }
+  y << "  backoffLimit: 2\n  activeDeadlineSeconds: "
+    << static_cast<int>(std::ceil(std::max(minutes, 1.0) * 60.0) * (indexed ? 2 : 1)) << "\n"
+    << "  template:\n    spec:\n      restartPolicy: Never\n      containers:\n"
+    << "        - name: raycarve\n          image: raycarve:latest\n"
+    << "          workingDir: " << plan.working_directory << "\n"
+    << "          command: [\"/bin/sh\", \"-c\", " << json(command).dump() << "]\n"
+    << "          resources:\n            requests:\n              cpu: \"2\"\n"
+    << "              memory: " << MemoryMiB(gib) << "Mi\n            limits:\n"
+    << "              memory: " << MemoryMiB(gib) << "Mi\n"
+    << "          volumeMounts:\n            - name: workspace\n              mountPath: "
+    << plan.working_directory << "\n      volumes:\n        - name: workspace\n"
+    << "          persistentVolumeClaim:\n            claimName: raycarve-workspace\n";
+  return y.str();
+}
+
+}  // namespace
+
+void WriteTileJobScripts(const std::string& folder, const TilePlan& plan,
+                         const std::string& raycarve, const std::string& plan_path) {
+  JobCommands jobs;
+  for (const TilePlan::Tile& tile : plan.tiles) {
+    if (tile.job < 0) continue;
+    jobs.memory_gib = std::max(jobs.memory_gib, tile.memory_gib);
+    jobs.minutes = std::max(jobs.minutes, tile.minutes);
+  }
+  jobs.logs = (fs::path(folder) / "logs").string();
+  jobs.run = Quoted(raycarve) + " tile run --plan " + Quoted(plan_path);
+  jobs.merge = Quoted(raycarve) + " tile merge --plan " + Quoted(plan_path);
+  WriteSlurmJobs(folder, plan, jobs);
   WriteTextFileAtomically((fs::path(folder) / "tiles.k8s.yaml").string(),
-                          k8s_job("raycarve-tiles", true, memory, minutes,
-                                  run + " --index \"$JOB_COMPLETION_INDEX\""));
-  WriteTextFileAtomically(
-      (fs::path(folder) / "merge.k8s.yaml").string(),
-      "# Apply once the tiles' Job has completed:\n"
-      "#   kubectl wait --for=condition=complete job/raycarve-tiles --timeout=24h\n" +
-          k8s_job("raycarve-merge", false, plan.merge_memory_gib, plan.merge_minutes, merge));
-
+                          KubernetesJob(plan, raycarve, "raycarve-tiles", true, jobs.memory_gib,
+                                        jobs.minutes, jobs.run + " --index \"$JOB_COMPLETION_INDEX\""));
+  WriteTextFileAtomically((fs::path(folder) / "merge.k8s.yaml").string(),
+                          "# Apply once the tiles' Job has completed:\n"
+                          "#   kubectl wait --for=condition=complete job/raycarve-tiles --timeout=24h\n" +
+                              KubernetesJob(plan, raycarve, "raycarve-merge", false,
+                                            plan.merge_memory_gib, plan.merge_minutes, jobs.merge));
   std::ostringstream local;
   local << "#!/bin/bash\n"
         << "# The tile jobs as processes on this machine, JOBS at a time (default 1), then the merge.\n"
         << "set -euo pipefail\n"
         << "cd " << Quoted(plan.working_directory) << "\n"
-        << "seq 0 " << plan.jobs - 1 << " | xargs -P \"${JOBS:-1}\" -I{} " << run << " --index {}\n"
-        << merge << "\n";
+        << "seq 0 " << plan.jobs - 1 << " | xargs -P \"${JOBS:-1}\" -I{} " << jobs.run << " --index {}\n"
+        << jobs.merge << "\n";
   WriteTextFileAtomically((fs::path(folder) / "run_local.sh").string(), local.str());
-  fs::permissions(fs::path(folder) / "run_local.sh", fs::perms::owner_exec | fs::perms::group_exec,
-                  fs::perm_options::add);
+  MakeExecutable(fs::path(folder) / "run_local.sh");
 }
 
 }  // namespace raycarve

@@ -22,6 +22,8 @@
 
 #include <Eigen/Core>
 
+#include "calib/calibrated_view.h"
+#include "carve/carver.h"
 #include "carve/tiling.h"
 #include "carve/volume.h"
 
@@ -55,6 +57,21 @@ struct TilePlan {
 
   const Tile* TileOfJob(int job) const;
 };
+
+// The plan of carving `views` over `box` with `options` in `tiles` (per axis) with `overlap`,
+// from the coarse levels' result: the tiles, which have work (a solid coarse voxel, with the band
+// the final level starts from, in their region), the photos in view of each, the memory and time
+// each job should ask for (from `load_seconds`, the photos' loading, and the coarse levels' own
+// time), and the plan id. `arguments` are the carve's options as given, in `working_directory`.
+TilePlan MakeTilePlan(const std::vector<CalibratedView>& views,
+                      const Eigen::AlignedBox3d& box,
+                      const CarveOptions& options,
+                      const CoarseCarve& coarse,
+                      const Eigen::Vector3i& tiles,
+                      int overlap,
+                      double load_seconds,
+                      std::vector<std::string> arguments,
+                      std::string working_directory);
 
 // Short hex digest (FNV-1a, 64 bits) of bytes, for plan ids.
 std::string HexDigest(const std::string& bytes);

@@ -124,28 +124,6 @@ CoarseCarve ReadCoarse(const CarvePipeline& pipeline, const TilePlan& plan,
   return coarse;
 }
 
-// Solid voxels of `volume` in the coarse voxels that hold the final grid's [lo, hi).
-int64_t CoarseSolidIn(const Volume& volume, const TileRegion& tile) {
-  const VoxelGrid& grid = volume.grid();
-  const Eigen::Vector3i lo = tile.lo / 2;
-  const Eigen::Vector3i hi = ((tile.hi.array() + 1) / 2).matrix().cwiseMin(grid.dimensions());
-  int64_t count = 0;
-  for (int z = lo.z(); z < hi.z(); ++z) {
-    for (int y = lo.y(); y < hi.y(); ++y) {
-      for (int x = lo.x(); x < hi.x(); ++x) {
-        count += volume.IsSolid(grid.Index(Eigen::Vector3i(x, y, z)));
-      }
-    }
-  }
-  return count;
-}
-
-int64_t PixelsOf(const std::vector<CalibratedView>& views) {
-  int64_t pixels = 0;
-  for (const CalibratedView& view : views) pixels += static_cast<int64_t>(view.width) * view.height;
-  return pixels;
-}
-
 double StageSeconds(const CarveRun& run, const std::string& stage) {
   for (const auto& [name, seconds] : run.stage_seconds) {
     if (name == stage) return seconds;
@@ -222,54 +200,9 @@ int RunTilePlan(int argc, char** argv) {
   if (error) throw InputError(tile_path + ": cannot make the plan's folder: " + error.message());
 
   const CoarseCarve coarse = pipeline.CarveCoarse();
-  const Volume band = DilateSolid(coarse.volume, options.lod_band);
-  TilePlan plan;
-  plan.working_directory = fs::current_path().string();
-  plan.arguments = CarveArguments(argc, argv, 3);
-  plan.resolution = options.resolution;
-  plan.dimensions = VoxelGrid(box, options.resolution).dimensions();
-  plan.coarse_dimensions = coarse.volume.grid().dimensions();
-  plan.tiles_per_axis = tiles;
-  plan.overlap = overlap;
-  plan.final_threshold = coarse.final_threshold;
-  plan.final_pattern_threshold = coarse.final_pattern_threshold;
-  // Estimates for the jobs' requests, from what this process measured: the photos as loaded
-  // (about 14 bytes a pixel, README), a ray and a valid byte a pixel, a few bytes a voxel; the
-  // time of loading, and of the coarse carve shared out by the tiles' solid coarse voxels (a
-  // finer level costs about 4 times its coarser one), three times over.
-  const double gib = 1024.0 * 1024.0 * 1024.0;
-  const double pixels = static_cast<double>(PixelsOf(pipeline.carved_views()));
-  const double load = StageSeconds(pipeline.run(), "load_project");
-  const double coarse_seconds = coarse.statistics.carve_seconds + coarse.statistics.setup_seconds;
-  const double total_solid = std::max<double>(1.0, band.num_solid());
-  const double coarse_bytes = 2.0 * coarse.volume.grid().num_voxels();
-  for (const TileRegion& region : SplitIntoTiles(plan.dimensions, tiles, overlap)) {
-    TilePlan::Tile tile;
-    tile.region = region;
-    tile.coarse_solid = CoarseSolidIn(band, region);
-    const Eigen::AlignedBox3d region_box =
-        VoxelGrid(box, options.resolution).Region(region.lo, region.hi).Box();
-    for (const CalibratedView& view : pipeline.carved_views()) {
-      tile.views += BoxInView(view, region_box);
-    }
-    if (tile.coarse_solid > 0) tile.job = plan.jobs++;
-    const Eigen::Vector3i n = region.hi - region.lo;
-    const double voxels = static_cast<double>(n.x()) * n.y() * n.z();
-    tile.memory_gib = 0.5 + (pixels * 19.0 + voxels * 3.0 + coarse_bytes) / gib;
-    tile.minutes = std::max(5.0, 3.0 * (load + 4.0 * coarse_seconds * tile.coarse_solid / total_solid) / 60.0);
-    plan.tiles.push_back(tile);
-  }
-  const double full_voxels = static_cast<double>(VoxelGrid(box, options.resolution).num_voxels());
-  plan.merge_memory_gib = 1.0 + (pixels * 18.0 + full_voxels * 3.0) / gib;
-  plan.merge_minutes = std::max(10.0, 3.0 * (load + 8.0 * coarse_seconds) / 60.0);
-  std::string identity;
-  for (const std::string& argument : plan.arguments) identity += argument + '\0';
-  identity += std::to_string(plan.resolution) + "," + std::to_string(plan.dimensions.x()) + "," +
-              std::to_string(plan.dimensions.y()) + "," + std::to_string(plan.dimensions.z());
-  const std::vector<uint64_t>& bits = coarse.volume.solid_bits();
-  identity.append(reinterpret_cast<const char*>(bits.data()), bits.size() * sizeof(uint64_t));
-  plan.plan_id = HexDigest(identity);
-
+  const TilePlan plan = MakeTilePlan(pipeline.carved_views(), box, options, coarse, tiles, overlap,
+                                     StageSeconds(pipeline.run(), "load_project"),
+                                     CarveArguments(argc, argv, 3), fs::current_path().string());
   const std::string plan_path = (folder / "plan.json").string();
   WriteCoarseVolume((folder / "coarse.bin").string(), plan.plan_id, coarse.volume);
   char self[4096];
@@ -283,7 +216,9 @@ int RunTilePlan(int argc, char** argv) {
               plan.plan_id.c_str(), plan.dimensions.x(), plan.dimensions.y(), plan.dimensions.z(),
               plan.resolution, tiles.x(), tiles.y(), tiles.z(), overlap, plan.jobs,
               static_cast<int>(plan.tiles.size()) - plan.jobs);
-  std::printf("coarse levels: %.1f s; final threshold %.2f\n", coarse_seconds, plan.final_threshold);
+  std::printf("coarse levels: %.1f s; final threshold %.2f\n",
+              coarse.statistics.carve_seconds + coarse.statistics.setup_seconds,
+              plan.final_threshold);
   std::printf("plan: %s\n", plan_path.c_str());
   std::printf("run:  %s/submit_slurm.sh (Slurm), kubectl apply -f %s/tiles.k8s.yaml (Kubernetes),\n"
               "      or %s/run_local.sh (this machine); one job: raycarve tile run --plan %s --index I\n",

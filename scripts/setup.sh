@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake pkg-config libeigen3-dev libopencv-dev libceres-dev libpcl-dev
-          libvtk9-dev libgoogle-glog-dev libgflags-dev libjpeg-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libtinygltf-dev libtinyobjloader-dev nlohmann-json3-dev colmap chromium)
+          libvtk9-dev libgoogle-glog-dev libgflags-dev libjpeg-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libtinygltf-dev libtinyobjloader-dev nlohmann-json3-dev python3-yaml colmap chromium)
 # Node.js and npm for report.html's viewer (three.js) and its browser test (playwright-core):
 # from Debian unless the machine already has them.
 if ! command -v npm > /dev/null 2>&1; then packages+=(nodejs npm); fi

@@ -60,6 +60,23 @@ TEST_F(TileCommand, JobsInSeparateProcessesMergeToWhatOneCarveGives) {
   EXPECT_NE(k8s.find("completions: " + std::to_string(jobs) + "\n"), std::string::npos) << k8s;
   EXPECT_NE(k8s.find("JOB_COMPLETION_INDEX"), std::string::npos) << k8s;
   EXPECT_TRUE(fs::is_regular_file(tiles + "/run_local.sh"));
+  // The manifests are YAML that Kubernetes reads as an indexed Job and a plain one.
+  std::string parsed;
+  ASSERT_EQ(testing::RunShell(
+                "/usr/bin/python3 -c \"import sys, yaml\n"
+                "for path in sys.argv[1:]:\n"
+                "  job = yaml.safe_load(open(path))\n"
+                "  spec = job['spec']; pod = spec['template']['spec']; c = pod['containers'][0]\n"
+                "  print(job['kind'], spec.get('completionMode', '-'), spec.get('completions', 0), "
+                "pod['restartPolicy'], c['resources']['requests']['memory'], "
+                "'INDEX' if 'JOB_COMPLETION_INDEX' in c['command'][2] else 'noindex')\" " +
+                    tiles + "/tiles.k8s.yaml " + tiles + "/merge.k8s.yaml",
+                &parsed),
+            0)
+      << parsed;
+  EXPECT_NE(parsed.find("Job Indexed " + std::to_string(jobs) + " Never "), std::string::npos) << parsed;
+  EXPECT_NE(parsed.find("Mi INDEX\nJob - 0 Never "), std::string::npos) << parsed;
+  EXPECT_NE(parsed.find("Mi noindex"), std::string::npos) << parsed;
 
   ASSERT_EQ(Run("tile merge --plan " + tiles + "/plan.json", &output), 0) << output;
   const std::string tiled = *root_ + "/tiled";

@@ -1,5 +1,8 @@
 #include "pipeline/tile_plan.h"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +16,7 @@
 #include <glog/logging.h>
 #include <nlohmann/json.hpp>
 
+#include "calib/atomic_file.h"
 #include "calib/input_error.h"
 #include "carve/level_of_detail.h"
 #include "pipeline/output_files.h"
@@ -55,9 +59,23 @@ void WriteBlock(const std::string& path, const std::string& plan_id, int job,
     header.hi[axis] = hi[axis];
   }
   header.words = bits.size();
-  std::string bytes(reinterpret_cast<const char*>(&header), sizeof(header));
-  bytes.append(reinterpret_cast<const char*>(bits.data()), bits.size() * sizeof(uint64_t));
-  WriteTextFileAtomically(path, bytes);
+  // A temporary name of this process's own: a job run again while an earlier run of it is still
+  // writing (a cluster's requeue) must not write into the same file.
+  const fs::path target(path);
+  const std::string temporary =
+      (target.parent_path() / (".tmp." + std::to_string(getpid()) + "." + target.filename().string()))
+          .string();
+  {
+    errno = 0;
+    std::ofstream stream(temporary, std::ios::binary);
+    if (!stream) throw InputError(temporary + ": cannot open for writing: " + std::strerror(errno));
+    stream.write(reinterpret_cast<const char*>(&header), sizeof(header));
+    stream.write(reinterpret_cast<const char*>(bits.data()),
+                 static_cast<std::streamsize>(bits.size() * sizeof(uint64_t)));
+    stream.close();
+    if (!stream) ThrowWriteFailure(temporary, "the voxels (" + path + " is unchanged)", errno);
+  }
+  RenameIntoPlace(temporary, path);
 }
 
 std::vector<uint64_t> ReadBlock(const std::string& path, const std::string& what,

@@ -11,6 +11,7 @@
 #include "carve/carver_internal.h"
 #include "carve/level_of_detail.h"
 #include "carve/ray_image.h"
+#include "carve/view_workers.h"
 
 namespace raycarve {
 namespace {
@@ -150,11 +151,12 @@ std::vector<CalibratedView> TileViews(const std::vector<CalibratedView>& views,
                                       int64_t* occluded_pixels) {
   const BlockOccupancy blocks(outside);
   const VoxelGrid& grid = outside.grid();
+  const int threads = std::max(1, std::min(ResolveNumThreads(num_threads), 64));
   std::vector<CalibratedView> result = views;
   int64_t occluded = 0;
   for (CalibratedView& view : result) {
     RayImage rays(grid, view.WorldFromPixel(), view.centre, view.width, view.height, view.valid);
-    rays.Initialise(outside, &blocks, num_threads);
+    rays.Initialise(outside, &blocks, threads);
     cv::Mat valid = view.valid.empty() ? cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(255))
                                        : view.valid.clone();
     uint8_t* pixels = valid.ptr<uint8_t>(0);

@@ -87,7 +87,8 @@ CoarseCarve CarveCoarseLevels(const std::vector<CalibratedView>& views,
 // The views as the voxels inside `tile_box` see them: a pixel whose ray meets a solid voxel of
 // `outside` (a volume that holds nothing inside the tile) before it enters the box is made
 // invalid; every other pixel keeps its validity. `occluded_pixels` (may be null) gets how many
-// were made invalid. The photos themselves are shared, not copied.
+// were made invalid. The photos themselves are shared, not copied. `num_threads` < 1: one per
+// core.
 std::vector<CalibratedView> TileViews(const std::vector<CalibratedView>& views,
                                       const Volume& outside,
                                       const Eigen::AlignedBox3d& tile_box,

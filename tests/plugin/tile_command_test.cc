@@ -85,6 +85,13 @@ TEST_F(TileCommand, JobsInSeparateProcessesMergeToWhatOneCarveGives) {
   }
   const std::string tiled_report = ReadFileBytes(tiled + "/report.json");
   EXPECT_EQ(JsonNumber(tiled_report, "jobs"), jobs);
+  // One mesh from the joined volume: no seam along the cuts. The scene's ground runs out of the
+  // box, so both meshes are open there; a seam would add its edges along every cut.
+  const double single_edges = JsonNumber(ReadFileBytes(single + "/report.json"), "boundary_edges");
+  const double tiled_edges = JsonNumber(tiled_report, "boundary_edges");
+  std::printf("boundary edges: single %.0f, tiled %.0f\n", single_edges, tiled_edges);
+  EXPECT_LE(tiled_edges, 1.1 * single_edges + 20);
+  EXPECT_EQ(JsonNumber(tiled_report, "self_intersecting_pairs"), 0);
   EXPECT_GT(JsonNumber(tiled_report, "merge_evaluated"), 0);
   EXPECT_NE(output.find("joined from " + std::to_string(jobs) + " jobs"), std::string::npos) << output;
   // Against the truth as good as the single carve, and the two models within a voxel.

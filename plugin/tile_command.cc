@@ -203,6 +203,10 @@ int RunTilePlan(int argc, char** argv) {
   const TilePlan plan = MakeTilePlan(pipeline.carved_views(), box, options, coarse, tiles, overlap,
                                      StageSeconds(pipeline.run(), "load_project"),
                                      CarveArguments(argc, argv, 3), fs::current_path().string());
+  if (plan.jobs == 0) {
+    throw InputError("the coarse levels left no solid voxel: no tile has work (raycarve carve "
+                     "would keep nothing either; see its summary for what to try)");
+  }
   const std::string plan_path = (folder / "plan.json").string();
   WriteCoarseVolume((folder / "coarse.bin").string(), plan.plan_id, coarse.volume);
   char self[4096];

@@ -511,6 +511,7 @@ DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
     result.factors.push_back(reduced[v].factor);
   }
   result.masks = std::move(masks);
+  result.photos_judged = static_cast<int>(result.masks.size());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

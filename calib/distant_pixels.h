@@ -61,6 +61,7 @@ struct DistantPixels {
   // where found nearer, 0 elsewhere.
   std::vector<cv::Mat> masks;
   std::vector<int> factors;
+  int photos_judged = 0;
   int64_t textured = 0;  // pixels judged
   int64_t distant = 0;   // of those, found distant
   int64_t nearer = 0;    // of those, found inside the volume by some photo

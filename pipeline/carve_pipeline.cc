@@ -234,6 +234,21 @@ void CarvePipeline::FindDistant() {
     run_.distant_reason = "--distant_free_space 0";
   } else {
     run_.distant_reason.clear();
+    if (scope_.distant != nullptr) {
+      for (const DistantRay& ray : scope_.distant->rays) {
+        if (ray.view < 0 || ray.view >= static_cast<int>(carved_.size())) {
+          throw InputError("raycarve " + scope_.command + ": the given distant pixels name view " +
+                           std::to_string(ray.view) + " of " + std::to_string(carved_.size()) +
+                           ": not this project's (plan again)");
+        }
+      }
+      run_.distant = *scope_.distant;
+      distant_rays_ = std::move(run_.distant.rays);
+      run_.distant.rays.clear();
+      run_.distant.seconds = 0.0;
+      LOG(INFO) << distant_rays_.size() << " rays of distant pixels from the tile plan";
+      return;
+    }
     DistantOptions options;
     options.num_threads = request_.options.num_threads;
     LOG(INFO) << "looking for pixels that show what lies beyond the volume (sky, far hills) in "
@@ -247,6 +262,14 @@ void CarvePipeline::FindDistant() {
     run_.distant.rays.clear();
     RecordSeconds("distant_pixels", run_.distant.seconds);
   }
+}
+
+DistantPixels CarvePipeline::DistantFound() const {
+  DistantPixels found = run_.distant;
+  found.masks.clear();
+  found.factors.clear();
+  found.rays = distant_rays_;
+  return found;
 }
 
 void CarvePipeline::CheckVolume() {

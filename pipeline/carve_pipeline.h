@@ -33,6 +33,10 @@ struct PipelineScope {
   // > 0: every k-th photo in name order is left out of everything the carve sees (its sparse
   // observations too) and kept apart in held_out_views().
   int hold_out_every = 0;
+  // The distant pixels when already found for these views (a tile job takes its plan's: the rays
+  // and the counts, no masks): used instead of searching the photos again. Null: searched (where
+  // the rules ask for it).
+  const DistantPixels* distant = nullptr;
   ProgressCallback progress;           // during the carve stage (optional)
   std::function<void()> progress_end;  // after the carve stage (optional: ends a progress bar)
 };
@@ -175,6 +179,10 @@ class CarvePipeline {
   const std::vector<CalibratedView>& held_out_views() const { return held_out_; }
   // The reliable sparse points of the carved views (SurfacePointsOf).
   const std::vector<SurfacePoint>& surface_points() const { return surface_points_; }
+  // The distant pixels' rays the carve takes (after CheckVolume; empty where none were looked for).
+  const std::vector<DistantRay>& distant_rays() const { return distant_rays_; }
+  // The distant pixels' counts (run().distant) with the rays: what a tile plan passes to its jobs.
+  DistantPixels DistantFound() const;
   const exporter::ModelMesh& model() const { return model_; }
   const CarveRun& run() const { return run_; }
 

@@ -184,7 +184,7 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
   json.Key("distant_pixels").BeginObject()
       .Key("looked_for").Value(run.distant_reason.empty())
       .Key("reason").Value(run.distant_reason)
-      .Key("photos_judged").Value(static_cast<int64_t>(distant.masks.size()))
+      .Key("photos_judged").Value(distant.photos_judged)
       .Key("textured_pixels").Value(distant.textured)
       .Key("found_pixels").Value(distant.distant)
       .Key("nearer_pixels").Value(distant.nearer)

@@ -417,6 +417,92 @@ std::vector<uint64_t> ReadTilePart(const std::string& path, const TilePlan& plan
                    tile->region.core_lo, tile->region.core_hi);
 }
 
+namespace {
+
+constexpr char kRaysMagic[8] = {'R', 'C', 'R', 'A', 'Y', 'S', '0', '1'};
+
+struct RaysHeader {
+  char magic[8];
+  char plan_id[16];
+  int64_t textured;
+  int64_t distant;
+  int64_t nearer;
+  int64_t grown;
+  int64_t photos_judged;
+  uint64_t count;
+};
+
+struct RayRecord {
+  int64_t view;
+  double direction[3];
+};
+
+}  // namespace
+
+void WriteDistantPixels(const std::string& path, const std::string& plan_id,
+                        const DistantPixels& distant) {
+  RaysHeader header{};
+  std::memcpy(header.magic, kRaysMagic, sizeof(kRaysMagic));
+  std::memcpy(header.plan_id, plan_id.data(), std::min<size_t>(16, plan_id.size()));
+  header.textured = distant.textured;
+  header.distant = distant.distant;
+  header.nearer = distant.nearer;
+  header.grown = distant.grown;
+  header.photos_judged = distant.photos_judged;
+  header.count = distant.rays.size();
+  std::string bytes(reinterpret_cast<const char*>(&header), sizeof(header));
+  for (const DistantRay& ray : distant.rays) {
+    const RayRecord record{ray.view, {ray.direction.x(), ray.direction.y(), ray.direction.z()}};
+    bytes.append(reinterpret_cast<const char*>(&record), sizeof(record));
+  }
+  WriteTextFileAtomically(path, bytes);
+}
+
+DistantPixels ReadDistantPixels(const std::string& path, const TilePlan& plan) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError(path + ": cannot read the plan's distant pixels (" +
+                     (fs::exists(path) ? "not readable" : "missing: run raycarve tile plan again") +
+                     ")");
+  }
+  RaysHeader header{};
+  in.read(reinterpret_cast<char*>(&header), sizeof(header));
+  if (!in || std::memcmp(header.magic, kRaysMagic, sizeof(kRaysMagic)) != 0) {
+    throw InputError(path + ": not a raycarve distant-pixel file");
+  }
+  if (std::string(header.plan_id, 16) != plan.plan_id) {
+    throw InputError(path + ": plan_id " + std::string(header.plan_id, 16) + " is not the plan's " +
+                     plan.plan_id + " (plan again)");
+  }
+  std::error_code error;
+  const uintmax_t size = fs::file_size(path, error);
+  if (error || size != sizeof(header) + header.count * sizeof(RayRecord)) {
+    throw InputError(path + ": count " + std::to_string(header.count) +
+                     " does not match the file's size");
+  }
+  DistantPixels distant;
+  distant.textured = header.textured;
+  distant.distant = header.distant;
+  distant.nearer = header.nearer;
+  distant.grown = header.grown;
+  if (header.photos_judged < 0 || header.photos_judged > std::numeric_limits<int>::max()) {
+    throw InputError(path + ": photos_judged out of range");
+  }
+  distant.photos_judged = static_cast<int>(header.photos_judged);
+  distant.rays.reserve(header.count);
+  for (uint64_t i = 0; i < header.count; ++i) {
+    RayRecord record{};
+    in.read(reinterpret_cast<char*>(&record), sizeof(record));
+    const Eigen::Vector3d direction(record.direction[0], record.direction[1], record.direction[2]);
+    if (!in || record.view < 0 || record.view > std::numeric_limits<int>::max() ||
+        !direction.allFinite() || !(direction.norm() > 0.0)) {
+      throw InputError(path + ": ray " + std::to_string(i) + " is not a view and a direction");
+    }
+    distant.rays.push_back({static_cast<int>(record.view), direction});
+  }
+  return distant;
+}
+
 std::string TilePartPath(const std::string& folder, int job) {
   const std::string name = "tile_" + std::to_string(job) + ".bin";
   return folder.empty() ? name : (fs::path(folder) / name).string();

@@ -6,6 +6,7 @@
 //                    threshold, and per tile its region, whether it has work, and the memory and
 //                    time a job should ask for
 //   coarse.bin       the coarse levels' volume (one bit a voxel), which every tile starts from
+//   distant.bin      the distant pixels' rays the plan found, which every job takes as they are
 //   tile_<i>.bin     job i's result: its tile's core (written by `tile run`, under a temporary
 //                    name and renamed)
 //   tiles.sbatch, merge.sbatch, submit_slurm.sh   a Slurm array job, the merge after it
@@ -23,6 +24,7 @@
 #include <Eigen/Core>
 
 #include "calib/calibrated_view.h"
+#include "calib/distant_pixels.h"
 #include "carve/carver.h"
 #include "carve/tiling.h"
 #include "carve/volume.h"
@@ -89,6 +91,13 @@ std::vector<uint64_t> ReadCoarseVolume(const std::string& path, const TilePlan& 
 void WriteTilePart(const std::string& path, const TilePlan& plan, int job,
                    const std::vector<uint64_t>& core_bits);
 std::vector<uint64_t> ReadTilePart(const std::string& path, const TilePlan& plan, int job);
+
+// The distant pixels the plan found (CarvePipeline::DistantFound: the rays and the counts), for
+// the jobs, so that each does not search every photo again. Read back with the plan's id and the
+// sizes checked (InputError naming the file).
+void WriteDistantPixels(const std::string& path, const std::string& plan_id,
+                        const DistantPixels& distant);
+DistantPixels ReadDistantPixels(const std::string& path, const TilePlan& plan);
 
 // The part file of a job, and the plan's other files, in `folder`.
 std::string TilePartPath(const std::string& folder, int job);

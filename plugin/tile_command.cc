@@ -209,6 +209,7 @@ int RunTilePlan(int argc, char** argv) {
   }
   const std::string plan_path = (folder / "plan.json").string();
   WriteCoarseVolume((folder / "coarse.bin").string(), plan.plan_id, coarse.volume);
+  WriteDistantPixels((folder / "distant.bin").string(), plan.plan_id, pipeline.DistantFound());
   char self[4096];
   const ssize_t length = readlink("/proc/self/exe", self, sizeof(self) - 1);
   const std::string raycarve = length > 0 ? std::string(self, length) : std::string(argv[0]);
@@ -249,9 +250,11 @@ int RunTileRun(int argc, char** argv) {
     throw InputError("raycarve tile run: --index " + std::to_string(job) + ": the plan has jobs 0 to " +
                      std::to_string(plan.jobs - 1));
   }
+  const DistantPixels distant = ReadDistantPixels((fs::path(folder) / "distant.bin").string(), plan);
   EnterWorkingDirectory(plan, plan_path);
   ProgressDisplay display;
-  const PipelineScope scope = ScopeOf("tile run", &display);
+  PipelineScope scope = ScopeOf("tile run", &display);
+  scope.distant = &distant;
   CarvePipeline pipeline(RequestOfPlan(plan, "tile run"), scope);
   pipeline.LoadViews();
   pipeline.AgreeMasks();
@@ -310,9 +313,11 @@ int RunTileMerge(int argc, char** argv) {
                      " parts are missing (jobs " + list + "): run raycarve tile run --plan " +
                      plan_path + " --index I for each");
   }
+  const DistantPixels distant = ReadDistantPixels((fs::path(folder) / "distant.bin").string(), plan);
   EnterWorkingDirectory(plan, plan_path);
   ProgressDisplay display;
-  const PipelineScope scope = ScopeOf("tile merge", &display);
+  PipelineScope scope = ScopeOf("tile merge", &display);
+  scope.distant = &distant;
   const CarveRequest request = RequestOfPlan(plan, "tile merge");
   TiledCarveInfo tiled;
   tiled.plan_id = plan.plan_id;

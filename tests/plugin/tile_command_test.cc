@@ -138,6 +138,10 @@ TEST_F(TileCommand, TheMergeRefusesMissingOrForeignPartsAndAJobRunAgainRestoresI
   ASSERT_EQ(Run("tile run --plan " + other + "/plan.json --index 1", &output), 0) << output;
   fs::copy_file(other + "/tile_1.bin", part, fs::copy_options::overwrite_existing);
   ExpectUserError("tile merge --plan " + tiles + "/plan.json", {part, "plan_id", "another plan"});
+  // The plan's distant pixels, which every job takes instead of searching the photos again.
+  fs::rename(tiles + "/distant.bin", tiles + "/distant.saved");
+  ExpectUserError("tile run --plan " + tiles + "/plan.json --index 0", {"distant.bin", "missing"});
+  fs::rename(tiles + "/distant.saved", tiles + "/distant.bin");
   // Jobs and plans that do not exist.
   ExpectUserError("tile run --plan " + tiles + "/plan.json --index 99", {"--index 99", "jobs 0 to"});
   ExpectUserError("tile run --plan " + *root_ + "/nowhere/plan.json --index 0", {"nowhere/plan.json", "missing"});

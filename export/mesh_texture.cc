@@ -289,6 +289,13 @@ bool MeshTextureOptions::IsValid(std::string* reason) const {
 std::string MeshTextureSummary::Summary() const {
   std::ostringstream text;
   text.precision(3);
+  if (too_large) {
+    text << "mesh texture: none: " << triangles << " triangles would need an atlas of "
+         << needed_width << " x " << needed_height << " texels, over the limit of its longest side; "
+         << "the mesh keeps its vertex colours (a coarser --resolution textures), in " << seconds
+         << " s";
+    return text.str();
+  }
   text << "mesh texture: " << textured << " of " << triangles << " triangles from the photos in "
        << charts << " charts (" << relabelled << " took their neighbours' photo), the rest from their vertices' colours; atlas "
        << atlas_width << " x " << atlas_height;
@@ -499,6 +506,19 @@ MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& view
     charts.pop_back();
     if (height <= options.max_atlas_side && width <= options.max_atlas_side) break;
     scale *= 0.9;
+  }
+  if (height > options.max_atlas_side || width > options.max_atlas_side) {
+    // Even at a tenth of the photos' resolution the charts do not fit, or the cells of the
+    // triangles no photo sees whole fill the atlas alone (millions of them on a grid finer than
+    // the photos): no texture, the mesh keeps its vertex colours (readers refuse larger images).
+    summary.too_large = true;
+    summary.textured = 0;
+    summary.charts = 0;
+    summary.relabelled = 0;
+    summary.needed_width = width;
+    summary.needed_height = height;
+    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return summary;
   }
   summary.scale = scale;
   summary.atlas_width = width;

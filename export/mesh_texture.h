@@ -45,6 +45,12 @@ struct MeshTextureSummary {
   int atlas_width = 0;
   int atlas_height = 0;
   double scale = 1.0;  // photo pixels to atlas pixels (1 unless the atlas had to shrink)
+  // No texture: the atlas would pass max_atlas_side even scaled down (`needed_width` x
+  // `needed_height` at a tenth or less of the photos' resolution); the mesh keeps its vertex
+  // colours and atlas_width is 0.
+  bool too_large = false;
+  int needed_width = 0;
+  int needed_height = 0;
   double seconds = 0.0;
   // How the charts join (MeasureTextureSeams).
   int64_t seam_edges = 0;

@@ -638,7 +638,10 @@ void CarvePipeline::WriteReportPage(const fs::path& staging) const {
     }
   }
   const fs::path glb = staging / "mesh.glb";
-  if (fs::exists(glb)) {
+  if (fs::exists(glb) && fs::file_size(glb) > kMaxEmbeddedGlbBytes) {
+    page.glb_name = "mesh.glb";
+    page.glb_bytes_not_embedded = fs::file_size(glb);
+  } else if (fs::exists(glb)) {
     page.glb_name = "mesh.glb";
     std::ifstream file(glb, std::ios::binary);
     page.glb.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());

@@ -358,6 +358,7 @@ void WriteMesh(const CarveRequest& request, const CarveRun& run, JsonWriter& jso
         .Key("texture_width").Value(run.mesh_texture.atlas_width)
         .Key("texture_height").Value(run.mesh_texture.atlas_height)
         .Key("texture_scale").Value(run.mesh_texture.scale)
+        .Key("texture_too_large").Value(run.mesh_texture.too_large)
         .Key("texture_seam_edges").Value(run.mesh_texture.seam_edges)
         .Key("texture_seam_step").Value(run.mesh_texture.seam_step)
         .Key("texture_inner_step").Value(run.mesh_texture.inner_step)

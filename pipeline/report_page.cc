@@ -221,7 +221,13 @@ std::string ReportPageHtml(const ReportPageContent& content) {
        << "<title>raycarve: " << HtmlEscape(content.title) << "</title>\n<style>" << kStyle
        << "</style>\n</head>\n<body>\n<h1>raycarve: " << HtmlEscape(content.title) << "</h1>\n";
   html << "<section id=\"view-section\">\n<h2>The model</h2>\n";
-  if (content.glb.empty()) {
+  if (content.glb_bytes_not_embedded > 0) {
+    char size[32];
+    std::snprintf(size, sizeof(size), "%.0f MB", content.glb_bytes_not_embedded / 1e6);
+    html << "<p>" << HtmlEscape(content.glb_name) << " (" << size << ") is too large to show in "
+         << "this page: open it in a viewer such as Blender or MeshLab, or carve at a coarser "
+            "--resolution.</p>\n";
+  } else if (content.glb.empty()) {
     html << "<p>No mesh to show (the carve kept nothing, or wrote its voxels' faces only).</p>\n";
   } else if (!ReportPageHasViewer()) {
     html << "<p>This raycarve was built without the 3D view's scripts (scripts/setup.sh installs "

@@ -13,6 +13,10 @@
 
 namespace raycarve {
 
+// The largest mesh.glb the page embeds (base64 grows it by a third; browsers give up on pages
+// of a few hundred MB): 256 MiB.
+constexpr uint64_t kMaxEmbeddedGlbBytes = uint64_t{256} << 20;
+
 struct ReportPageContent {
   std::string title;    // the page's heading (e.g. the model's path)
   std::string summary;  // the summary as the command prints it (shown as preformatted text)
@@ -20,6 +24,9 @@ struct ReportPageContent {
   std::vector<CurveSample> convergence;  // voxels carved against seconds; empty: no plot
   std::vector<uint8_t> glb;  // the mesh as glTF binary; empty: no 3D view
   std::string glb_name;      // its file beside the page, named in the view's caption
+  // When the mesh's file is too large to embed (kMaxEmbeddedGlbBytes): its size, and `glb` is
+  // left empty; the page names the file instead of showing it.
+  uint64_t glb_bytes_not_embedded = 0;
   // Where the 3D view starts: the world's "up" and the direction from the model towards its
   // eye (the photos' mean up and mean camera direction); zero: +z up, seen from an oblique corner.
   Eigen::Vector3d view_up = Eigen::Vector3d::Zero();

@@ -135,6 +135,32 @@ TEST(TextureMeshFromPhotos, ATriangleNoPhotoSeesWholeKeepsItsVertexColours) {
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(centre[k], 200.0 / 3.0, 25.0) << k;
 }
 
+TEST(TextureMeshFromPhotos, AnAtlasOverTheLimitIsNotMadeAndTheVertexColoursStay) {
+  const std::vector<CalibratedView> views = {PatternView()};
+  TriangleMesh mesh = Rectangle(views[0]);
+  // The rectangle's 48 triangles 8 times over (the copies share its vertices), none seen whole by
+  // a photo: 384 cells of 4 x 4 texels need more than a 64 x 64 atlas, and such cells do not
+  // shrink.
+  const std::vector<Eigen::Vector3i> once = mesh.triangles;
+  for (int copy = 1; copy < 8; ++copy) mesh.triangles.insert(mesh.triangles.end(), once.begin(), once.end());
+  const std::vector<std::vector<uint32_t>> unseen(mesh.vertices.size());
+  MeshTextureOptions options;
+  options.max_atlas_side = 64;
+  MeshTextureSummary summary = TextureMeshFromPhotos(views, unseen, options, &mesh);
+  EXPECT_TRUE(summary.too_large);
+  EXPECT_EQ(summary.atlas_width, 0);
+  EXPECT_GT(summary.needed_width * static_cast<int64_t>(summary.needed_height), 64 * 64);
+  EXPECT_TRUE(mesh.texture.empty());
+  EXPECT_TRUE(mesh.corner_uvs.empty());
+  EXPECT_NE(summary.Summary().find("keeps its vertex colours"), std::string::npos) << summary.Summary();
+  // The same mesh with a limit it fits: an atlas.
+  options.max_atlas_side = 256;
+  summary = TextureMeshFromPhotos(views, unseen, options, &mesh);
+  EXPECT_FALSE(summary.too_large);
+  EXPECT_GT(summary.atlas_width, 0);
+  EXPECT_FALSE(mesh.texture.empty());
+}
+
 // Two triangles sharing an edge, textured from a 64 x 32 atlas whose right half is `step` levels
 // brighter: in one chart (both in the left half) the edge is inside it and nothing steps; in two
 // (the second triangle's copy in the right half) the edge is a seam that steps by `step`.

@@ -194,14 +194,14 @@ TileCarve CarveTile(const std::vector<CalibratedView>& views,
   CHECK_GE(num_levels, 2) << "CheckTiling";
   const VoxelGrid final_grid(box, options.resolution);
   const VoxelGrid region = final_grid.Region(tile.lo, tile.hi);
-  // The outside as the fine level will start from it (the coarse volume with its band), less the
-  // coarse voxels that hold any of the region's.
-  Volume outside = DilateSolid(coarse.volume, options.lod_band);
-  const VoxelGrid& coarse_grid = outside.grid();
+  // The coarse volume with its band, dilated once: refined with no further band it is the region's
+  // start; less the coarse voxels that hold any of the region's, it is the outside.
+  const Volume band = DilateSolid(coarse.volume, options.lod_band);
+  const VoxelGrid& coarse_grid = band.grid();
   const Eigen::Vector3i coarse_lo = tile.lo / 2;
   const Eigen::Vector3i coarse_hi = ((tile.hi.array() + 1) / 2).matrix().cwiseMin(
       coarse_grid.dimensions());
-  std::vector<uint64_t> bits = outside.solid_bits();
+  std::vector<uint64_t> bits = band.solid_bits();
   for (int z = coarse_lo.z(); z < coarse_hi.z(); ++z) {
     for (int y = coarse_lo.y(); y < coarse_hi.y(); ++y) {
       for (int x = coarse_lo.x(); x < coarse_hi.x(); ++x) {
@@ -210,7 +210,7 @@ TileCarve CarveTile(const std::vector<CalibratedView>& views,
       }
     }
   }
-  outside = Volume(coarse_grid, std::move(bits));
+  const Volume outside(coarse_grid, std::move(bits));
   int64_t occluded = 0;
   const std::vector<CalibratedView> tile_views =
       TileViews(views, outside, region.Box(), options.num_threads, &occluded);
@@ -218,7 +218,7 @@ TileCarve CarveTile(const std::vector<CalibratedView>& views,
   CarveStages stages;
   stages.first_level = num_levels - 1;
   stages.start = std::make_unique<Volume>(
-      RefineRegion(coarse.volume, region, tile.lo, options.lod_band));
+      RefineRegion(band, region, tile.lo, /*band=*/0));
   stages.final_views = &tile_views;
   stages.final_thresholds_given = true;
   stages.final_threshold = coarse.final_threshold;

@@ -11,7 +11,7 @@
 //                    name and renamed)
 //   tiles.sbatch, merge.sbatch, submit_slurm.sh   a Slurm array job, the merge after it
 //   tiles.k8s.yaml, merge.k8s.yaml                a Kubernetes indexed Job and the merge Job
-//   run_local.sh     the same jobs as processes on this machine
+//   run_local.sh     the same jobs as processes on this machine (pipeline/tile_jobs.h)
 //
 // Every file a job reads names the plan it belongs to (plan_id: a hash of the arguments, the grid
 // and the coarse volume), so that a part from another plan, or a plan made again since, is
@@ -102,9 +102,5 @@ DistantPixels ReadDistantPixels(const std::string& path, const TilePlan& plan);
 // The part file of a job, and the plan's other files, in `folder`.
 std::string TilePartPath(const std::string& folder, int job);
 
-// The job scripts in `folder` (Slurm, Kubernetes, local processes) for `plan`, running
-// `raycarve` (an absolute path) on `plan_path`; each job's memory and time from the plan.
-void WriteTileJobScripts(const std::string& folder, const TilePlan& plan,
-                         const std::string& raycarve, const std::string& plan_path);
 
 }  // namespace raycarve

@@ -18,6 +18,7 @@
 #include "pipeline/carve_pipeline.h"
 #include "pipeline/carve_summary.h"
 #include "pipeline/output_files.h"
+#include "pipeline/tile_jobs.h"
 #include "pipeline/tile_plan.h"
 #include "plugin/carve_flags.h"
 #include "plugin/commands.h"

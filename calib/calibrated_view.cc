@@ -1,5 +1,7 @@
 #include "calib/calibrated_view.h"
 
+#include <algorithm>
+
 #include <glog/logging.h>
 #include <opencv2/imgproc.hpp>
 
@@ -102,6 +104,48 @@ CalibratedView ReduceView(const CalibratedView& view, int factor) {
   reduced.K = scale * view.K;
   reduced.P = scale * view.P;
   return reduced;
+}
+
+CalibratedView EnlargeView(const CalibratedView& view, int factor) {
+  CHECK(factor >= 1 && factor <= 16) << "factor " << factor;
+  if (factor == 1) return view;
+  CalibratedView enlarged = view;
+  enlarged.width = view.width * factor;
+  enlarged.height = view.height * factor;
+  const cv::Size size(enlarged.width, enlarged.height);
+  // OpenCV samples output pixel x at input (x + 0.5) / factor - 0.5: pixel centres in COLMAP's
+  // convention scale by `factor` exactly, as K does below.
+  cv::resize(view.image, enlarged.image, size, 0, 0, cv::INTER_LINEAR);
+  // Valid only where every input pixel the interpolation weighs is: a blend with the black
+  // beyond an undistorted frame is no photo colour.
+  cv::Mat weighed;
+  cv::resize(view.valid, weighed, size, 0, 0, cv::INTER_LINEAR);
+  enlarged.valid = weighed == 255;
+  if (!view.mask.empty()) {
+    cv::resize(view.mask, enlarged.mask, size, 0, 0, cv::INTER_NEAREST);
+    // Nor where it blends the object with the background: such a pixel is the colour of neither
+    // (the photo's own rim pixels stay, as in the view).
+    cv::Mat object;
+    cv::resize(view.mask != 0, object, size, 0, 0, cv::INTER_LINEAR);
+    enlarged.valid &= (object == 0) | (object == 255);
+  }
+  Eigen::Matrix3d scale = Eigen::Matrix3d::Identity();
+  scale(0, 0) = scale(1, 1) = factor;
+  enlarged.K = scale * view.K;
+  enlarged.P = scale * view.P;
+  return enlarged;
+}
+
+double MedianPixelFootprint(const std::vector<CalibratedView>& views, const Eigen::Vector3d& point) {
+  std::vector<double> widths;
+  for (const CalibratedView& view : views) {
+    const double depth = view.Depth(point);
+    const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
+    if (depth > 0.0 && focal > 0.0) widths.push_back(depth / focal);
+  }
+  if (widths.empty()) return 0.0;
+  std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
+  return widths[widths.size() / 2];
 }
 
 }  // namespace raycarve

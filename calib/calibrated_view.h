@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -58,5 +59,19 @@ CalibratedView MakeCalibratedView(const Camera& camera,
 // silhouette's colours, but no object pixel is lost to a visual hull. factor 1 returns a copy
 // sharing the pixels. CHECKs 1 <= factor <= min(width, height).
 CalibratedView ReduceView(const CalibratedView& view, int factor);
+
+// The view seen through an image `factor` times larger along each axis, for carving voxels
+// smaller than a pixel: each output pixel is the bilinear interpolation of the photo at its
+// centre, so that every voxel is crossed by rays and the mean of a voxel's rays approximates the
+// photo's mean over its projection (a footprint, not the one pixel its centre falls in). COLMAP
+// pixel coordinates scale by `factor` exactly (K and P follow). A pixel is valid only where every
+// input pixel it is interpolated from is, and, with a mask, where those are all object or all
+// background (a blend is the colour of neither); the mask by nearest neighbour. factor 1 returns
+// a copy sharing the pixels. CHECKs 1 <= factor <= 16.
+CalibratedView EnlargeView(const CalibratedView& view, int factor);
+
+// The median over `views` of the width a pixel spans at `point` (depth / focal length, in world
+// units), over the views that have it in front; 0 when none has.
+double MedianPixelFootprint(const std::vector<CalibratedView>& views, const Eigen::Vector3d& point);
 
 }  // namespace raycarve

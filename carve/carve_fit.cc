@@ -78,9 +78,12 @@ bool CheckCarveFits(const std::vector<CalibratedView>& views,
   double bytes_per_pixel = lists ? kBytesPerListedRay : kBytesPerRay;
   if (options.method == CarveMethod::kGvc) bytes_per_pixel = kBytesPerItemPixel;
   if (options.method == CarveMethod::kGvcLdi) bytes_per_pixel = kBytesPerLayeredPixel;
+  // Supersampling: the final level's rays and its enlarged copy of the photos (RGB, valid, mask).
+  const int supersample = FinalSupersample(views, box, options);
+  if (supersample > 1) bytes_per_pixel += 5.0;
   double ray_bytes = 0.0;
   for (const CalibratedView& view : views) {
-    ray_bytes += bytes_per_pixel * view.width * view.height;
+    ray_bytes += bytes_per_pixel * view.width * view.height * supersample * supersample;
   }
   const double max_bytes = options.max_memory_gib * 1024.0 * 1024.0 * 1024.0;
   if (ray_bytes > max_bytes) {
@@ -88,6 +91,10 @@ bool CheckCarveFits(const std::vector<CalibratedView>& views,
     text << "the " << (options.method == CarveMethod::kRay ? "rays" : "buffers") << " of "
          << views.size() << " views need " << ray_bytes / (1 << 30)
          << " GiB, above max_memory_gib " << options.max_memory_gib;
+    if (supersample > 1) {
+      text << " (the photos enlarged " << supersample << " times for voxels finer than a pixel: "
+           << "supersample 1 carves them as they are)";
+    }
     *reason = text.str();
     return false;
   }

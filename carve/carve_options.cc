@@ -90,6 +90,11 @@ bool CarveOptions::IsValid(std::string* reason) const {
     *reason = "incremental statistics need ray casting (--method ray)";
     return false;
   }
+  if (supersample != kAutomaticSupersample &&
+      (supersample < 1 || supersample > kMaxSupersample || (supersample & (supersample - 1)) != 0)) {
+    *reason = "supersample must be 0 (automatic), 1, 2 or 4, got " + std::to_string(supersample);
+    return false;
+  }
   std::vector<int> resolutions;
   if (!LevelResolutions(resolution, lod_levels, &resolutions, reason)) return false;
   if (!(lod_threshold_scale >= 1.0 && lod_threshold_scale <= 10.0)) {

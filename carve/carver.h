@@ -123,6 +123,18 @@ struct CarveOptions {
   // pixels at every level (fewer while any photo's shorter side would drop below
   // kMinReducedSide pixels). Off: every level carves the full photos.
   bool lod_reduce_images = true;
+  // Rays per pixel side at the final level (supersampling): the photos are enlarged this many
+  // times (EnlargeView: bilinear) before their rays are cast, so that a voxel smaller than a
+  // pixel is still crossed by rays from every view that sees it and judged on the photo's mean
+  // over its projection, not left unjudged where rays pass between voxels. Coarse levels follow
+  // (with lod_reduce_images, a level of voxels f times the final ones carves the photos scaled
+  // supersample / f). 1: the photos as they are. kAutomaticSupersample: the smallest power of
+  // two that makes a final voxel span kMinRaysPerVoxel ray spacings (the median over the views
+  // at the box's centre; at most kMaxSupersample).
+  static constexpr int kAutomaticSupersample = 0;
+  static constexpr int kMaxSupersample = 4;
+  static constexpr double kMinRaysPerVoxel = 1.5;
+  int supersample = 1;
   // After the final level converges: carve every 26-connected component of solid voxels with
   // fewer voxels than this (specks in empty space whose pixels agree by chance), then carry on
   // carving from what they hid; repeated while any is found (at most 4 rounds). 0: keep all.
@@ -323,6 +335,12 @@ BoxCoverage MeasureBoxCoverage(const std::vector<CalibratedView>& views,
 // Carves the volume over `box` seen by `views` until no voxel whose visibility changed is
 // inconsistent. `progress` (optional) is called about every `progress_interval_seconds` of
 // carving. Options must pass CheckCarveFits (CHECKed).
+// The photos' enlargement at the final level (CarveOptions::supersample, resolved where automatic):
+// 1 when the views' pixels at the box's centre are at most 1 / kMinRaysPerVoxel of a voxel.
+int FinalSupersample(const std::vector<CalibratedView>& views,
+                     const Eigen::AlignedBox3d& box,
+                     const CarveOptions& options);
+
 CarveResult CarveVolume(const std::vector<CalibratedView>& views,
                         const Eigen::AlignedBox3d& box,
                         const CarveOptions& options,

@@ -18,11 +18,15 @@ namespace raycarve {
 struct LevelStatistics {
   int resolution = 0;
   int image_factor = 1;  // the photos were reduced this many times (CarveOptions::lod_reduce_images)
+  int image_enlargement = 1;  // or enlarged this many times (CarveOptions::supersample)
   double threshold = 0.0;  // the consistency threshold this level judged with
   double pattern_threshold = 0.0;  // and, with kPatchCorrelation, its pattern threshold
   // CarveOptions::auto_threshold: whether the threshold came from the surface points (false:
   // too few could be judged, and the fallback was used); `estimate` holds what it came from.
   bool threshold_from_data = false;
+  // With enlarged photos: the grid `estimate` was measured at (the photos as they are, a grid as
+  // many times coarser); 0: this level's own.
+  int threshold_resolution = 0;
   ThresholdEstimate estimate;
   // The threshold was estimated before, over the whole volume, and given (a carve in tiles:
   // carve/tiling.h); `estimate` is then empty.

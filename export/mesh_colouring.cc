@@ -315,17 +315,5 @@ MeshColouringSummary ColourMeshFromPhotos(const std::vector<CalibratedView>& vie
   return summary;
 }
 
-double MedianPixelFootprint(const std::vector<CalibratedView>& views, const Eigen::Vector3d& point) {
-  std::vector<double> widths;
-  for (const CalibratedView& view : views) {
-    const double depth = view.Depth(point);
-    const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));
-    if (depth > 0.0 && focal > 0.0) widths.push_back(depth / focal);
-  }
-  if (widths.empty()) return 0.0;
-  std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
-  return widths[widths.size() / 2];
-}
-
 }  // namespace exporter
 }  // namespace raycarve

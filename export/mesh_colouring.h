@@ -109,9 +109,5 @@ MeshColouringSummary ColourMeshFromPhotos(const std::vector<CalibratedView>& vie
                                           TriangleMesh* mesh,
                                           std::vector<std::vector<uint32_t>>* seen_by = nullptr);
 
-// The median over the views of the width, in world units, that one pixel covers at `point`
-// (depth / focal length): the scale of the photos' own detail there. 0 without views.
-double MedianPixelFootprint(const std::vector<CalibratedView>& views, const Eigen::Vector3d& point);
-
 }  // namespace exporter
 }  // namespace raycarve

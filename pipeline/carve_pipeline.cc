@@ -73,7 +73,12 @@ void LogCarve(const CarveOptions& options, const CarveStatistics& s) {
       LOG(INFO) << "level " << level.resolution << ": threshold " << level.threshold
                 << " (estimated over the whole volume by the tile plan)";
     } else if (level.threshold_from_data) {
-      LOG(INFO) << "level " << level.resolution << ": " << level.estimate.Summary();
+      LOG(INFO) << "level " << level.resolution << ": " << level.estimate.Summary()
+                << (level.threshold_resolution > 0
+                        ? " (measured at " + std::to_string(level.threshold_resolution) +
+                              " voxels on the photos as they are: this level enlarges them " +
+                              std::to_string(level.image_enlargement) + "x)"
+                        : std::string());
     } else {
       LOG(WARNING) << "level " << level.resolution << ": only " << level.estimate.points_judged
                    << " sparse points could be judged (" << kMinThresholdPoints
@@ -275,7 +280,7 @@ void CarvePipeline::CheckVolume() {
   CheckVolumeSeen(scope_.command, project_, carved_, request_.options.min_views, request_.bounds);
   // Said before the work: a voxel finer than a pixel of the photos gains no detail (the photos
   // cannot tell its neighbours apart, and rays pass between voxels that are then never judged).
-  const double pixel = exporter::MedianPixelFootprint(carved_, project_.bounds.box.center());
+  const double pixel = MedianPixelFootprint(carved_, project_.bounds.box.center());
   if (!(pixel > 0.0)) return;
   const auto measure = [&] {
     const VoxelGrid grid(project_.bounds.box, request_.options.resolution);
@@ -494,7 +499,7 @@ void CarvePipeline::SampleCloud() {
   // The mesh's surface that --cloud_min_views or more photos see, and which ones, in COLMAP's
   // visibility format (image indices: positions among the model's images in id order).
   const double spacing =
-      exporter::MedianPixelFootprint(carved_, run_.result->volume.grid().Box().center());
+      MedianPixelFootprint(carved_, run_.result->volume.grid().Box().center());
   if (!model_.mesh.empty() && spacing > 0.0) {
     points_ = exporter::SampleMeshPoints(model_, spacing, request_.cloud_min_views, /*seed=*/1,
                                          &visibility_);

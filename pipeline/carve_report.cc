@@ -38,6 +38,7 @@ void WriteOptions(const CarveRequest& request, const CarveRun& run, JsonWriter& 
       .Key("lod_levels_automatic").Value(request.options.lod_levels == kAutomaticLevels)
       .Key("lod_band").Value(request.options.lod_band)
       .Key("lod_reduce_images").Value(request.options.lod_reduce_images)
+      .Key("supersample").Value(request.options.supersample)
       .Key("lod_threshold_scale").Value(request.options.lod_threshold_scale)
       .Key("min_component_voxels").Value(request.options.min_component_voxels)
       .Key("vis_lookup").Value(VisLookupToString(request.options.vis_lookup))
@@ -256,11 +257,15 @@ void WriteLevels(const CarveRequest& request, const CarveRun& run, JsonWriter& j
                                                 static_cast<double>(level.dimensions.y()),
                                                 static_cast<double>(level.dimensions.z())})
         .Key("image_factor").Value(level.image_factor)
+        .Key("image_enlargement").Value(level.image_enlargement)
         .Key("free_space_carved").Value(level.free_space_carved)
         .Key("threshold").Value(level.threshold);
     const bool patterns = request.options.consistency == ConsistencyMethod::kPatchCorrelation;
     if (patterns) json.Key("pattern_threshold").Value(level.pattern_threshold);
     if (level.threshold_given) json.Key("threshold_from_tile_plan").Value(true);
+    if (level.threshold_resolution > 0) {
+      json.Key("threshold_resolution").Value(level.threshold_resolution);
+    }
     if (!level.threshold_given &&
         (request.options.auto_threshold || (patterns && request.options.auto_pattern_threshold))) {
       const ThresholdEstimate& e = level.estimate;

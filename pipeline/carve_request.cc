@@ -12,6 +12,7 @@ CarveRequest::CarveRequest() {
   view_options.max_image_size = kDefaultMaxImageSize;
   options.num_threads = -1;
   options.lod_levels = kAutomaticLevels;
+  options.supersample = CarveOptions::kAutomaticSupersample;
   options.min_component_voxels = kDefaultMinComponentVoxels;
   options.auto_threshold = true;
   options.protect_surface_points = true;

@@ -206,6 +206,9 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
                     level_line.empty() ? "" : ", ", level.resolution, level.threshold);
     }
     level_line += text;
+    if (level.image_enlargement > 1) {
+      level_line += " (photos enlarged " + std::to_string(level.image_enlargement) + "x)";
+    }
   }
   std::string floater_text;
   if (s.unsupported_components > 0) {

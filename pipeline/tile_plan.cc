@@ -214,6 +214,11 @@ TilePlan MakeTilePlan(const std::vector<CalibratedView>& views,
   const double gib = 1024.0 * 1024.0 * 1024.0;
   double pixels = 0.0;
   for (const CalibratedView& view : views) pixels += static_cast<double>(view.width) * view.height;
+  // Supersampling (CarveOptions::supersample): the final level's rays and enlarged photos (RGB,
+  // valid, mask) in place of one ray a pixel.
+  const int supersample = FinalSupersample(views, grid.Box(), options);
+  const double enlarged_bytes =
+      supersample > 1 ? pixels * (9.0 * supersample * supersample - 4.0) : 0.0;
   const double coarse_seconds = coarse.statistics.carve_seconds + coarse.statistics.setup_seconds;
   const double total_solid = std::max<double>(1.0, band.num_solid());
   const double coarse_bytes = 2.0 * coarse.volume.grid().num_voxels();
@@ -226,7 +231,7 @@ TilePlan MakeTilePlan(const std::vector<CalibratedView>& views,
     if (tile.coarse_solid > 0) tile.job = plan.jobs++;
     const Eigen::Vector3i n = region.hi - region.lo;
     const double voxels = static_cast<double>(n.x()) * n.y() * n.z();
-    tile.memory_gib = 0.5 + (pixels * 19.0 + voxels * 3.0 + coarse_bytes) / gib;
+    tile.memory_gib = 0.5 + (pixels * 19.0 + enlarged_bytes + voxels * 3.0 + coarse_bytes) / gib;
     tile.minutes = std::max(
         5.0, 3.0 * (load_seconds + 4.0 * coarse_seconds * tile.coarse_solid / total_solid) / 60.0);
     plan.tiles.push_back(tile);
@@ -237,7 +242,7 @@ TilePlan MakeTilePlan(const std::vector<CalibratedView>& views,
   // the final surface being about 4 times the coarse level's.
   const double surface = 4.0 * static_cast<double>(coarse.volume.num_surface());
   plan.merge_memory_gib =
-      1.0 + (pixels * 18.0 + grid.num_voxels() * 3.0 + surface * 2048.0) / gib;
+      1.0 + (pixels * 18.0 + enlarged_bytes + grid.num_voxels() * 3.0 + surface * 2048.0) / gib;
   plan.merge_minutes = std::max(
       10.0, 3.0 * (load_seconds + 8.0 * coarse_seconds + 150e-6 * surface) / 60.0);
   std::string identity;

@@ -143,6 +143,11 @@ void AddLevelFlags(OptionParser* parser, CarveRequest* request) {
   parser->AddDefault("lod_reduce_images", &request->options.lod_reduce_images,
                      "coarse levels carve photos reduced by the level's voxel scale (block "
                      "means): a voxel covers about as many pixels at every level");
+  parser->AddDefault("supersample", &request->options.supersample,
+                     "rays per pixel side at the final level: the photos enlarged (bilinear) so "
+                     "that a voxel finer than a pixel is still crossed by rays of every view "
+                     "that sees it; 1: the photos as they are; 0: as many (1, 2 or 4) as make a "
+                     "voxel span 1.5 rays");
   parser->AddDefault("lod_threshold_scale", &request->options.lod_threshold_scale,
                      "a level whose voxels are 2^k times the final ones judges with threshold x "
                      "this^k (coarse voxels straddle more texture; only the final level uses "

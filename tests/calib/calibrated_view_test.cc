@@ -200,6 +200,80 @@ TEST(CalibratedView, AReducedViewAveragesBlocksAndProjectsToScaledPixels) {
   EXPECT_EQ(same.image.data, view.image.data);
 }
 
+TEST(CalibratedView, AnEnlargedViewInterpolatesAndProjectsToScaledPixels) {
+  const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kPinhole));
+  const Reconstruction& reconstruction = scene.reconstruction;
+  const Image& image = reconstruction.images.begin()->second;
+  CalibratedView view = MakeCalibratedView(reconstruction.cameras.at(image.camera_id), image,
+                                           scene.photos.at(image.image_id), image.name);
+  view.mask = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
+  view.mask.at<uint8_t>(50, 70) = 255;
+  view.valid.at<uint8_t>(10, 21) = 0;
+  for (int factor : {2, 4}) {
+    SCOPED_TRACE(factor);
+    const CalibratedView enlarged = EnlargeView(view, factor);
+    ASSERT_EQ(enlarged.width, 160 * factor);
+    ASSERT_EQ(enlarged.height, 120 * factor);
+    ASSERT_EQ(enlarged.image.cols, enlarged.width);
+    // The pixel at COLMAP coordinates (x, y) of the enlarged view is the photo interpolated at
+    // (x, y) / factor: checked against bilinear interpolation written out, away from the border.
+    for (int row = factor; row < enlarged.height - factor; row += 7) {
+      for (int col = factor; col < enlarged.width - factor; col += 11) {
+        const double x = (col + 0.5) / factor - 0.5, y = (row + 0.5) / factor - 0.5;
+        const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+        const double fx = x - x0, fy = y - y0;
+        for (int channel = 0; channel < 3; ++channel) {
+          auto at = [&](int r, int c) { return double(view.image.at<cv::Vec3b>(r, c)[channel]); };
+          const double expected = (1 - fy) * ((1 - fx) * at(y0, x0) + fx * at(y0, x0 + 1)) +
+                                  fy * ((1 - fx) * at(y0 + 1, x0) + fx * at(y0 + 1, x0 + 1));
+          EXPECT_NEAR(enlarged.image.at<cv::Vec3b>(row, col)[channel], expected, 1.01)
+              << row << " " << col;
+        }
+      }
+    }
+    for (const Point2D& point2D : image.points2D) {
+      const Eigen::Vector3d xyz = reconstruction.points3D.at(point2D.point3D_id).xyz;
+      EXPECT_LT((enlarged.Project(xyz) - view.Project(xyz) * factor).norm(), 1e-9);
+    }
+    EXPECT_TRUE(enlarged.WorldFromPixel().col(2).isApprox(
+        view.WorldFromPixel() * Eigen::Vector3d(0, 0, 1)));  // the principal ray is the same
+    // The lone object pixel becomes a factor x factor block. The invalid pixel spoils every
+    // enlarged pixel interpolated from it (2 factor x 2 factor of them: no weight is 0 at these
+    // factors), and so does the lone object pixel, each of whose pixels blends it with the
+    // background; no other pixel is spoiled.
+    EXPECT_EQ(cv::countNonZero(enlarged.mask), factor * factor);
+    EXPECT_EQ(enlarged.mask.at<uint8_t>(50 * factor, 70 * factor), 255);
+    EXPECT_EQ(enlarged.valid.at<uint8_t>(10 * factor + factor / 2, 21 * factor + factor / 2), 0);
+    EXPECT_EQ(enlarged.valid.at<uint8_t>(50 * factor + factor / 2, 70 * factor + factor / 2), 0);
+    const int spoiled = enlarged.width * enlarged.height - cv::countNonZero(enlarged.valid);
+    EXPECT_EQ(spoiled, 2 * 4 * factor * factor);
+  }
+  const CalibratedView same = EnlargeView(view, 1);
+  EXPECT_EQ(same.image.data, view.image.data);
+}
+
+TEST(CalibratedView, MedianPixelFootprintIsDepthOverFocal) {
+  const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kPinhole));
+  const Reconstruction& reconstruction = scene.reconstruction;
+  std::vector<CalibratedView> views;
+  for (const auto& [id, image] : reconstruction.images) {
+    views.push_back(MakeCalibratedView(reconstruction.cameras.at(image.camera_id), image,
+                                       scene.photos.at(image.image_id), image.name));
+  }
+  const Eigen::Vector3d point = scene.object_box.center();
+  std::vector<double> widths;
+  for (const CalibratedView& view : views) {
+    widths.push_back(view.Depth(point) / (0.5 * (view.K(0, 0) + view.K(1, 1))));
+  }
+  std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
+  EXPECT_NEAR(MedianPixelFootprint(views, point), widths[widths.size() / 2], 1e-12);
+  // Enlarged photos: pixels that many times narrower.
+  std::vector<CalibratedView> enlarged;
+  for (const CalibratedView& view : views) enlarged.push_back(EnlargeView(view, 2));
+  EXPECT_NEAR(MedianPixelFootprint(enlarged, point), widths[widths.size() / 2] / 2, 1e-12);
+  EXPECT_EQ(MedianPixelFootprint({}, point), 0.0);
+}
+
 TEST(ViewReader, MissingPhotosAreErrorsOrSkippedAndCounted) {
   const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kSimpleRadial));
   const std::string root = testing::MakeTemporaryDirectory("view_reader");

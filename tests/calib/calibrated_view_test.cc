@@ -150,16 +150,24 @@ TEST(CalibratedView, PhotoOfTheWrongSizeIsAnErrorNamingIt) {
   }
 }
 
-TEST(CalibratedView, AReducedViewAveragesBlocksAndProjectsToScaledPixels) {
-  const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kPinhole));
+// The first view of a small pinhole scene (160 x 120), with an object mask of one isolated object
+// pixel at (row 50, col 70) and one invalid pixel at (10, 21).
+CalibratedView ViewWithLonePixels(const SyntheticScene& scene) {
   const Reconstruction& reconstruction = scene.reconstruction;
   const Image& image = reconstruction.images.begin()->second;
   CalibratedView view = MakeCalibratedView(reconstruction.cameras.at(image.camera_id), image,
                                            scene.photos.at(image.image_id), image.name);
-  // An object mask with one isolated object pixel, and one invalid pixel.
   view.mask = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
   view.mask.at<uint8_t>(50, 70) = 255;
   view.valid.at<uint8_t>(10, 21) = 0;
+  return view;
+}
+
+TEST(CalibratedView, AReducedViewAveragesBlocksAndProjectsToScaledPixels) {
+  const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kPinhole));
+  const Reconstruction& reconstruction = scene.reconstruction;
+  const Image& image = reconstruction.images.begin()->second;
+  const CalibratedView view = ViewWithLonePixels(scene);
   for (int factor : {2, 3, 7}) {  // 7 does not divide 160 or 120
     SCOPED_TRACE(factor);
     const CalibratedView reduced = ReduceView(view, factor);
@@ -204,11 +212,7 @@ TEST(CalibratedView, AnEnlargedViewInterpolatesAndProjectsToScaledPixels) {
   const SyntheticScene scene = GenerateSyntheticScene(SmallScene(CameraModelId::kPinhole));
   const Reconstruction& reconstruction = scene.reconstruction;
   const Image& image = reconstruction.images.begin()->second;
-  CalibratedView view = MakeCalibratedView(reconstruction.cameras.at(image.camera_id), image,
-                                           scene.photos.at(image.image_id), image.name);
-  view.mask = cv::Mat(view.height, view.width, CV_8UC1, cv::Scalar(0));
-  view.mask.at<uint8_t>(50, 70) = 255;
-  view.valid.at<uint8_t>(10, 21) = 0;
+  const CalibratedView view = ViewWithLonePixels(scene);
   for (int factor : {2, 4}) {
     SCOPED_TRACE(factor);
     const CalibratedView enlarged = EnlargeView(view, factor);

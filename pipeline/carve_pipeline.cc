@@ -278,8 +278,9 @@ void CarvePipeline::CheckVolume() {
     throw InputError("raycarve " + scope_.command + ": " + reason);
   }
   CheckVolumeSeen(scope_.command, project_, carved_, request_.options.min_views, request_.bounds);
-  // Said before the work: a voxel finer than a pixel of the photos gains no detail (the photos
-  // cannot tell its neighbours apart, and rays pass between voxels that are then never judged).
+  // Said before the work: a voxel finer than a pixel of the photos gains little detail (the
+  // photos cannot tell its neighbours apart; the carve supersamples its rays, so each voxel is
+  // still judged: CarveOptions::supersample), and under half a pixel it is refused.
   const double pixel = MedianPixelFootprint(carved_, project_.bounds.box.center());
   if (!(pixel > 0.0)) return;
   const auto measure = [&] {

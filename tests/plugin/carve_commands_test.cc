@@ -334,6 +334,20 @@ TEST_F(CarveCommands, AGridFinerThanThePhotosResolveIsRefusedWithWhatTheySupport
   EXPECT_LT(supported, 128);
   EXPECT_NEAR(JsonNumber(lowered_report, "voxel_pixels"), 1.0, 0.1);
   EXPECT_EQ(JsonNumber(lowered_report, "resolution"), supported);
+  // A voxel of about a pixel is under 1.5 rays: the final level's rays are supersampled from the
+  // photos enlarged twice, and its threshold measured at half the resolution on the photos as
+  // they are. At 24 voxels (several pixels each) nothing is enlarged.
+  const auto last_number = [](const std::string& json, const std::string& key) {
+    const size_t at = json.rfind("\"" + key + "\": ");
+    return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 4));
+  };
+  EXPECT_EQ(last_number(lowered_report, "image_enlargement"), 2);
+  EXPECT_EQ(last_number(lowered_report, "threshold_resolution"), supported / 2);
+  EXPECT_NE(output.find("(photos enlarged 2x)"), std::string::npos) << output;
+  EXPECT_EQ(last_number(report, "image_enlargement"), 1);
+  ExpectUserError("carve --workspace_path " + Project() + " --output_path " + *root_ +
+                      "/supersample3 --supersample 3",
+                  {"supersample must be 0 (automatic), 1, 2 or 4, got 3"});
 }
 
 TEST_F(CarveCommands, AVolumeNoPhotoSeesIsRefusedWithWhatEachPhotoSees) {

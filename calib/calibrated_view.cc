@@ -106,6 +106,23 @@ CalibratedView ReduceView(const CalibratedView& view, int factor) {
   return reduced;
 }
 
+cv::Mat EnlargedValid(const CalibratedView& view, int factor) {
+  const cv::Size size(view.width * factor, view.height * factor);
+  // Valid only where every input pixel the interpolation weighs is: a blend with the black
+  // beyond an undistorted frame is no photo colour.
+  cv::Mat weighed;
+  cv::resize(view.valid, weighed, size, 0, 0, cv::INTER_LINEAR);
+  cv::Mat valid = weighed == 255;
+  if (!view.mask.empty()) {
+    // Nor where it blends the object with the background: such a pixel is the colour of neither
+    // (the photo's own rim pixels stay, as in the view).
+    cv::Mat object;
+    cv::resize(view.mask != 0, object, size, 0, 0, cv::INTER_LINEAR);
+    valid &= (object == 0) | (object == 255);
+  }
+  return valid;
+}
+
 CalibratedView EnlargeView(const CalibratedView& view, int factor) {
   CHECK(factor >= 1 && factor <= 16) << "factor " << factor;
   if (factor == 1) return view;
@@ -116,18 +133,9 @@ CalibratedView EnlargeView(const CalibratedView& view, int factor) {
   // OpenCV samples output pixel x at input (x + 0.5) / factor - 0.5: pixel centres in COLMAP's
   // convention scale by `factor` exactly, as K does below.
   cv::resize(view.image, enlarged.image, size, 0, 0, cv::INTER_LINEAR);
-  // Valid only where every input pixel the interpolation weighs is: a blend with the black
-  // beyond an undistorted frame is no photo colour.
-  cv::Mat weighed;
-  cv::resize(view.valid, weighed, size, 0, 0, cv::INTER_LINEAR);
-  enlarged.valid = weighed == 255;
+  enlarged.valid = EnlargedValid(view, factor);
   if (!view.mask.empty()) {
     cv::resize(view.mask, enlarged.mask, size, 0, 0, cv::INTER_NEAREST);
-    // Nor where it blends the object with the background: such a pixel is the colour of neither
-    // (the photo's own rim pixels stay, as in the view).
-    cv::Mat object;
-    cv::resize(view.mask != 0, object, size, 0, 0, cv::INTER_LINEAR);
-    enlarged.valid &= (object == 0) | (object == 255);
   }
   Eigen::Matrix3d scale = Eigen::Matrix3d::Identity();
   scale(0, 0) = scale(1, 1) = factor;

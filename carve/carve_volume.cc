@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include <glog/logging.h>
+#include <opencv2/imgproc.hpp>
 
 #include "carve/free_space.h"
 #include "carve/item_buffer_visibility.h"
@@ -229,6 +230,16 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
     const std::vector<CalibratedView>& photos =
         final_level && stages.final_views ? *stages.final_views : views;
     const std::vector<CalibratedView>& level_views = ScaleViews(photos, image_scale, &scaled_views);
+    if (&photos != &views && image_scale.enlarge > 1) {
+      // A tile's views leave out pixels (carve/tiling.h: TileViews) by marking them invalid,
+      // though they hold photo colours: an enlarged pixel blending a kept and a left-out one is
+      // a photo colour, kept where its nearest photo pixel is.
+      for (size_t v = 0; v < views.size(); ++v) {
+        cv::Mat kept;
+        cv::resize(photos[v].valid, kept, scaled_views[v].valid.size(), 0, 0, cv::INTER_NEAREST);
+        scaled_views[v].valid = EnlargedValid(views[v], image_scale.enlarge) & kept;
+      }
+    }
     LevelStatistics level_statistics;
     if (final_level && stages.final_thresholds_given) {
       level_options.threshold = stages.final_threshold;

@@ -106,6 +106,9 @@ CalibratedView ReduceView(const CalibratedView& view, int factor) {
   return reduced;
 }
 
+namespace {
+
+// EnlargeView's valid pixels.
 cv::Mat EnlargedValid(const CalibratedView& view, int factor) {
   const cv::Size size(view.width * factor, view.height * factor);
   // Valid only where every input pixel the interpolation weighs is: a blend with the black
@@ -122,6 +125,8 @@ cv::Mat EnlargedValid(const CalibratedView& view, int factor) {
   }
   return valid;
 }
+
+}  // namespace
 
 CalibratedView EnlargeView(const CalibratedView& view, int factor) {
   CHECK(factor >= 1 && factor <= 16) << "factor " << factor;

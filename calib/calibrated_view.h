@@ -69,8 +69,6 @@ CalibratedView ReduceView(const CalibratedView& view, int factor);
 // background (a blend is the colour of neither); the mask by nearest neighbour. factor 1 returns
 // a copy sharing the pixels. CHECKs 1 <= factor <= 16.
 CalibratedView EnlargeView(const CalibratedView& view, int factor);
-// EnlargeView's valid pixels alone.
-cv::Mat EnlargedValid(const CalibratedView& view, int factor);
 
 // The median over `views` of the width a pixel spans at `point` (depth / focal length, in world
 // units), over the views that have it in front; 0 when none has.

@@ -74,8 +74,8 @@ const std::vector<CalibratedView>& ScaleViews(const std::vector<CalibratedView>&
 // `enlarge` times coarser, the finest they resolve: interpolated rays add samples, not evidence,
 // and the errors of voxels finer than a pixel understate how far views must disagree for space
 // to be empty (measured on the paper scene at 512 voxels: estimated on the enlarged photos the
-// threshold fell from 17.6 to 12.6 and the objects' surface within 2 voxels of 256 lost 1.5
-// points of precision and 3 of completeness).
+// threshold fell from 17.6 to 9.7, and within 2 voxels of 256 the objects' precision fell from
+// 95.2% to 85.8% and their completeness from 98.3% to 94.1%).
 void ChooseLevelThresholds(const std::vector<CalibratedView>& level_views,
                            const std::vector<CalibratedView>& photos,
                            const Eigen::AlignedBox3d& box,
@@ -229,16 +229,16 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
     scaled_views.clear();  // the last level's go before this one's are made
     const std::vector<CalibratedView>& photos =
         final_level && stages.final_views ? *stages.final_views : views;
-    const std::vector<CalibratedView>& level_views = ScaleViews(photos, image_scale, &scaled_views);
-    if (&photos != &views && image_scale.enlarge > 1) {
-      // A tile's views leave out pixels (carve/tiling.h: TileViews) by marking them invalid,
-      // though they hold photo colours: an enlarged pixel blending a kept and a left-out one is
-      // a photo colour, kept where its nearest photo pixel is.
-      for (size_t v = 0; v < views.size(); ++v) {
-        cv::Mat kept;
-        cv::resize(photos[v].valid, kept, scaled_views[v].valid.size(), 0, 0, cv::INTER_NEAREST);
-        scaled_views[v].valid = EnlargedValid(views[v], image_scale.enlarge) & kept;
-      }
+    // A tile's views (carve/tiling.h: TileViews) are the carve's photos with the pixels it
+    // leaves out marked invalid, though they hold photo colours: enlarged, the photos are, and an
+    // enlarged pixel is left out where its nearest photo pixel is (not where it blends one).
+    const bool enlarged_tile = &photos != &views && image_scale.enlarge > 1;
+    const std::vector<CalibratedView>& level_views =
+        ScaleViews(enlarged_tile ? views : photos, image_scale, &scaled_views);
+    for (size_t v = 0; enlarged_tile && v < views.size(); ++v) {
+      cv::Mat kept;
+      cv::resize(photos[v].valid, kept, scaled_views[v].valid.size(), 0, 0, cv::INTER_NEAREST);
+      scaled_views[v].valid &= kept;
     }
     LevelStatistics level_statistics;
     if (final_level && stages.final_thresholds_given) {

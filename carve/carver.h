@@ -332,15 +332,15 @@ BoxCoverage MeasureBoxCoverage(const std::vector<CalibratedView>& views,
                                const Eigen::AlignedBox3d& box,
                                int min_views);
 
-// Carves the volume over `box` seen by `views` until no voxel whose visibility changed is
-// inconsistent. `progress` (optional) is called about every `progress_interval_seconds` of
-// carving. Options must pass CheckCarveFits (CHECKed).
 // The photos' enlargement at the final level (CarveOptions::supersample, resolved where automatic):
 // 1 when the views' pixels at the box's centre are at most 1 / kMinRaysPerVoxel of a voxel.
 int FinalSupersample(const std::vector<CalibratedView>& views,
                      const Eigen::AlignedBox3d& box,
                      const CarveOptions& options);
 
+// Carves the volume over `box` seen by `views` until no voxel whose visibility changed is
+// inconsistent. `progress` (optional) is called about every `progress_interval_seconds` of
+// carving. Options must pass CheckCarveFits (CHECKed).
 CarveResult CarveVolume(const std::vector<CalibratedView>& views,
                         const Eigen::AlignedBox3d& box,
                         const CarveOptions& options,

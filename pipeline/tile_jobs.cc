@@ -48,30 +48,34 @@ void MakeExecutable(const fs::path& path) {
 // tiles.sbatch (an array over the jobs), merge.sbatch and submit_slurm.sh (the merge after every
 // task of the array succeeded).
 void WriteSlurmJobs(const fs::path& folder, const TilePlan& plan, const JobCommands& jobs) {
-  std::ostringstream tiles;
-  tiles << "#!/bin/bash\n"
-        << "# raycarve tile jobs of plan " << plan.plan_id << ": one array task per tile with work.\n"
-        << "# Memory and time: the largest tile's estimate (plan.json lists each tile's).\n"
-        << "#SBATCH --job-name=raycarve-tiles\n"
-        << "#SBATCH --array=0-" << std::max(0, plan.jobs - 1) << "\n"
-        << "#SBATCH --cpus-per-task=2\n"
-        << "#SBATCH --mem=" << MemoryMiB(jobs.memory_gib) << "M\n"
-        << "#SBATCH --time=" << SlurmTime(jobs.minutes) << "\n"
-        << "#SBATCH --output=" << jobs.logs << "/tile_%a.log\n"
-        << "cd " << Quoted(plan.working_directory) << "\n"
-        << "exec " << jobs.run << " --index \"$SLURM_ARRAY_TASK_ID\"\n";
-  WriteTextFileAtomically((folder / "tiles.sbatch").string(), tiles.str());
-  std::ostringstream merge;
-  merge << "#!/bin/bash\n"
-        << "# raycarve: joins the tiles of plan " << plan.plan_id << " and writes the model.\n"
-        << "#SBATCH --job-name=raycarve-merge\n"
-        << "#SBATCH --cpus-per-task=2\n"
-        << "#SBATCH --mem=" << MemoryMiB(plan.merge_memory_gib) << "M\n"
-        << "#SBATCH --time=" << SlurmTime(plan.merge_minutes) << "\n"
-        << "#SBATCH --output=" << jobs.logs << "/merge.log\n"
-        << "cd " << Quoted(plan.working_directory) << "\n"
-        << "exec " << jobs.merge << "\n";
-  WriteTextFileAtomically((folder / "merge.sbatch").string(), merge.str());
+  // One sbatch script: its comment lines, name, extra directives, request and command.
+  const auto script = [&](const std::string& comment, const std::string& name,
+                          const std::string& directives, double memory_gib, double minutes,
+                          const std::string& log, const std::string& command) {
+    std::ostringstream text;
+    text << "#!/bin/bash\n" << comment << "#SBATCH --job-name=" << name << "\n" << directives
+         << "#SBATCH --cpus-per-task=2\n"
+         << "#SBATCH --mem=" << MemoryMiB(memory_gib) << "M\n"
+         << "#SBATCH --time=" << SlurmTime(minutes) << "\n"
+         << "#SBATCH --output=" << jobs.logs << "/" << log << "\n"
+         << "cd " << Quoted(plan.working_directory) << "\n"
+         << "exec " << command << "\n";
+    return text.str();
+  };
+  WriteTextFileAtomically(
+      (folder / "tiles.sbatch").string(),
+      script("# raycarve tile jobs of plan " + plan.plan_id +
+                 ": one array task per tile with work.\n"
+                 "# Memory and time: the largest tile's estimate (plan.json lists each tile's).\n",
+             "raycarve-tiles",
+             "#SBATCH --array=0-" + std::to_string(std::max(0, plan.jobs - 1)) + "\n",
+             jobs.memory_gib, jobs.minutes, "tile_%a.log",
+             jobs.run + " --index \"$SLURM_ARRAY_TASK_ID\""));
+  WriteTextFileAtomically(
+      (folder / "merge.sbatch").string(),
+      script("# raycarve: joins the tiles of plan " + plan.plan_id + " and writes the model.\n",
+             "raycarve-merge", "", plan.merge_memory_gib, plan.merge_minutes, "merge.log",
+             jobs.merge));
   std::ostringstream submit;
   submit << "#!/bin/bash\n"
          << "# Submits the tile array, then the merge once every task has succeeded.\n"

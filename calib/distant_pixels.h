@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -43,15 +45,25 @@ struct DistantOptions {
   // noise (ImageNoiseSigma) and at least `min_texture` grey levels.
   double texture_noise_factor = 4.0;
   double min_texture = 4.0;
+  // A patch is judged only when each of its four quadrants (the centre's row and column shared)
+  // is textured too: at an occluder's edge the plain side of the patch says nothing of where
+  // that side lies, and the textured side alone would carry the match (FindGroundPixels: a plain
+  // box's foot on a textured floor). Off for the distant test (a sky's edge is its own).
+  bool textured_quadrants = false;
+  // Whether plain regions are judged by their rims (above).
+  bool grow_plain_regions = true;
   int num_threads = 1;  // < 1: one per hardware thread
 
   bool IsValid(std::string* reason) const;
 };
 
-// A distant pixel's ray: `view` indexes the views, `direction` is a unit world direction.
+// A distant pixel's ray: `view` indexes the views, `direction` is a unit world direction. The
+// photo saw across empty space along it up to `length` from its centre (infinite for a distant
+// pixel; where a ground pixel's ray comes near the ground, FindGroundPixels in carve/ground.h).
 struct DistantRay {
   int view = 0;
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+  double length = std::numeric_limits<double>::infinity();
 };
 
 struct DistantPixels {
@@ -78,6 +90,23 @@ DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
                                 const Eigen::AlignedBox3d& box,
                                 const DistantOptions& options,
                                 const std::vector<std::vector<Eigen::Vector2d>>& observations = {});
+
+// The test above with another surface in place of infinity: `surface` says where the ray from
+// `centre` along the unit `direction` meets the supposed surface (*at, a distance along the ray;
+// infinity for the sky) and up to where the ray, if it ends there, crossed space that the photos
+// can tell from it (*clear_to <= *at); false where it says nothing of that ray. A pixel matches
+// the surface when its patch, each pixel's ray ending on the surface, matches the other photos
+// there clearly better than anywhere on its ray inside `box` up to *clear_to, that part's far end
+// lying at least `min_parallax` pixels from the surface's point. Rays are those of the pixels
+// found (judged and grown), with `length` *clear_to where the surface is at a finite distance.
+// FindDistantPixels is this with the sky at infinity (clear_to: the box's far side).
+using SupposedSurface = std::function<bool(const Eigen::Vector3d& centre, const Eigen::Vector3d& direction,
+                                           double* at, double* clear_to)>;
+DistantPixels FindPixelsOnSurface(const std::vector<CalibratedView>& views,
+                                  const Eigen::AlignedBox3d& box,
+                                  const DistantOptions& options,
+                                  const SupposedSurface& surface,
+                                  const std::vector<std::vector<Eigen::Vector2d>>& observations = {});
 
 // The noise of a grey image (CV_32F) in grey levels: after Immerkaer, the response to the
 // difference of two Laplacians, its median absolute value scaled for a Gaussian (robust to

@@ -189,13 +189,13 @@ FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
     // Camera depth per unit along the ray.
     const double depth_rate = (view.cam_from_world.rotation * ray.direction).z();
     if (!(depth_rate > 0.0)) return false;
-    double length = (box.center() - centre).norm() + beyond;
+    double length = std::min(ray.length, (box.center() - centre).norm() + beyond);
     if (!known[ray.view].empty()) {
       const Eigen::Vector2d pixel = view.Project(centre + ray.direction);
       const int col = static_cast<int>(std::floor(pixel.x())), row = static_cast<int>(std::floor(pixel.y()));
       if (col >= 0 && row >= 0 && col < known[ray.view].cols && row < known[ray.view].rows) {
         const float depth = known[ray.view].at<float>(row, col);
-        if (depth > 0.0f) length = depth / depth_rate - margin_voxels * grid.voxel_size();
+        if (depth > 0.0f) length = std::min(length, depth / depth_rate - margin_voxels * grid.voxel_size());
       }
     }
     if (!(length > 0.0)) return false;

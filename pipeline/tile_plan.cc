@@ -410,7 +410,7 @@ std::vector<uint64_t> ReadTilePart(const std::string& path, const TilePlan& plan
 
 namespace {
 
-constexpr char kRaysMagic[8] = {'R', 'C', 'R', 'A', 'Y', 'S', '0', '1'};
+constexpr char kRaysMagic[8] = {'R', 'C', 'R', 'A', 'Y', 'S', '0', '2'};
 
 struct RaysHeader {
   char magic[8];
@@ -426,6 +426,7 @@ struct RaysHeader {
 struct RayRecord {
   int64_t view;
   double direction[3];
+  double length;  // +infinity for a distant pixel's ray
 };
 
 }  // namespace
@@ -443,7 +444,7 @@ void WriteDistantPixels(const std::string& path, const std::string& plan_id,
   header.count = distant.rays.size();
   std::string bytes(reinterpret_cast<const char*>(&header), sizeof(header));
   for (const DistantRay& ray : distant.rays) {
-    const RayRecord record{ray.view, {ray.direction.x(), ray.direction.y(), ray.direction.z()}};
+    const RayRecord record{ray.view, {ray.direction.x(), ray.direction.y(), ray.direction.z()}, ray.length};
     bytes.append(reinterpret_cast<const char*>(&record), sizeof(record));
   }
   WriteTextFileAtomically(path, bytes);
@@ -486,10 +487,11 @@ DistantPixels ReadDistantPixels(const std::string& path, const TilePlan& plan) {
     in.read(reinterpret_cast<char*>(&record), sizeof(record));
     const Eigen::Vector3d direction(record.direction[0], record.direction[1], record.direction[2]);
     if (!in || record.view < 0 || record.view > std::numeric_limits<int>::max() ||
-        !direction.allFinite() || !(direction.norm() > 0.0)) {
-      throw InputError(path + ": ray " + std::to_string(i) + " is not a view and a direction");
+        !direction.allFinite() || !(direction.norm() > 0.0) || !(record.length > 0.0)) {
+      throw InputError(path + ": ray " + std::to_string(i) +
+                       " is not a view, a direction and a positive length");
     }
-    distant.rays.push_back({static_cast<int>(record.view), direction});
+    distant.rays.push_back({static_cast<int>(record.view), direction, record.length});
   }
   return distant;
 }

@@ -138,7 +138,8 @@ TEST(CarveFreeSpace, NoPointsOrAZeroMarginCarveOnlyWhatTheLinesReach) {
 }
 
 // A distant pixel's ray carves its whole column; where a sparse point the photo saw lies near
-// the pixel, the ray stops two voxels short of it; the voxels to keep stay.
+// the pixel, the ray stops two voxels short of it; the voxels to keep stay; a ray with a length
+// stops there.
 TEST(CarveDistantRays, CarveTheWholeRayOrStopShortOfTheKnownSurface) {
   const VoxelGrid grid(Eigen::AlignedBox3d(Eigen::Vector3d::Constant(-0.5), Eigen::Vector3d::Constant(0.5)), 10);
   const std::vector<uint64_t> all((grid.num_voxels() + 63) / 64, ~uint64_t{0});
@@ -160,6 +161,14 @@ TEST(CarveDistantRays, CarveTheWholeRayOrStopShortOfTheKnownSurface) {
   s = CarveDistantRays(views, {ray}, {point}, 2.0, {grid.Index(Eigen::Vector3i(5, 5, 9))}, &stopped);
   for (int z = 0; z < 10; ++z) EXPECT_EQ(stopped.IsSolid(Eigen::Vector3i(5, 5, z)), z < 7 || z == 9) << z;
   EXPECT_EQ(s.carved, 2);
+  // A ground pixel's ray ends where its length does (z = 5 - 4.55 = 0.45, in voxel 9), and a
+  // known surface farther along does not carry it on.
+  DistantRay ground_ray = ray;
+  ground_ray.length = -4.55 / ray.direction.z();
+  Volume short_ray(grid, all);
+  s = CarveDistantRays(views, {ground_ray}, {point}, 2.0, {}, &short_ray);
+  for (int z = 0; z < 10; ++z) EXPECT_EQ(short_ray.IsSolid(Eigen::Vector3i(5, 5, z)), z < 9) << z;
+  EXPECT_EQ(s.carved, 1);
   // A ray pointing away from the photo's axis carves nothing.
   Volume behind(grid, all);
   EXPECT_EQ(CarveDistantRays(views, {DistantRay{0, -ray.direction}}, {}, 2.0, {}, &behind).carved, 0);

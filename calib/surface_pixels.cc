@@ -1,0 +1,543 @@
+// The search behind FindDistantPixels and FindGroundPixels (carve/ground_pixels.h):
+// FindPixelsOnSurface of calib/distant_pixels.h, which declares it. Photos reduced, patches
+// compared under the supposed surface's mapping and along each pixel's ray, plain regions judged
+// by their rims.
+#include "calib/distant_pixels.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include <glog/logging.h>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/pixel.h"
+#include "calib/ray_box.h"
+
+namespace raycarve {
+
+namespace {
+
+// The verdicts in DistantPixels::masks.
+constexpr uint8_t kDistantJudged = 255;
+constexpr uint8_t kGrown = 200;
+constexpr uint8_t kUndecided = 128;
+constexpr uint8_t kNearer = 64;
+// A plain region is distant when at least this many of the judged pixels on its rim, and this
+// share of them, are distant, and those found nearer are at most this share of the distant.
+constexpr int kMinRimVotes = 3;
+constexpr double kMinRimShare = 0.25;
+constexpr double kMaxRimNearShare = 0.05;
+// A match's correlation loses this much per standard deviation (of the photo's patch) between the
+// two patches' mean colours.
+constexpr double kMeanPenalty = 0.25;
+// The volume's segment is searched with samples about this many pixels apart, first with every
+// other row and column of the patch; the best sample and its two neighbours are then judged with
+// the whole patch. (Where the search costs most: it ran 8.5 s of a 26 s carve of 25 photos of
+// 1600 x 1200 judged whole and a pixel apart.)
+constexpr double kSegmentStep = 1.5;
+
+// A photo as judged: reduced, with its geometry in the reduced pixels. Eight bits a channel: a
+// photo of 640 x 480 holds 1.2 MB here, 200 of them 240 MB.
+struct ReducedView {
+  cv::Mat rgb;    // CV_8UC3
+  cv::Mat valid;  // CV_8UC1
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // camera from world
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 3, 4> P = Eigen::Matrix<double, 3, 4>::Zero();
+  int factor = 1;
+  double texture = 0.0;  // the smallest standard deviation of a textured patch
+};
+
+// The photo in grey levels (CV_32F).
+cv::Mat Grey(const ReducedView& g) {
+  cv::Mat rgb, grey;
+  g.rgb.convertTo(rgb, CV_32FC3);
+  cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+  return grey;
+}
+
+ReducedView ReducedViewOf(const CalibratedView& view, const DistantOptions& options) {
+  ReducedView g;
+  g.factor = std::max(1, (std::max(view.width, view.height) + options.max_side - 1) / options.max_side);
+  g.factor = std::min(g.factor, std::max(1, std::min(view.width, view.height)));
+  const CalibratedView reduced = ReduceView(view, g.factor);
+  g.rgb = reduced.image;
+  g.valid = reduced.valid.empty() ? cv::Mat(reduced.image.size(), CV_8UC1, cv::Scalar(255))
+                                  : reduced.valid.clone();
+  g.K = reduced.K;
+  g.R = reduced.cam_from_world.rotation.toRotationMatrix();
+  g.centre = reduced.centre;
+  g.P = reduced.P;
+  g.texture = std::max(options.min_texture, options.texture_noise_factor * ImageNoiseSigma(Grey(g)));
+  return g;
+}
+
+// Bilinear RGB at a COLMAP pixel position into value[0..2]; false outside the valid pixels.
+bool Sample(const ReducedView& g, const Eigen::Vector2d& colmap, float* value) {
+  const Eigen::Vector2d cv = OpenCvFromColmap(colmap);
+  const int x0 = static_cast<int>(std::floor(cv.x())), y0 = static_cast<int>(std::floor(cv.y()));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= g.rgb.cols || y0 + 1 >= g.rgb.rows) return false;
+  if (!g.valid.at<uint8_t>(y0, x0) || !g.valid.at<uint8_t>(y0 + 1, x0 + 1)) return false;
+  const float fx = static_cast<float>(cv.x() - x0), fy = static_cast<float>(cv.y() - y0);
+  const cv::Vec3b* a = g.rgb.ptr<cv::Vec3b>(y0);
+  const cv::Vec3b* b = g.rgb.ptr<cv::Vec3b>(y0 + 1);
+  for (int c = 0; c < 3; ++c) {
+    value[c] = (1 - fy) * ((1 - fx) * a[x0][c] + fx * a[x0 + 1][c]) +
+               fy * ((1 - fx) * b[x0][c] + fx * b[x0 + 1][c]);
+  }
+  return true;
+}
+
+// A patch of RGB samples (k * 3 + channel), each channel less its mean: the means and the
+// squared norm of what is left.
+struct CentredPatch {
+  std::vector<float> values;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double norm = 0.0;
+
+  // Takes the samples' means out (values as sampled in, centred out).
+  void Centre() {
+    const size_t count = values.size() / 3;
+    norm = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0.0;
+      for (size_t k = 0; k < count; ++k) sum += values[3 * k + c];
+      mean[c] = sum / static_cast<double>(count);
+      for (size_t k = 0; k < count; ++k) {
+        values[3 * k + c] = static_cast<float>(values[3 * k + c] - mean[c]);
+        norm += values[3 * k + c] * values[3 * k + c];
+      }
+    }
+  }
+};
+
+// How well photo j sampled at `centre` + `offsets` matches the centred patch `a`: the zero-mean
+// normalised correlation over the three channels (in colour, an edge between two colours does not
+// match an edge between two others, as it would in grey), less kMeanPenalty times the difference
+// of the means in units of a's standard deviation (a smooth ramp, a soft cloud's edge, correlates
+// with itself shifted along it; its mean does not). -1 where a sample falls outside j's valid
+// pixels or either patch is plain. `b` is the caller's buffer.
+double Correlation(const CentredPatch& a, const ReducedView& j, const Eigen::Vector2d& centre,
+                   const std::vector<Eigen::Vector2d>& offsets, CentredPatch* b) {
+  if (!(a.norm > 1e-6)) return -1.0;
+  b->values.resize(3 * offsets.size());
+  for (size_t k = 0; k < offsets.size(); ++k) {
+    if (!Sample(j, centre + offsets[k], &b->values[3 * k])) return -1.0;
+  }
+  b->Centre();
+  if (!(b->norm > 1e-6)) return -1.0;
+  double dot = 0.0;
+  for (size_t k = 0; k < b->values.size(); ++k) dot += a.values[k] * b->values[k];
+  const double a_deviation = std::sqrt(a.norm / static_cast<double>(b->values.size()));
+  const double shift = (b->mean - a.mean).norm() / std::sqrt(3.0);
+  return dot / std::sqrt(a.norm * b->norm) - kMeanPenalty * shift / a_deviation;
+}
+
+// One pair's geometry for one pixel: where the supposed surface and the ray's segment inside the
+// volume land in photo j.
+struct PairGeometry {
+  int partner = -1;
+  Eigen::Vector2d on_surface;
+  std::vector<Eigen::Vector2d> offsets;  // the patch's pixels on the surface, around on_surface
+  std::vector<Eigen::Vector2d> segment;  // samples of the ray inside the volume, projected
+};
+
+bool ProjectInFront(const ReducedView& j, const Eigen::Vector4d& x, Eigen::Vector2d* pixel) {
+  const Eigen::Vector3d h = j.P * x;
+  if (!(h.z() > 1e-9)) return false;
+  *pixel = h.hnormalized();
+  return true;
+}
+
+bool ProjectPointInFront(const ReducedView& j, const Eigen::Vector3d& x, Eigen::Vector2d* pixel) {
+  return ProjectInFront(j, Eigen::Vector4d(x.homogeneous()), pixel);
+}
+
+// A pixel's ray and where the supposed surface puts its patch: `points` per patch pixel, a
+// homogeneous world point (w = 0: a direction, at infinity).
+struct PixelRay {
+  Eigen::Vector3d direction;  // unit
+  double t0 = 0.0, t1 = 0.0;  // the part inside the volume that is compared with the surface
+  double at = 0.0;            // where the centre's ray meets the surface
+  std::vector<Eigen::Vector4d> points;
+};
+
+Eigen::Vector4d SurfacePoint(const Eigen::Vector3d& centre, const Eigen::Vector3d& direction, double at) {
+  if (std::isinf(at)) return Eigen::Vector4d(direction.x(), direction.y(), direction.z(), 0.0);
+  return (centre + at * direction).homogeneous();
+}
+
+bool PairFor(const ReducedView& i, const ReducedView& j, int partner, const PixelRay& ray,
+             size_t centre_index, const DistantOptions& options, PairGeometry* pair) {
+  Eigen::Vector2d q;
+  if (!ProjectInFront(j, ray.points[centre_index], &q)) return false;  // behind photo j
+  const double margin = options.patch_radius + 2.0;
+  if (q.x() < margin || q.y() < margin || q.x() > j.rgb.cols - margin ||
+      q.y() > j.rgb.rows - margin) {
+    return false;
+  }
+  // The segment's far end must be told apart from the surface.
+  Eigen::Vector2d far;
+  if (!ProjectPointInFront(j, i.centre + ray.t1 * ray.direction, &far)) return false;
+  if ((far - q).norm() < options.min_parallax) return false;
+  pair->partner = partner;
+  pair->on_surface = q;
+  pair->offsets.clear();
+  for (const Eigen::Vector4d& x : ray.points) {
+    Eigen::Vector2d pixel;
+    if (!ProjectInFront(j, x, &pixel)) return false;
+    pair->offsets.push_back(pixel - q);
+  }
+  // Samples uniform in inverse distance (about uniform in the image), about a pixel apart, of the
+  // part of the segment in front of photo j.
+  pair->segment.clear();
+  Eigen::Vector2d near_pixel = Eigen::Vector2d::Zero();
+  double t_near = std::max(ray.t0, 1e-6);
+  while (t_near < ray.t1 && !ProjectPointInFront(j, i.centre + t_near * ray.direction, &near_pixel)) {
+    t_near = t_near * 2.0 + 1e-6;
+  }
+  if (!(t_near < ray.t1)) return true;
+  const double length = (near_pixel - far).norm();
+  const int count = std::clamp(static_cast<int>(std::ceil(length / kSegmentStep)) + 1, 2, 128);
+  for (int k = 0; k < count; ++k) {
+    const double s = 1.0 / ray.t1 + (1.0 / t_near - 1.0 / ray.t1) * k / (count - 1);
+    Eigen::Vector2d pixel;
+    if (ProjectPointInFront(j, i.centre + ray.direction / s, &pixel)) pair->segment.push_back(pixel);
+  }
+  return true;
+}
+
+// The ray of pixel p of photo i (COLMAP coordinates) and the surface's points for its patch; false
+// where the surface says nothing of it or it does not cross the volume in front of the surface.
+bool RayOf(const ReducedView& i, const Eigen::Vector2d& p, const Eigen::AlignedBox3d& box,
+           const std::vector<Eigen::Vector2d>& patch, const SupposedSurface& surface,
+           PixelRay* ray) {
+  const Eigen::Matrix3d pixel_to_world = i.R.transpose() * i.K.inverse();
+  ray->direction = (pixel_to_world * p.homogeneous()).normalized();
+  double clear_to = 0.0;
+  if (!surface(i.centre, ray->direction, &ray->at, &clear_to)) return false;
+  if (!ClipRayToBox(i.centre, ray->direction, box, &ray->t0, &ray->t1)) return false;
+  ray->t1 = std::min(ray->t1, clear_to);
+  if (!(ray->t1 > ray->t0)) return false;
+  ray->points.clear();
+  for (const Eigen::Vector2d& o : patch) {
+    const Eigen::Vector3d d = (pixel_to_world * (p + o).homogeneous()).normalized();
+    double at = 0.0, unused = 0.0;
+    if (!surface(i.centre, d, &at, &unused)) return false;
+    ray->points.push_back(SurfacePoint(i.centre, d, at));
+  }
+  return true;
+}
+
+// Judges the textured pixels of one photo against the others (one per thread at a time).
+class PhotoJudge {
+ public:
+  PhotoJudge(const std::vector<ReducedView>& views, int v, const Eigen::AlignedBox3d& box,
+             const std::vector<Eigen::Vector2d>& patch, const SupposedSurface& surface,
+             const DistantOptions& options)
+      : views_(views), i_(views[v]), box_(box), patch_(patch), surface_(surface), options_(options) {
+    // Partners: the other photos, farthest first (the most parallax).
+    for (int w = 0; w < static_cast<int>(views.size()); ++w) {
+      if (w != v) partners_.push_back(w);
+    }
+    std::stable_sort(partners_.begin(), partners_.end(), [&](int x, int y) {
+      return (views[x].centre - i_.centre).squaredNorm() > (views[y].centre - i_.centre).squaredNorm();
+    });
+    // The coarse search's samples: every other row and column of the patch.
+    const int side = 2 * options.patch_radius + 1;
+    for (size_t k = 0; k < patch.size(); ++k) {
+      if ((k % side) % 2 == 0 && (k / side) % 2 == 0) kept_.push_back(k);
+    }
+  }
+
+  // The verdict on pixel p, whose centred patch is `a`: 1 on the surface, -1 nearer, 0 neither.
+  // `ray` is p's ray (RayOf).
+  int Verdict(const PixelRay& ray, const CentredPatch& a) {
+    // First the cheap test on the surface, on up to max_partners photos.
+    pairs_.clear();
+    on_surface_.clear();
+    int matched = 0;
+    const size_t centre_index = patch_.size() / 2;
+    for (int partner : partners_) {
+      if (static_cast<int>(pairs_.size()) >= options_.max_partners) break;
+      PairGeometry pair;
+      if (!PairFor(i_, views_[partner], partner, ray, centre_index, options_, &pair)) continue;
+      const double c = Correlation(a, views_[partner], pair.on_surface, pair.offsets, &buffer_);
+      on_surface_.push_back(c);
+      if (c >= options_.min_correlation) ++matched;
+      pairs_.push_back(std::move(pair));
+    }
+    if (matched < options_.min_agreeing_views) return 0;
+    // Then the volume's segment, in every photo asked: one that matches inside clearly better is
+    // a veto; a match on the surface counts where nothing inside comes near it.
+    coarse_.values.clear();
+    for (size_t k : kept_) {
+      coarse_.values.insert(coarse_.values.end(), {a.values[3 * k], a.values[3 * k + 1], a.values[3 * k + 2]});
+    }
+    coarse_.Centre();
+    coarse_.mean += a.mean;  // a's values were centred already
+    int agreeing = 0;
+    for (size_t k = 0; k < pairs_.size(); ++k) {
+      const double inside = BestInside(a, pairs_[k]);
+      if (inside >= options_.min_correlation && inside - on_surface_[k] >= options_.min_advantage) {
+        return -1;
+      }
+      if (on_surface_[k] >= options_.min_correlation &&
+          on_surface_[k] - inside >= options_.min_advantage) {
+        ++agreeing;
+      }
+    }
+    return agreeing >= options_.min_agreeing_views ? 1 : 0;
+  }
+
+ private:
+  // The best match on the pair's segment: searched with the coarse patch, then the whole patch
+  // at the best sample and its two neighbours. -1 where none can be judged.
+  double BestInside(const CentredPatch& a, const PairGeometry& pair) {
+    const ReducedView& j = views_[pair.partner];
+    coarse_offsets_.clear();
+    for (size_t k : kept_) coarse_offsets_.push_back(pair.offsets[k]);
+    const auto away = [&](int s) {
+      return s >= 0 && s < static_cast<int>(pair.segment.size()) &&
+             (pair.segment[s] - pair.on_surface).norm() >= options_.min_parallax;
+    };
+    double best = -2.0;
+    int best_sample = -1;
+    for (int s = 0; s < static_cast<int>(pair.segment.size()); ++s) {
+      if (!away(s)) continue;
+      const double c = Correlation(coarse_, j, pair.segment[s], coarse_offsets_, &buffer_);
+      if (c > best) {
+        best = c;
+        best_sample = s;
+      }
+    }
+    double inside = -1.0;
+    for (int s = best_sample - 1; best_sample >= 0 && s <= best_sample + 1; ++s) {
+      if (away(s)) inside = std::max(inside, Correlation(a, j, pair.segment[s], pair.offsets, &buffer_));
+    }
+    return inside;
+  }
+
+  const std::vector<ReducedView>& views_;
+  const ReducedView& i_;
+  const Eigen::AlignedBox3d& box_;
+  const std::vector<Eigen::Vector2d>& patch_;
+  const SupposedSurface& surface_;
+  const DistantOptions& options_;
+  std::vector<int> partners_;
+  std::vector<size_t> kept_;
+  // Scratch, kept between pixels.
+  std::vector<PairGeometry> pairs_;
+  std::vector<double> on_surface_;
+  CentredPatch coarse_, buffer_;
+  std::vector<Eigen::Vector2d> coarse_offsets_;
+};
+
+// Whether each quadrant of the patch (rows and columns <= 0 and >= 0 of its centre, raw RGB
+// samples in row order) has a grey standard deviation of at least `texture`.
+bool QuadrantsTextured(const std::vector<float>& values, int radius, double texture) {
+  const int side = 2 * radius + 1;
+  for (int qy = 0; qy < 2; ++qy) {
+    for (int qx = 0; qx < 2; ++qx) {
+      double sum = 0.0, square = 0.0;
+      int count = 0;
+      for (int y = qy * radius; y <= qy * radius + radius; ++y) {
+        for (int x = qx * radius; x <= qx * radius + radius; ++x) {
+          const size_t k = static_cast<size_t>(y * side + x);
+          const double grey = 0.299 * values[3 * k] + 0.587 * values[3 * k + 1] + 0.114 * values[3 * k + 2];
+          sum += grey;
+          square += grey * grey;
+          ++count;
+        }
+      }
+      const double mean = sum / count;
+      if (!(square / count - mean * mean >= texture * texture)) return false;
+    }
+  }
+  return true;
+}
+
+// The plain regions (connected pixels whose patch is not textured) whose rim is mostly found
+// distant: the inside of a patch of sky whose edges move as the sky does. Marks them kGrown in
+// `mask` (which holds the judged pixels' verdicts), counts their pixels in *grown and returns the
+// pixels (COLMAP coordinates) of their rays, every `stride` pixels. A region holding one of
+// `seen` (the photo's own pixels of sparse points inside the volume) is never distant: a plain
+// object that runs into a sky of its colour without an edge has points where it has detail.
+std::vector<Eigen::Vector2d> GrowIntoPlainRegions(const ReducedView& g, const DistantOptions& options,
+                                                  const std::vector<Eigen::Vector2d>& seen,
+                                                  cv::Mat* mask, int64_t* grown) {
+  const int side = 2 * options.patch_radius + 1;
+  cv::Mat mean, square;
+  const cv::Mat grey = Grey(g);
+  cv::boxFilter(grey, mean, CV_32F, cv::Size(side, side));
+  cv::boxFilter(grey.mul(grey), square, CV_32F, cv::Size(side, side));
+  cv::Mat plain(grey.size(), CV_8UC1, cv::Scalar(0));
+  const float limit = static_cast<float>(g.texture * g.texture);
+  for (int row = options.patch_radius; row < grey.rows - options.patch_radius; ++row) {
+    for (int col = options.patch_radius; col < grey.cols - options.patch_radius; ++col) {
+      const float m = mean.at<float>(row, col);
+      if (square.at<float>(row, col) - m * m < limit && g.valid.at<uint8_t>(row, col)) {
+        plain.at<uint8_t>(row, col) = 255;
+      }
+    }
+  }
+  cv::Mat labels;
+  const int count = cv::connectedComponents(plain, labels, 4, CV_32S);
+  // Per region, the verdicts of the judged pixels within reach of it (a patch and a stride).
+  std::vector<int> distant(count, 0), judged(count, 0), nearer(count, 0), size(count, 0);
+  for (int row = 0; row < labels.rows; ++row) {
+    for (int col = 0; col < labels.cols; ++col) ++size[labels.at<int>(row, col)];
+  }
+  const int reach = options.patch_radius + options.stride;
+  std::vector<int> near_labels;
+  for (int row = 0; row < mask->rows; ++row) {
+    for (int col = 0; col < mask->cols; ++col) {
+      const uint8_t verdict = mask->at<uint8_t>(row, col);
+      if (verdict == 0) continue;
+      near_labels.clear();
+      for (int y = std::max(0, row - reach); y <= std::min(labels.rows - 1, row + reach); ++y) {
+        for (int x = std::max(0, col - reach); x <= std::min(labels.cols - 1, col + reach); ++x) {
+          const int label = labels.at<int>(y, x);
+          if (label > 0 && std::find(near_labels.begin(), near_labels.end(), label) == near_labels.end()) {
+            near_labels.push_back(label);
+          }
+        }
+      }
+      for (int label : near_labels) {
+        ++judged[label];
+        if (verdict == kDistantJudged) ++distant[label];
+        if (verdict == kNearer) ++nearer[label];
+      }
+    }
+  }
+  std::vector<uint8_t> holds_point(count, 0);
+  for (const Eigen::Vector2d& pixel : seen) {
+    const Eigen::Vector2d at = OpenCvFromColmap(pixel / g.factor);
+    const int col = static_cast<int>(std::lround(at.x())), row = static_cast<int>(std::lround(at.y()));
+    if (col >= 0 && row >= 0 && col < labels.cols && row < labels.rows) holds_point[labels.at<int>(row, col)] = 1;
+  }
+  std::vector<uint8_t> is_distant(count, 0);
+  for (int label = 1; label < count; ++label) {
+    is_distant[label] = !holds_point[label] && size[label] >= side * side && distant[label] >= kMinRimVotes &&
+                        distant[label] >= kMinRimShare * judged[label] &&
+                        nearer[label] <= kMaxRimNearShare * distant[label];
+  }
+  std::vector<Eigen::Vector2d> pixels;
+  for (int row = 0; row < labels.rows; ++row) {
+    for (int col = 0; col < labels.cols; ++col) {
+      if (!is_distant[labels.at<int>(row, col)]) continue;
+      ++*grown;
+      if (mask->at<uint8_t>(row, col) == 0) mask->at<uint8_t>(row, col) = kGrown;
+      if (row % options.stride == 0 && col % options.stride == 0) pixels.push_back(PixelCentre(row, col));
+    }
+  }
+  return pixels;
+}
+
+}  // namespace
+
+DistantPixels FindPixelsOnSurface(const std::vector<CalibratedView>& views,
+                                  const Eigen::AlignedBox3d& box,
+                                  const DistantOptions& options,
+                                  const SupposedSurface& surface,
+                                  const std::vector<std::vector<Eigen::Vector2d>>& observations) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string reason;
+  CHECK(options.IsValid(&reason)) << reason;
+  DistantPixels result;
+  const int n = static_cast<int>(views.size());
+  std::vector<ReducedView> reduced(n);
+  for (int v = 0; v < n; ++v) reduced[v] = ReducedViewOf(views[v], options);
+  const int r = options.patch_radius;
+  std::vector<Eigen::Vector2d> patch;
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) patch.emplace_back(dx, dy);
+  }
+  std::vector<std::vector<DistantRay>> rays(n);
+  std::vector<cv::Mat> masks(n);
+  std::vector<int64_t> textured(n, 0), distant(n, 0), nearer(n, 0), grown(n, 0);
+  std::atomic<int> next{0};
+  auto work = [&] {
+    CentredPatch a;
+    a.values.resize(3 * patch.size());
+    PixelRay ray;
+    const auto add_ray = [&](int v, const PixelRay& found) {
+      const double length = std::isinf(found.at) ? std::numeric_limits<double>::infinity() : found.t1;
+      rays[v].push_back(DistantRay{v, found.direction, length});
+    };
+    for (int v = next++; v < n; v = next++) {
+      const ReducedView& i = reduced[v];
+      PhotoJudge judge(reduced, v, box, patch, surface, options);
+      cv::Mat mask(i.rgb.size(), CV_8UC1, cv::Scalar(0));
+      for (int row = r + 1; row < i.rgb.rows - r - 1; row += options.stride) {
+        for (int col = r + 1; col < i.rgb.cols - r - 1; col += options.stride) {
+          const Eigen::Vector2d p = PixelCentre(row, col);
+          bool ok = true;
+          for (size_t k = 0; k < patch.size() && ok; ++k) ok = Sample(i, p + patch[k], &a.values[3 * k]);
+          if (!ok) continue;
+          // Textured: the grey patch's standard deviation (the colour patch's is its upper bound).
+          double grey_mean = 0.0, grey_square = 0.0;
+          for (size_t k = 0; k < patch.size(); ++k) {
+            const double grey_value =
+                0.299 * a.values[3 * k] + 0.587 * a.values[3 * k + 1] + 0.114 * a.values[3 * k + 2];
+            grey_mean += grey_value;
+            grey_square += grey_value * grey_value;
+          }
+          grey_mean /= static_cast<double>(patch.size());
+          const double grey_variance = grey_square / patch.size() - grey_mean * grey_mean;
+          if (!(grey_variance >= i.texture * i.texture)) continue;
+          if (options.textured_quadrants && !QuadrantsTextured(a.values, r, i.texture)) continue;
+          ++textured[v];
+          if (!RayOf(i, p, box, patch, surface, &ray)) {
+            mask.at<uint8_t>(row, col) = kUndecided;
+            continue;
+          }
+          a.Centre();
+          const int verdict = judge.Verdict(ray, a);
+          mask.at<uint8_t>(row, col) = verdict > 0 ? kDistantJudged : verdict < 0 ? kNearer : kUndecided;
+          if (verdict < 0) ++nearer[v];
+          if (verdict <= 0) continue;
+          ++distant[v];
+          add_ray(v, ray);
+        }
+      }
+      if (!options.grow_plain_regions) {
+        masks[v] = mask;
+        continue;
+      }
+      static const std::vector<Eigen::Vector2d> kNone;
+      const std::vector<Eigen::Vector2d>& seen =
+          v < static_cast<int>(observations.size()) ? observations[v] : kNone;
+      for (const Eigen::Vector2d& p : GrowIntoPlainRegions(i, options, seen, &mask, &grown[v])) {
+        if (RayOf(i, p, box, {}, surface, &ray)) add_ray(v, ray);
+      }
+      masks[v] = mask;
+    }
+  };
+  const int threads = std::max(1, std::min(n, options.num_threads > 0
+                                                  ? options.num_threads
+                                                  : static_cast<int>(std::thread::hardware_concurrency())));
+  std::vector<std::thread> workers;
+  for (int t = 1; t < threads; ++t) workers.emplace_back(work);
+  work();
+  for (std::thread& worker : workers) worker.join();
+  for (int v = 0; v < n; ++v) {
+    result.rays.insert(result.rays.end(), rays[v].begin(), rays[v].end());
+    result.textured += textured[v];
+    result.distant += distant[v];
+    result.nearer += nearer[v];
+    result.grown += grown[v];
+    result.factors.push_back(reduced[v].factor);
+  }
+  result.masks = std::move(masks);
+  result.photos_judged = static_cast<int>(result.masks.size());
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace raycarve

@@ -311,13 +311,15 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
     sample(SecondsSince(start));
     level_statistics.carved =
         carver->carved() + carver->visual_hull().carved + carver->free_space().carved +
-        carver->distant().carved + carver->beyond_ground_carved();
+        carver->distant().carved + carver->ground_seen().carved + carver->beyond_ground_carved();
     level_statistics.free_space_carved = carver->free_space().carved;
     statistics.free_space_carved += carver->free_space().carved;
     statistics.free_space_sight_lines = carver->free_space().sight_lines;
     statistics.free_space_seconds += carver->free_space().seconds;
     statistics.distant_carved += carver->distant().carved;
     statistics.distant_rays = carver->distant().sight_lines;
+    statistics.ground_seen_carved += carver->ground_seen().carved;
+    statistics.ground_seen_rays = carver->ground_seen().sight_lines;
     level_statistics.evaluated = carver->evaluated();
     level_statistics.protected_kept = carver->protected_kept();
     statistics.ground_voxels = carver->ground_voxels();

@@ -72,6 +72,8 @@ class IncrementalCarver {
   const VisualHullStatistics& visual_hull() const { return visual_hull_; }
   const FreeSpaceStatistics& free_space() const { return free_space_; }
   const FreeSpaceStatistics& distant() const { return distant_; }
+  // The ground pixels' rays (those of CarveOptions::distant_rays with a finite length).
+  const FreeSpaceStatistics& ground_seen() const { return ground_seen_; }
   Volume* mutable_volume() { return &volume_; }
   Visibility& visibility() { return *visibility_; }
   // The ray-cast visibility, or nullptr with another method.
@@ -165,6 +167,7 @@ class IncrementalCarver {
   VisualHullStatistics visual_hull_;  // declared before volume_: filled while volume_ is built
   FreeSpaceStatistics free_space_;    // likewise
   FreeSpaceStatistics distant_;       // likewise
+  FreeSpaceStatistics ground_seen_;   // likewise
   int64_t beyond_ground_carved_ = 0;  // likewise
   std::vector<int64_t> ground_held_;   // likewise: the voxels under the ground, until protected
   // Per view, KnownSurfaceDepths: with protection, or for the distant rays (made with the volume,

@@ -199,80 +199,11 @@ void CarvePipeline::AgreeMasks() {
   if (run_.mask_agreement.views > 0) RecordSeconds("agree_masks", SecondsSince(start));
 }
 
-void CarvePipeline::DecideGround() {
-  run_.ground = Ground();
-  if (!run_.plane.found) {
-    run_.ground_reason = "no supporting plane";
-  } else if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
-    run_.ground_reason = "masks bound the subject";
-  } else if (!request_.hold_ground) {
-    run_.ground_reason = "--hold_ground 0";
-  } else {
-    // The floor runs on beyond the box: its points around the box too (the box's margin has
-    // none of its own), those of the carved photos.
-    const Eigen::AlignedBox3d& box = project_.bounds.box;
-    const Eigen::AlignedBox3d around(box.min() - 0.5 * box.sizes(), box.max() + 0.5 * box.sizes());
-    std::vector<Eigen::Vector3d> points;
-    for (const SurfacePoint& point : SurfacePointsOf(project_.reconstruction, carved_, around)) {
-      points.push_back(point.xyz);
-    }
-    run_.ground = exporter::GroundUnder(run_.plane, points);
-    std::ostringstream text;
-    text.precision(3);
-    if (run_.ground.empty()) {
-      text << "no sparse point of the carved photos on the plane";
-    } else {
-      text << "held solid under the plane, within " << run_.ground.radius << " of its "
-           << run_.ground.footprint.size() << " sparse points";
-    }
-    run_.ground_reason = text.str();
-  }
-  LOG(INFO) << "ground: " << run_.ground_reason;
-}
-
-void CarvePipeline::FindDistant() {
-  run_.distant = DistantPixels();
-  distant_rays_.clear();
-  if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
-    run_.distant_reason = "masks say what is background";
-  } else if (!request_.distant_free_space) {
-    run_.distant_reason = "--distant_free_space 0";
-  } else {
-    run_.distant_reason.clear();
-    if (scope_.distant != nullptr) {
-      for (const DistantRay& ray : scope_.distant->rays) {
-        if (ray.view < 0 || ray.view >= static_cast<int>(carved_.size())) {
-          throw InputError("raycarve " + scope_.command + ": the given distant pixels name view " +
-                           std::to_string(ray.view) + " of " + std::to_string(carved_.size()) +
-                           ": not this project's (plan again)");
-        }
-      }
-      run_.distant = *scope_.distant;
-      distant_rays_ = std::move(run_.distant.rays);
-      run_.distant.rays.clear();
-      run_.distant.seconds = 0.0;
-      LOG(INFO) << distant_rays_.size() << " rays of distant pixels from the tile plan";
-      return;
-    }
-    DistantOptions options;
-    options.num_threads = request_.options.num_threads;
-    LOG(INFO) << "looking for pixels that show what lies beyond the volume (sky, far hills) in "
-              << carved_.size() << " photos ...";
-    // The photos' own pixels of the sparse points in the volume: plain regions holding one are
-    // surfaces, not sky.
-    run_.distant = FindDistantPixels(carved_, project_.bounds.box, options,
-                                     SurfacePointPixels(carved_, surface_points_));
-    LOG(INFO) << run_.distant.Summary();
-    distant_rays_ = std::move(run_.distant.rays);
-    run_.distant.rays.clear();
-    RecordSeconds("distant_pixels", run_.distant.seconds);
-  }
-}
-
 void CarvePipeline::CheckVolume() {
   CHECK(loaded_);
   DecideGround();
   FindDistant();
+  FindGroundPixels();
   std::string reason;
   if (!CheckCarveFits(carved_, project_.bounds.box, request_.options, &reason)) {
     throw InputError("raycarve " + scope_.command + ": " + reason);

@@ -68,6 +68,10 @@ struct CarveRun {
   // left empty here (the carve takes them).
   DistantPixels distant;
   std::string distant_reason;  // why none were looked for (empty when they were)
+  // The ground pixels (CarveRequest::ground_free_space), likewise; their rays are carved with
+  // the distant pixels' (a tile job gets both in its plan's rays, and no counts of these).
+  DistantPixels ground_pixels;
+  std::string ground_pixels_reason;
   int num_views = 0;  // the views carved
   int num_missing_images = 0;
   int masks_from_files = 0;
@@ -194,6 +198,7 @@ class CarvePipeline {
   void DecideMasks();
   void DecideGround();  // run_.ground, once the masks are decided
   void FindDistant();   // distant_rays_ and run_.distant, once the masks are decided
+  void FindGroundPixels();  // appends to distant_rays_, run_.ground_pixels, once the ground is
   void RecordSeconds(const std::string& stage, double seconds);
   void WriteMasks(const std::filesystem::path& staging) const;
   // report.html (pipeline/report_page.h): the summary, preview.png, the convergence plot and

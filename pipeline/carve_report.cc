@@ -194,6 +194,17 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
       .Key("distant_voxels_carved").Value(s.distant_carved)
       .Key("seconds").Value(distant.seconds)
       .EndObject();
+  const DistantPixels& ground = run.ground_pixels;
+  json.Key("ground_pixels").BeginObject()
+      .Key("looked_for").Value(run.ground_pixels_reason.empty())
+      .Key("reason").Value(run.ground_pixels_reason)
+      .Key("textured_pixels").Value(ground.textured)
+      .Key("found_pixels").Value(ground.distant)
+      .Key("nearer_pixels").Value(ground.nearer)
+      .Key("rays").Value(s.ground_seen_rays)
+      .Key("voxels_carved").Value(s.ground_seen_carved)
+      .Key("seconds").Value(ground.seconds)
+      .EndObject();
   json.EndObject();
   json.Key("statistics").BeginObject()
       .Key("visibility").Value(s.visibility)

@@ -78,6 +78,11 @@ struct CarveRequest {
   // volume would (sky, clouds, far hills; calib/distant_pixels.h) saw across the volume, and
   // their rays are carved before colouring (CarveOptions::distant_rays).
   bool distant_free_space = true;
+  // Without masks, where the ground is held (hold_ground): photo pixels whose pattern moves
+  // between the photos as the ground's plane does (carve/ground_pixels.h) saw the floor across
+  // empty space, and their rays are carved before colouring down to kGroundClearanceVoxels
+  // above the plane's tolerance.
+  bool ground_free_space = true;
   // A grid whose voxels span fewer pixels of the photos than this (median at the volume's
   // centre) is refused before the work: there the photos cannot tell a voxel from its
   // neighbours, rays pass between voxels that are never judged, and the carve degrades (the

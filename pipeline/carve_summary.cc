@@ -149,6 +149,16 @@ std::string CaptureText(const CarveRun& run) {
       const CarveStatistics& s = run.result->statistics;
       text += " (" + std::to_string(s.ground_voxels) + " voxels; " +
               std::to_string(s.beyond_ground_carved) + " below it past its edge carved)";
+      if (run.ground_pixels_reason.empty()) {
+        const DistantPixels& g = run.ground_pixels;
+        char line[240];
+        std::snprintf(line, sizeof(line),
+                      "ground seen: %.1f%% of the photos' textured pixels move as the ground does "
+                      "(%lld found nearer); their rays carved %lld voxels above it",
+                      g.textured > 0 ? 100.0 * g.distant / g.textured : 0.0,
+                      static_cast<long long>(g.nearer), static_cast<long long>(s.ground_seen_carved));
+        text += next_line + line;
+      }
     }
   }
   return text;

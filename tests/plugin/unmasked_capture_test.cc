@@ -86,18 +86,19 @@ TEST(UnmaskedCapture, TheSubjectIsCarvedInItsOwnBoxWithoutTheBoxsWalls) {
   EXPECT_GT(JsonNumber(report, "on_plane_share"), 0.2);
   EXPECT_NE(output.find("a supporting plane: normal"), std::string::npos) << output;
   // The cloud against the truth (the objects, the ground square and the room's floor) inside the
-  // volume, at two voxels (measured: F-score 96.6%).
+  // volume, at two voxels (measured: F-score 98.4%).
   EXPECT_GT(FScoreInVolume(root, report), 0.88);
   // Held out, scored inside the truth's silhouettes and against the photos' sparse points: the
-  // colour test against no colour test (measured: 23.57 against 14.11 dB; 93.3% of the sparse
-  // points at their depth and 3.8% hidden, against 30.8% and 68.7%).
+  // colour test against no colour test (measured: 23.92 against 16.36 dB; 93.6% of the sparse
+  // points at their depth and 3.4% hidden, against 55.5% and 43.8%: the ground pixels' free
+  // space, which colour off keeps, opens the floor's surroundings to it too).
   const std::string defaults = HeldOut(root, "defaults", "");
   const std::string colour_off = HeldOut(root, "colour_off", " --threshold 1000000");
   EXPECT_GT(JsonNumber(defaults, "mean_psnr_db"), JsonNumber(colour_off, "mean_psnr_db") + 5.0);
   EXPECT_GT(Overall(defaults, "sparse_points"), 1000);
   EXPECT_GT(Overall(defaults, "sparse_at_depth_share"), 0.9);
   EXPECT_LT(Overall(defaults, "sparse_hidden_share"), 0.05);
-  EXPECT_LT(Overall(colour_off, "sparse_at_depth_share"), 0.5);
+  EXPECT_LT(Overall(colour_off, "sparse_at_depth_share"), Overall(defaults, "sparse_at_depth_share") - 0.25);
 }
 
 // An object amid clutter: blocks standing around it, some between the arc of cameras and the
@@ -108,10 +109,19 @@ TEST(UnmaskedCapture, WhatStandsInFrontOfTheSubjectIsInTheVolume) {
   const std::string root = testing::MakeTemporaryDirectory("unmasked_clutter");
   const std::string scene = SceneWithoutMasks(root, "--scene clutter --backdrop room --layout arc");
   std::string output;
+  // Without the ground pixels' free space first: between the clutter and the objects, where few
+  // photos see, the photos agree on much that is empty over the floor.
+  ASSERT_EQ(RunRaycarve("carve --workspace_path " + scene + " --ground_free_space 0", &output), 0) << output;
+  const std::string without_ground = testing::ReadFileBytes(scene + "/raycarve/report.json");
+  const double f_without_ground = FScoreInVolume(root, without_ground);
   ASSERT_EQ(RunRaycarve("carve --workspace_path " + scene, &output), 0) << output;
   EXPECT_NE(output.find("in front of them that hide some of them from photos"), std::string::npos)
       << output;
   const std::string report = testing::ReadFileBytes(scene + "/raycarve/report.json");
+  const std::string ground = report.substr(report.find("\"ground_pixels\""));
+  EXPECT_GT(JsonNumber(ground, "found_pixels"), 1000) << ground.substr(0, 300);
+  EXPECT_GT(JsonNumber(ground, "voxels_carved"), 1000) << ground.substr(0, 300);
+  EXPECT_NE(output.find("ground seen: "), std::string::npos) << output;
   EXPECT_GE(JsonNumber(report, "occluder_points"), 10);
   // The bench in front of the arc's middle cameras (x in [-0.35, 0.55], y in [2.075, 2.425]) is
   // inside the volume.
@@ -121,10 +131,12 @@ TEST(UnmaskedCapture, WhatStandsInFrontOfTheSubjectIsInTheVolume) {
   for (std::string value; std::getline(stream, value, ',');) corners.push_back(std::stod(value));
   ASSERT_EQ(corners.size(), 6u) << box;
   EXPECT_GT(corners[4], 2.425) << box;
-  // Measured: F-score 84.6%.
-  EXPECT_GT(FScoreInVolume(root, report), 0.8);
-  // Held out inside the truth's silhouettes (measured: 22.48 dB against 18.83 with the colour
-  // test off; 89.9% of the sparse points at their depth, 5.3% hidden).
+  // Measured: F-score 87.4% without the ground pixels, 90.7% with them.
+  const double f = FScoreInVolume(root, report);
+  EXPECT_GT(f, 0.85);
+  EXPECT_GT(f, f_without_ground + 0.02) << f_without_ground << " -> " << f;
+  // Held out inside the truth's silhouettes (measured: 22.80 dB against 19.32 with the colour
+  // test off; 90.6% of the sparse points at their depth, 4.2% hidden).
   const std::string defaults = HeldOut(root, "defaults", "");
   const std::string colour_off = HeldOut(root, "colour_off", " --threshold 1000000");
   EXPECT_GT(JsonNumber(defaults, "mean_psnr_db"), JsonNumber(colour_off, "mean_psnr_db") + 1.5);

@@ -1,0 +1,112 @@
+// The carve pipeline's decisions for a capture without masks, before the carve: the ground under
+// the supporting plane, and the photo pixels that show what lies beyond the volume (sky, far
+// hills) or show the ground; their rays are free space (CarveOptions::distant_rays).
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glog/logging.h>
+
+#include "calib/input_error.h"
+#include "carve/ground_pixels.h"
+#include "pipeline/carve_pipeline.h"
+
+namespace raycarve {
+
+void CarvePipeline::DecideGround() {
+  run_.ground = Ground();
+  if (!run_.plane.found) {
+    run_.ground_reason = "no supporting plane";
+  } else if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
+    run_.ground_reason = "masks bound the subject";
+  } else if (!request_.hold_ground) {
+    run_.ground_reason = "--hold_ground 0";
+  } else {
+    // The floor runs on beyond the box: its points around the box too (the box's margin has
+    // none of its own), those of the carved photos.
+    const Eigen::AlignedBox3d& box = project_.bounds.box;
+    const Eigen::AlignedBox3d around(box.min() - 0.5 * box.sizes(), box.max() + 0.5 * box.sizes());
+    std::vector<Eigen::Vector3d> points;
+    for (const SurfacePoint& point : SurfacePointsOf(project_.reconstruction, carved_, around)) {
+      points.push_back(point.xyz);
+    }
+    run_.ground = exporter::GroundUnder(run_.plane, points);
+    std::ostringstream text;
+    text.precision(3);
+    if (run_.ground.empty()) {
+      text << "no sparse point of the carved photos on the plane";
+    } else {
+      text << "held solid under the plane, within " << run_.ground.radius << " of its "
+           << run_.ground.footprint.size() << " sparse points";
+    }
+    run_.ground_reason = text.str();
+  }
+  LOG(INFO) << "ground: " << run_.ground_reason;
+}
+
+void CarvePipeline::FindDistant() {
+  run_.distant = DistantPixels();
+  distant_rays_.clear();
+  if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
+    run_.distant_reason = "masks say what is background";
+  } else if (!request_.distant_free_space) {
+    run_.distant_reason = "--distant_free_space 0";
+  } else {
+    run_.distant_reason.clear();
+    if (scope_.distant != nullptr) {
+      for (const DistantRay& ray : scope_.distant->rays) {
+        if (ray.view < 0 || ray.view >= static_cast<int>(carved_.size())) {
+          throw InputError("raycarve " + scope_.command + ": the given distant pixels name view " +
+                           std::to_string(ray.view) + " of " + std::to_string(carved_.size()) +
+                           ": not this project's (plan again)");
+        }
+      }
+      run_.distant = *scope_.distant;
+      distant_rays_ = std::move(run_.distant.rays);
+      run_.distant.rays.clear();
+      run_.distant.seconds = 0.0;
+      LOG(INFO) << distant_rays_.size() << " rays of distant pixels from the tile plan";
+      return;
+    }
+    DistantOptions options;
+    options.num_threads = request_.options.num_threads;
+    LOG(INFO) << "looking for pixels that show what lies beyond the volume (sky, far hills) in "
+              << carved_.size() << " photos ...";
+    // The photos' own pixels of the sparse points in the volume: plain regions holding one are
+    // surfaces, not sky.
+    run_.distant = FindDistantPixels(carved_, project_.bounds.box, options,
+                                     SurfacePointPixels(carved_, surface_points_));
+    LOG(INFO) << run_.distant.Summary();
+    distant_rays_ = std::move(run_.distant.rays);
+    run_.distant.rays.clear();
+    RecordSeconds("distant_pixels", run_.distant.seconds);
+  }
+}
+
+void CarvePipeline::FindGroundPixels() {
+  run_.ground_pixels = DistantPixels();
+  if (scope_.distant != nullptr) {
+    run_.ground_pixels_reason = "in the tile plan's rays";
+  } else if (run_.ground.empty()) {
+    run_.ground_pixels_reason = "no ground held";
+  } else if (!request_.ground_free_space) {
+    run_.ground_pixels_reason = "--ground_free_space 0";
+  } else {
+    run_.ground_pixels_reason.clear();
+    DistantOptions options;
+    options.num_threads = request_.options.num_threads;
+    options.grow_plain_regions = false;
+    const double voxel = VoxelGrid(project_.bounds.box, request_.options.resolution).voxel_size();
+    const double clearance = run_.ground.depth + kGroundClearanceVoxels * voxel;
+    LOG(INFO) << "looking for pixels that show the ground in " << carved_.size() << " photos ...";
+    run_.ground_pixels = raycarve::FindGroundPixels(carved_, project_.bounds.box, run_.ground, clearance,
+                                                    options, SurfacePointPixels(carved_, surface_points_));
+    LOG(INFO) << GroundPixelsSummary(run_.ground_pixels);
+    distant_rays_.insert(distant_rays_.end(), run_.ground_pixels.rays.begin(), run_.ground_pixels.rays.end());
+    run_.ground_pixels.rays.clear();
+    RecordSeconds("ground_pixels", run_.ground_pixels.seconds);
+  }
+}
+
+}  // namespace raycarve

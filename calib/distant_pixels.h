@@ -52,6 +52,11 @@ struct DistantOptions {
   bool textured_quadrants = false;
   // Whether plain regions are judged by their rims (above).
   bool grow_plain_regions = true;
+  // Whether a judged pixel found casts the rays of every pixel of its stride cell (those it stands
+  // for, judged with it), not its own alone: rays every `stride` pixels leave voxels of a pixel or
+  // two between them untouched (FindGroundPixels sets it: room arc F 89.1% -> 92.5%). Off for the
+  // sky: with it, and the plain regions' every pixel, patchwork forward fell 90.0 -> 89.4%.
+  bool cell_rays = false;
   int num_threads = 1;  // < 1: one per hardware thread
 
   bool IsValid(std::string* reason) const;

@@ -504,6 +504,15 @@ DistantPixels FindPixelsOnSurface(const std::vector<CalibratedView>& views,
           if (verdict <= 0) continue;
           ++distant[v];
           add_ray(v, ray);
+          if (!options.cell_rays) continue;
+          PixelRay neighbour;  // the pixels of the stride cell that p stands for
+          for (int dy = 0; dy < options.stride; ++dy) {
+            for (int dx = 0; dx < options.stride; ++dx) {
+              if ((dx != 0 || dy != 0) && RayOf(i, PixelCentre(row + dy, col + dx), box, {}, surface, &neighbour)) {
+                add_ray(v, neighbour);
+              }
+            }
+          }
         }
       }
       if (!options.grow_plain_regions) {

@@ -28,6 +28,7 @@ DistantPixels FindGroundPixels(const std::vector<CalibratedView>& views,
     return true;
   };
   options.textured_quadrants = true;
+  options.cell_rays = true;
   return FindPixelsOnSurface(views, box, options, plane, observations);
 }
 

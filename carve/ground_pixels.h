@@ -28,7 +28,8 @@ constexpr double kGroundClearanceVoxels = 2.0;
 // returned with that length). Judged patches must be textured in each quadrant
 // (DistantOptions::textured_quadrants, set here): the foot of a plain box on a textured floor
 // moves with the floor in photos near each other (they share the box's occlusion of the floor
-// behind it), and its plain half says nothing. Plain regions are not grown from their rims unless
+// behind it), and its plain half says nothing. A pixel found casts the rays of its stride cell
+// (DistantOptions::cell_rays, set here). Plain regions are not grown from their rims unless
 // `options.grow_plain_regions` (an object of the floor's colour merges with it). `ground` must not
 // be empty; `observations` as for FindDistantPixels.
 DistantPixels FindGroundPixels(const std::vector<CalibratedView>& views,

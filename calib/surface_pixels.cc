@@ -439,6 +439,82 @@ std::vector<Eigen::Vector2d> GrowIntoPlainRegions(const ReducedView& g, const Di
   return pixels;
 }
 
+// Whether the patch (raw RGB samples) is textured: its grey standard deviation reaches `texture`
+// (the colour patch's is its upper bound).
+bool PatchTextured(const std::vector<float>& values, double texture) {
+  const size_t count = values.size() / 3;
+  double mean = 0.0, square = 0.0;
+  for (size_t k = 0; k < count; ++k) {
+    const double grey = 0.299 * values[3 * k] + 0.587 * values[3 * k + 1] + 0.114 * values[3 * k + 2];
+    mean += grey;
+    square += grey * grey;
+  }
+  mean /= static_cast<double>(count);
+  return square / static_cast<double>(count) - mean * mean >= texture * texture;
+}
+
+// One photo's verdicts (DistantPixels::masks), counts and rays.
+struct PhotoVerdicts {
+  std::vector<DistantRay> rays;
+  cv::Mat mask;
+  int64_t textured = 0, found = 0, nearer = 0, grown = 0;
+};
+
+// Judges photo v's textured pixels (every `stride`) against the others, then its plain regions.
+// `seen`: the photo's own pixels of sparse points inside the volume.
+PhotoVerdicts JudgePhoto(const std::vector<ReducedView>& reduced, int v, const Eigen::AlignedBox3d& box,
+                         const std::vector<Eigen::Vector2d>& patch, const SupposedSurface& surface,
+                         const DistantOptions& options, const std::vector<Eigen::Vector2d>& seen) {
+  const ReducedView& i = reduced[v];
+  const int r = options.patch_radius;
+  PhotoVerdicts out;
+  out.mask = cv::Mat(i.rgb.size(), CV_8UC1, cv::Scalar(0));
+  PhotoJudge judge(reduced, v, box, patch, surface, options);
+  CentredPatch a;
+  a.values.resize(3 * patch.size());
+  PixelRay ray;
+  const auto add_ray = [&](const PixelRay& found) {
+    const double length = std::isinf(found.at) ? std::numeric_limits<double>::infinity() : found.t1;
+    out.rays.push_back(DistantRay{v, found.direction, length});
+  };
+  for (int row = r + 1; row < i.rgb.rows - r - 1; row += options.stride) {
+    for (int col = r + 1; col < i.rgb.cols - r - 1; col += options.stride) {
+      const Eigen::Vector2d p = PixelCentre(row, col);
+      bool ok = true;
+      for (size_t k = 0; k < patch.size() && ok; ++k) ok = Sample(i, p + patch[k], &a.values[3 * k]);
+      if (!ok || !PatchTextured(a.values, i.texture)) continue;
+      if (options.textured_quadrants && !QuadrantsTextured(a.values, r, i.texture)) continue;
+      ++out.textured;
+      if (!RayOf(i, p, box, patch, surface, &ray)) {
+        out.mask.at<uint8_t>(row, col) = kUndecided;
+        continue;
+      }
+      a.Centre();
+      const int verdict = judge.Verdict(ray, a);
+      out.mask.at<uint8_t>(row, col) = verdict > 0 ? kDistantJudged : verdict < 0 ? kNearer : kUndecided;
+      if (verdict < 0) ++out.nearer;
+      if (verdict <= 0) continue;
+      ++out.found;
+      add_ray(ray);
+      if (!options.cell_rays) continue;
+      PixelRay neighbour;  // the pixels of the stride cell that p stands for
+      for (int dy = 0; dy < options.stride; ++dy) {
+        for (int dx = 0; dx < options.stride; ++dx) {
+          if ((dx != 0 || dy != 0) && RayOf(i, PixelCentre(row + dy, col + dx), box, {}, surface, &neighbour)) {
+            add_ray(neighbour);
+          }
+        }
+      }
+    }
+  }
+  if (options.grow_plain_regions) {
+    for (const Eigen::Vector2d& p : GrowIntoPlainRegions(i, options, seen, &out.mask, &out.grown)) {
+      if (RayOf(i, p, box, {}, surface, &ray)) add_ray(ray);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 DistantPixels FindPixelsOnSurface(const std::vector<CalibratedView>& views,
@@ -449,7 +525,6 @@ DistantPixels FindPixelsOnSurface(const std::vector<CalibratedView>& views,
   const auto start = std::chrono::steady_clock::now();
   std::string reason;
   CHECK(options.IsValid(&reason)) << reason;
-  DistantPixels result;
   const int n = static_cast<int>(views.size());
   std::vector<ReducedView> reduced(n);
   for (int v = 0; v < n; ++v) reduced[v] = ReducedViewOf(views[v], options);
@@ -458,74 +533,13 @@ DistantPixels FindPixelsOnSurface(const std::vector<CalibratedView>& views,
   for (int dy = -r; dy <= r; ++dy) {
     for (int dx = -r; dx <= r; ++dx) patch.emplace_back(dx, dy);
   }
-  std::vector<std::vector<DistantRay>> rays(n);
-  std::vector<cv::Mat> masks(n);
-  std::vector<int64_t> textured(n, 0), distant(n, 0), nearer(n, 0), grown(n, 0);
+  std::vector<PhotoVerdicts> photos(n);
   std::atomic<int> next{0};
   auto work = [&] {
-    CentredPatch a;
-    a.values.resize(3 * patch.size());
-    PixelRay ray;
-    const auto add_ray = [&](int v, const PixelRay& found) {
-      const double length = std::isinf(found.at) ? std::numeric_limits<double>::infinity() : found.t1;
-      rays[v].push_back(DistantRay{v, found.direction, length});
-    };
+    static const std::vector<Eigen::Vector2d> kNone;
     for (int v = next++; v < n; v = next++) {
-      const ReducedView& i = reduced[v];
-      PhotoJudge judge(reduced, v, box, patch, surface, options);
-      cv::Mat mask(i.rgb.size(), CV_8UC1, cv::Scalar(0));
-      for (int row = r + 1; row < i.rgb.rows - r - 1; row += options.stride) {
-        for (int col = r + 1; col < i.rgb.cols - r - 1; col += options.stride) {
-          const Eigen::Vector2d p = PixelCentre(row, col);
-          bool ok = true;
-          for (size_t k = 0; k < patch.size() && ok; ++k) ok = Sample(i, p + patch[k], &a.values[3 * k]);
-          if (!ok) continue;
-          // Textured: the grey patch's standard deviation (the colour patch's is its upper bound).
-          double grey_mean = 0.0, grey_square = 0.0;
-          for (size_t k = 0; k < patch.size(); ++k) {
-            const double grey_value =
-                0.299 * a.values[3 * k] + 0.587 * a.values[3 * k + 1] + 0.114 * a.values[3 * k + 2];
-            grey_mean += grey_value;
-            grey_square += grey_value * grey_value;
-          }
-          grey_mean /= static_cast<double>(patch.size());
-          const double grey_variance = grey_square / patch.size() - grey_mean * grey_mean;
-          if (!(grey_variance >= i.texture * i.texture)) continue;
-          if (options.textured_quadrants && !QuadrantsTextured(a.values, r, i.texture)) continue;
-          ++textured[v];
-          if (!RayOf(i, p, box, patch, surface, &ray)) {
-            mask.at<uint8_t>(row, col) = kUndecided;
-            continue;
-          }
-          a.Centre();
-          const int verdict = judge.Verdict(ray, a);
-          mask.at<uint8_t>(row, col) = verdict > 0 ? kDistantJudged : verdict < 0 ? kNearer : kUndecided;
-          if (verdict < 0) ++nearer[v];
-          if (verdict <= 0) continue;
-          ++distant[v];
-          add_ray(v, ray);
-          if (!options.cell_rays) continue;
-          PixelRay neighbour;  // the pixels of the stride cell that p stands for
-          for (int dy = 0; dy < options.stride; ++dy) {
-            for (int dx = 0; dx < options.stride; ++dx) {
-              if ((dx != 0 || dy != 0) && RayOf(i, PixelCentre(row + dy, col + dx), box, {}, surface, &neighbour)) {
-                add_ray(v, neighbour);
-              }
-            }
-          }
-        }
-      }
-      if (!options.grow_plain_regions) {
-        masks[v] = mask;
-        continue;
-      }
-      static const std::vector<Eigen::Vector2d> kNone;
-      const std::vector<Eigen::Vector2d>& seen =
-          v < static_cast<int>(observations.size()) ? observations[v] : kNone;
-      for (const Eigen::Vector2d& p : GrowIntoPlainRegions(i, options, seen, &mask, &grown[v])) {
-        if (RayOf(i, p, box, {}, surface, &ray)) add_ray(v, ray);
-      }
-      masks[v] = mask;
+      photos[v] = JudgePhoto(reduced, v, box, patch, surface, options,
+                             v < static_cast<int>(observations.size()) ? observations[v] : kNone);
     }
   };
   const int threads = std::max(1, std::min(n, options.num_threads > 0
@@ -535,15 +549,17 @@ DistantPixels FindPixelsOnSurface(const std::vector<CalibratedView>& views,
   for (int t = 1; t < threads; ++t) workers.emplace_back(work);
   work();
   for (std::thread& worker : workers) worker.join();
+  DistantPixels result;
   for (int v = 0; v < n; ++v) {
-    result.rays.insert(result.rays.end(), rays[v].begin(), rays[v].end());
-    result.textured += textured[v];
-    result.distant += distant[v];
-    result.nearer += nearer[v];
-    result.grown += grown[v];
+    PhotoVerdicts& photo = photos[v];
+    result.rays.insert(result.rays.end(), photo.rays.begin(), photo.rays.end());
+    result.textured += photo.textured;
+    result.distant += photo.found;
+    result.nearer += photo.nearer;
+    result.grown += photo.grown;
     result.factors.push_back(reduced[v].factor);
+    result.masks.push_back(std::move(photo.mask));
   }
-  result.masks = std::move(masks);
   result.photos_judged = static_cast<int>(result.masks.size());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

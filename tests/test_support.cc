@@ -337,5 +337,38 @@ CalibratedView PinholeViewAtOrigin(int width, int height, double focal) {
   return view;
 }
 
+Eigen::Vector3d CellColour(int a, int b, int salt) {
+  uint32_t hash = static_cast<uint32_t>(a * 73856093) ^ static_cast<uint32_t>(b * 19349663) ^
+                  static_cast<uint32_t>(salt * 83492791);
+  hash = (hash ^ (hash >> 13)) * 0x5bd1e995u;
+  hash ^= hash >> 15;
+  return Eigen::Vector3d(40 + (hash & 0xbf), 40 + ((hash >> 8) & 0xbf), 40 + ((hash >> 16) & 0xbf));
+}
+
+cv::Mat TraceViewImage(
+    CalibratedView* view,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&, const Eigen::Vector3d&, bool*)>& trace) {
+  view->image = cv::Mat(view->height, view->width, CV_8UC3);
+  cv::Mat flagged(view->height, view->width, CV_8UC1, cv::Scalar(0));
+  const Eigen::Matrix3d world_from_pixel = view->WorldFromPixel();
+  for (int row = 0; row < view->height; ++row) {
+    for (int col = 0; col < view->width; ++col) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      bool flag = false;
+      for (int s = 0; s < 9; ++s) {
+        const Eigen::Vector2d at(col + (s % 3 + 0.5) / 3.0, row + (s / 3 + 0.5) / 3.0);
+        sum += trace(view->centre, (world_from_pixel * at.homogeneous()).normalized(), &flag);
+      }
+      view->image.at<cv::Vec3b>(row, col) =
+          cv::Vec3b(static_cast<uint8_t>(sum.x() / 9), static_cast<uint8_t>(sum.y() / 9),
+                    static_cast<uint8_t>(sum.z() / 9));
+      const Eigen::Vector2d centre(col + 0.5, row + 0.5);
+      trace(view->centre, (world_from_pixel * centre.homogeneous()).normalized(), &flag);
+      flagged.at<uint8_t>(row, col) = flag ? 255 : 0;
+    }
+  }
+  return flagged;
+}
+
 }  // namespace testing
 }  // namespace raycarve

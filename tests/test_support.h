@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <initializer_list>
 #include <map>
 #include <string>
@@ -115,6 +116,18 @@ CalibratedView PinholeViewLookingAtOrigin(const Eigen::Vector3d& centre, int wid
 // identity), `width` x `height` pixels, focal length `focal`, the principal point at the
 // centre; K, cam_from_world, centre and P set, no photo, `valid` all 255.
 CalibratedView PinholeViewAtOrigin(int width, int height, double focal);
+
+// A colour for cell (a, b) of a pattern, from a hash of the cell and `salt` (one pattern per
+// salt): each channel in 40..231, neighbouring cells unrelated.
+Eigen::Vector3d CellColour(int a, int b, int salt);
+
+// Renders view->image (CV_8UC3 RGB, of the view's size) with `trace`, 3 x 3 rays a pixel (as a
+// camera integrates its pixel's area): trace(origin, unit direction, &flag) gives a ray's colour
+// and a flag of the caller's (what the ray meets). Returns the mask (CV_8UC1, 255) of the pixels
+// whose centre ray was flagged.
+cv::Mat TraceViewImage(
+    CalibratedView* view,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&, const Eigen::Vector3d&, bool*)>& trace);
 
 }  // namespace testing
 }  // namespace raycarve

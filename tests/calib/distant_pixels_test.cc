@@ -14,14 +14,7 @@
 namespace raycarve {
 namespace {
 
-// A colour per cell of a pattern, from a hash of the cell.
-Eigen::Vector3d CellColour(int a, int b, int salt) {
-  uint32_t hash = static_cast<uint32_t>(a * 73856093) ^ static_cast<uint32_t>(b * 19349663) ^
-                  static_cast<uint32_t>(salt * 83492791);
-  hash = (hash ^ (hash >> 13)) * 0x5bd1e995u;
-  hash ^= hash >> 15;
-  return Eigen::Vector3d(40 + (hash & 0xbf), 40 + ((hash >> 8) & 0xbf), 40 + ((hash >> 16) & 0xbf));
-}
+using testing::CellColour;
 
 // The sky: plain cells of 5 degrees over directions, each a colour of its own.
 Eigen::Vector3d SkyColour(const Eigen::Vector3d& d) {
@@ -74,26 +67,11 @@ Rendered Render(bool wall) {
     const Eigen::Vector3d centre(4.0 * std::sin(a), 0.6 + 0.1 * (k % 3), 4.0 * std::cos(a));
     CalibratedView view = testing::PinholeViewLookingAtOrigin(centre, 200, 150, 170.0);
     view.name = "view" + std::to_string(k);
-    view.image = cv::Mat(view.height, view.width, CV_8UC3);
-    cv::Mat sky(view.height, view.width, CV_8UC1, cv::Scalar(0));
-    const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
-    for (int row = 0; row < view.height; ++row) {
-      for (int col = 0; col < view.width; ++col) {
-        // 3 x 3 rays a pixel, as a camera integrates its pixel's area.
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        for (int s = 0; s < 9; ++s) {
-          const Eigen::Vector2d at(col + (s % 3 + 0.5) / 3.0, row + (s / 3 + 0.5) / 3.0);
-          bool near = false;
-          sum += Trace(centre, (world_from_pixel * at.homogeneous()).normalized(), wall, &near);
-        }
-        const cv::Vec3b colour(static_cast<uint8_t>(sum.x() / 9), static_cast<uint8_t>(sum.y() / 9),
-                               static_cast<uint8_t>(sum.z() / 9));
-        view.image.at<cv::Vec3b>(row, col) = colour;
-        bool near = false;
-        Trace(centre, (world_from_pixel * PixelCentre(row, col).homogeneous()).normalized(), wall, &near);
-        sky.at<uint8_t>(row, col) = near ? 0 : 255;
-      }
-    }
+    const cv::Mat near = testing::TraceViewImage(
+        &view, [&](const Eigen::Vector3d& origin, const Eigen::Vector3d& d, bool* is_near) {
+          return Trace(origin, d, wall, is_near);
+        });
+    const cv::Mat sky = 255 - near;
     rendered.views.push_back(std::move(view));
     rendered.sky.push_back(sky);
   }

@@ -14,14 +14,7 @@
 namespace raycarve {
 namespace {
 
-// A colour per cell of a pattern, from a hash of the cell.
-Eigen::Vector3d CellColour(int a, int b, int salt) {
-  uint32_t hash = static_cast<uint32_t>(a * 73856093) ^ static_cast<uint32_t>(b * 19349663) ^
-                  static_cast<uint32_t>(salt * 83492791);
-  hash = (hash ^ (hash >> 13)) * 0x5bd1e995u;
-  hash ^= hash >> 15;
-  return Eigen::Vector3d(40 + (hash & 0xbf), 40 + ((hash >> 8) & 0xbf), 40 + ((hash >> 16) & 0xbf));
-}
+using testing::CellColour;
 
 // The floor y = 0 (cells of 0.07, each a colour of its own; about 3 pixels in the photos) under a
 // box standing on it, plain red or in cells of its own; a grey sky beyond.
@@ -61,26 +54,10 @@ Rendered Render(bool textured_box) {
     const Eigen::Vector3d centre(3.5 * std::sin(a), 2.0, 3.5 * std::cos(a));
     CalibratedView view = testing::PinholeViewLookingAtOrigin(centre, 200, 150, 170.0);
     view.name = "view" + std::to_string(k);
-    view.image = cv::Mat(view.height, view.width, CV_8UC3);
-    cv::Mat floor(view.height, view.width, CV_8UC1, cv::Scalar(0));
-    const Eigen::Matrix3d world_from_pixel = view.WorldFromPixel();
-    for (int row = 0; row < view.height; ++row) {
-      for (int col = 0; col < view.width; ++col) {
-        // 3 x 3 rays a pixel, as a camera integrates its pixel's area.
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        bool on_floor = false;
-        for (int s = 0; s < 9; ++s) {
-          const Eigen::Vector2d at(col + (s % 3 + 0.5) / 3.0, row + (s / 3 + 0.5) / 3.0);
-          sum += Trace(centre, (world_from_pixel * at.homogeneous()).normalized(), textured_box, &on_floor);
-        }
-        view.image.at<cv::Vec3b>(row, col) =
-            cv::Vec3b(static_cast<uint8_t>(sum.x() / 9), static_cast<uint8_t>(sum.y() / 9),
-                      static_cast<uint8_t>(sum.z() / 9));
-        Trace(centre, (world_from_pixel * PixelCentre(row, col).homogeneous()).normalized(), textured_box,
-              &on_floor);
-        floor.at<uint8_t>(row, col) = on_floor ? 255 : 0;
-      }
-    }
+    const cv::Mat floor = testing::TraceViewImage(
+        &view, [&](const Eigen::Vector3d& origin, const Eigen::Vector3d& d, bool* on_floor) {
+          return Trace(origin, d, textured_box, on_floor);
+        });
     rendered.views.push_back(std::move(view));
     rendered.floor.push_back(floor);
   }

@@ -47,8 +47,33 @@ double ImageNoiseSigma(const cv::Mat& grey) {
   const cv::Mat kernel = (cv::Mat_<float>(3, 3) << 1, -2, 1, -2, 4, -2, 1, -2, 1);
   cv::Mat response;
   cv::filter2D(grey, response, CV_32F, kernel, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
-  // The median absolute response, not the mean: texture over less than half of the photo (a
-  // field, a facade) leaves it as the plain parts' noise.
+  // Over blocks of 8 x 8 pixels, the mean absolute response. The plain blocks are those within
+  // twice the tenth percentile (a block's noise varies by about a tenth; texture lies far above),
+  // and their median is the noise's. Texture over up to four fifths of the photo (gravel or a
+  // patterned floor filling it, a facade) leaves it as the plain parts' noise: the median of all
+  // the responses read a photo 80% textured (cells of 3 pixels) as 4.7 levels of noise for 3.
+  constexpr int kBlock = 8;
+  std::vector<float> blocks;
+  for (int row = 1; row + kBlock <= grey.rows - 1; row += kBlock) {
+    for (int col = 1; col + kBlock <= grey.cols - 1; col += kBlock) {
+      double sum = 0.0;
+      for (int y = row; y < row + kBlock; ++y) {
+        const float* line = response.ptr<float>(y);
+        for (int x = col; x < col + kBlock; ++x) sum += std::abs(line[x]);
+      }
+      blocks.push_back(static_cast<float>(sum / (kBlock * kBlock)));
+    }
+  }
+  if (blocks.size() >= 10) {
+    std::sort(blocks.begin(), blocks.end());
+    const float limit = 2.0f * blocks[blocks.size() / 10];
+    const size_t plain = std::upper_bound(blocks.begin(), blocks.end(), limit) - blocks.begin();
+    // For Gaussian noise of sigma s the response is Gaussian of sigma 6 s (the kernel's squares
+    // sum to 36); the median of its blocks' mean absolute values, so chosen, is 4.736 s
+    // (simulated: 20 images of 512 x 512, spread 0.25%).
+    return blocks[(plain - 1) / 2] / 4.736;
+  }
+  // Too small for blocks: the median absolute response (0.6745 of its sigma for a Gaussian).
   std::vector<float> values;
   values.reserve(static_cast<size_t>(grey.rows - 2) * (grey.cols - 2));
   for (int row = 1; row < grey.rows - 1; ++row) {
@@ -56,8 +81,6 @@ double ImageNoiseSigma(const cv::Mat& grey) {
     for (int col = 1; col < grey.cols - 1; ++col) values.push_back(std::abs(line[col]));
   }
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  // For Gaussian noise of sigma s the response is Gaussian of sigma 6 s (the kernel's squares
-  // sum to 36), and its median absolute value 0.6745 times that.
   return values[values.size() / 2] / (0.6745 * 6.0);
 }
 

@@ -114,8 +114,10 @@ DistantPixels FindPixelsOnSurface(const std::vector<CalibratedView>& views,
                                   const std::vector<std::vector<Eigen::Vector2d>>& observations = {});
 
 // The noise of a grey image (CV_32F) in grey levels: after Immerkaer, the response to the
-// difference of two Laplacians, its median absolute value scaled for a Gaussian (robust to
-// texture over less than half of the image). 0 for images under 3x3.
+// difference of two Laplacians, its mean absolute value over blocks of 8 x 8 pixels, the median
+// of the plain blocks (within twice the tenth percentile) scaled for a Gaussian (robust to texture
+// over up to four fifths of the image; images of fewer than 10 blocks: the median absolute
+// response). 0 for images under 3x3.
 double ImageNoiseSigma(const cv::Mat& grey);
 
 }  // namespace raycarve

@@ -167,5 +167,18 @@ TEST(DistantPixels, NoiseOfAPlainImageIsItsNoise) {
   EXPECT_EQ(ImageNoiseSigma(cv::Mat(2, 2, CV_32F, cv::Scalar(0))), 0.0);
 }
 
+// A photo mostly filled by texture (gravel, grass, a patterned floor seen from above): the
+// noise is that of its plain fifth, not the texture's.
+TEST(DistantPixels, NoiseOfAPhotoFilledByTextureIsItsPlainPartsNoise) {
+  cv::Mat grey(200, 200, CV_32F);
+  cv::randn(grey, 100.0, 3.0);
+  for (int row = 0; row < grey.rows; ++row) {
+    for (int col = 0; col < 160; ++col) {
+      grey.at<float>(row, col) += static_cast<float>(CellColour(col / 3, row / 3, 7).x() - 135.0);
+    }
+  }
+  EXPECT_NEAR(ImageNoiseSigma(grey), 3.0, 0.3);
+}
+
 }  // namespace
 }  // namespace raycarve

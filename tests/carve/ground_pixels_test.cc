@@ -94,8 +94,9 @@ TEST(GroundPixels, TheFloorIsFoundAndNoRayEntersAPlainBoxStandingOnIt) {
   const Rendered scene = Render(/*textured_box=*/false);
   DistantOptions options;
   options.num_threads = 2;
-  // The renders are free of noise and the floor fills them (ImageNoiseSigma would take its
-  // texture for noise): textured from min_texture grey levels.
+  // The renders are free of noise and the floor fills nearly all of them (ImageNoiseSigma, robust
+  // to texture over four fifths of a photo, would take its texture for noise and judge a tenth of
+  // the floor's pixels): textured from min_texture grey levels.
   options.texture_noise_factor = 0.0;
   options.grow_plain_regions = false;
   const DistantPixels found = FindGroundPixels(scene.views, kVolume, FloorGround(), kClearance, options);
@@ -135,8 +136,9 @@ TEST(GroundPixels, NoRayEntersATexturedBox) {
   const Rendered scene = Render(/*textured_box=*/true);
   DistantOptions options;
   options.num_threads = 2;
-  // The renders are free of noise and the floor fills them (ImageNoiseSigma would take its
-  // texture for noise): textured from min_texture grey levels.
+  // The renders are free of noise and the floor fills nearly all of them (ImageNoiseSigma, robust
+  // to texture over four fifths of a photo, would take its texture for noise and judge a tenth of
+  // the floor's pixels): textured from min_texture grey levels.
   options.texture_noise_factor = 0.0;
   options.grow_plain_regions = false;
   const DistantPixels found = FindGroundPixels(scene.views, kVolume, FloorGround(), kClearance, options);

@@ -194,6 +194,8 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
   for (int64_t voxel : GroundHitVoxels(views, volume_.grid(), options)) {
     protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
   }
+  ground_voxels_ = static_cast<int64_t>(ground_held_.size());
+  std::vector<int64_t>().swap(ground_held_);
   batched_ = Batched(options) && ray_visibility_ != nullptr && ray_visibility_->ViewParallel();
   batch_voxels_ = batched_ ? options.batch_voxels : 1;
   view_parallel_ = !batched_ && ray_visibility_ != nullptr && ray_visibility_->ViewParallel() &&

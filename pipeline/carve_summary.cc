@@ -154,7 +154,7 @@ std::string CaptureText(const CarveRun& run) {
         char line[240];
         std::snprintf(line, sizeof(line),
                       "ground seen: %.1f%% of the photos' textured pixels move as the ground does "
-                      "(%lld found nearer); their rays carved %lld voxels above it",
+                      "(%lld found above it); their rays carved %lld voxels above it",
                       g.textured > 0 ? 100.0 * g.distant / g.textured : 0.0,
                       static_cast<long long>(g.nearer), static_cast<long long>(s.ground_seen_carved));
         text += next_line + line;

@@ -90,8 +90,28 @@ int64_t RaysIntoTheObject(const Rendered& scene, const DistantPixels& found) {
   return into;
 }
 
-TEST(GroundPixels, TheFloorIsFoundAndNoRayEntersAPlainBoxStandingOnIt) {
-  const Rendered scene = Render(/*textured_box=*/false);
+// The judged pixels (every second pixel, passing the patch's rules) whose centre ray meets the
+// floor (`on_floor`) or not, and how many of those were found on the ground.
+struct Judged {
+  int64_t judged = 0, found = 0;
+};
+Judged JudgedPixels(const Rendered& scene, const DistantPixels& found, bool on_floor) {
+  Judged count;
+  for (size_t v = 0; v < scene.views.size(); ++v) {
+    for (int row = 0; row < scene.floor[v].rows; ++row) {
+      for (int col = 0; col < scene.floor[v].cols; ++col) {
+        const uint8_t verdict = found.masks[v].at<uint8_t>(row, col);
+        if ((scene.floor[v].at<uint8_t>(row, col) != 0) != on_floor || verdict == 0) continue;
+        ++count.judged;
+        count.found += verdict == 255;
+      }
+    }
+  }
+  return count;
+}
+
+// The options of both tests.
+DistantOptions TestOptions() {
   DistantOptions options;
   options.num_threads = 2;
   // The renders are free of noise and the floor fills nearly all of them (ImageNoiseSigma, robust
@@ -99,7 +119,12 @@ TEST(GroundPixels, TheFloorIsFoundAndNoRayEntersAPlainBoxStandingOnIt) {
   // the floor's pixels): textured from min_texture grey levels.
   options.texture_noise_factor = 0.0;
   options.grow_plain_regions = false;
-  const DistantPixels found = FindGroundPixels(scene.views, kVolume, FloorGround(), kClearance, options);
+  return options;
+}
+
+TEST(GroundPixels, TheFloorIsFoundAndNoRayEntersAPlainBoxStandingOnIt) {
+  const Rendered scene = Render(/*textured_box=*/false);
+  const DistantPixels found = FindGroundPixels(scene.views, kVolume, FloorGround(), kClearance, TestOptions());
   ASSERT_EQ(found.masks.size(), scene.views.size());
   EXPECT_EQ(RaysIntoTheObject(scene, found), 0) << found.Summary();
   // Every ray ends kClearance above the floor, or where it leaves the volume before that.
@@ -116,47 +141,20 @@ TEST(GroundPixels, TheFloorIsFoundAndNoRayEntersAPlainBoxStandingOnIt) {
   // Much of the floor the photos see is found. Measured: 23% of the judged pixels on it (the
   // partners asked first, those farthest, see the floor turned round and foreshortened, and the
   // box hides from them what the photo sees of the floor near it).
-  int64_t floor = 0, floor_found = 0;
-  for (size_t v = 0; v < scene.views.size(); ++v) {
-    for (int row = 0; row < scene.floor[v].rows; ++row) {
-      for (int col = 0; col < scene.floor[v].cols; ++col) {
-        if (!scene.floor[v].at<uint8_t>(row, col)) continue;
-        const uint8_t verdict = found.masks[v].at<uint8_t>(row, col);
-        if (verdict == 0) continue;  // not judged (every second pixel, and the patch's rules)
-        ++floor;
-        floor_found += verdict == 255;
-      }
-    }
-  }
-  ASSERT_GT(floor, 1000);
-  EXPECT_GT(static_cast<double>(floor_found) / floor, 0.15) << floor_found << " of " << floor;
+  const Judged floor = JudgedPixels(scene, found, /*on_floor=*/true);
+  ASSERT_GT(floor.judged, 1000);
+  EXPECT_GT(static_cast<double>(floor.found) / floor.judged, 0.15) << floor.found << " of " << floor.judged;
 }
 
 TEST(GroundPixels, NoRayEntersATexturedBox) {
   const Rendered scene = Render(/*textured_box=*/true);
-  DistantOptions options;
-  options.num_threads = 2;
-  // The renders are free of noise and the floor fills nearly all of them (ImageNoiseSigma, robust
-  // to texture over four fifths of a photo, would take its texture for noise and judge a tenth of
-  // the floor's pixels): textured from min_texture grey levels.
-  options.texture_noise_factor = 0.0;
-  options.grow_plain_regions = false;
-  const DistantPixels found = FindGroundPixels(scene.views, kVolume, FloorGround(), kClearance, options);
+  const DistantPixels found = FindGroundPixels(scene.views, kVolume, FloorGround(), kClearance, TestOptions());
   EXPECT_EQ(RaysIntoTheObject(scene, found), 0) << found.Summary();
   EXPECT_GT(found.distant, 1000) << found.Summary();
   // The box's own cells are judged and never found on the floor.
-  int64_t judged = 0;
-  for (size_t v = 0; v < scene.views.size(); ++v) {
-    for (int row = 0; row < scene.floor[v].rows; ++row) {
-      for (int col = 0; col < scene.floor[v].cols; ++col) {
-        const uint8_t verdict = found.masks[v].at<uint8_t>(row, col);
-        if (scene.floor[v].at<uint8_t>(row, col) || verdict == 0) continue;
-        ++judged;
-        EXPECT_NE(verdict, 255) << "view " << v << " row " << row << " col " << col;
-      }
-    }
-  }
-  EXPECT_GT(judged, 100);
+  const Judged box = JudgedPixels(scene, found, /*on_floor=*/false);
+  EXPECT_GT(box.judged, 100);
+  EXPECT_EQ(box.found, 0);
 }
 
 }  // namespace

@@ -338,25 +338,35 @@ class PhotoJudge {
   std::vector<Eigen::Vector2d> coarse_offsets_;
 };
 
+// Whether the patch (raw RGB samples) is textured: its grey standard deviation reaches `texture`
+// (the colour patch's is its upper bound).
+bool PatchTextured(const std::vector<float>& values, double texture) {
+  const size_t count = values.size() / 3;
+  double mean = 0.0, square = 0.0;
+  for (size_t k = 0; k < count; ++k) {
+    const double grey = 0.299 * values[3 * k] + 0.587 * values[3 * k + 1] + 0.114 * values[3 * k + 2];
+    mean += grey;
+    square += grey * grey;
+  }
+  mean /= static_cast<double>(count);
+  return square / static_cast<double>(count) - mean * mean >= texture * texture;
+}
+
 // Whether each quadrant of the patch (rows and columns <= 0 and >= 0 of its centre, raw RGB
-// samples in row order) has a grey standard deviation of at least `texture`.
+// samples in row order) is textured (PatchTextured).
 bool QuadrantsTextured(const std::vector<float>& values, int radius, double texture) {
   const int side = 2 * radius + 1;
+  thread_local std::vector<float> quadrant;  // kept between calls: judged for every textured pixel
   for (int qy = 0; qy < 2; ++qy) {
     for (int qx = 0; qx < 2; ++qx) {
-      double sum = 0.0, square = 0.0;
-      int count = 0;
+      quadrant.clear();
       for (int y = qy * radius; y <= qy * radius + radius; ++y) {
         for (int x = qx * radius; x <= qx * radius + radius; ++x) {
           const size_t k = static_cast<size_t>(y * side + x);
-          const double grey = 0.299 * values[3 * k] + 0.587 * values[3 * k + 1] + 0.114 * values[3 * k + 2];
-          sum += grey;
-          square += grey * grey;
-          ++count;
+          quadrant.insert(quadrant.end(), {values[3 * k], values[3 * k + 1], values[3 * k + 2]});
         }
       }
-      const double mean = sum / count;
-      if (!(square / count - mean * mean >= texture * texture)) return false;
+      if (!PatchTextured(quadrant, texture)) return false;
     }
   }
   return true;
@@ -437,20 +447,6 @@ std::vector<Eigen::Vector2d> GrowIntoPlainRegions(const ReducedView& g, const Di
     }
   }
   return pixels;
-}
-
-// Whether the patch (raw RGB samples) is textured: its grey standard deviation reaches `texture`
-// (the colour patch's is its upper bound).
-bool PatchTextured(const std::vector<float>& values, double texture) {
-  const size_t count = values.size() / 3;
-  double mean = 0.0, square = 0.0;
-  for (size_t k = 0; k < count; ++k) {
-    const double grey = 0.299 * values[3 * k] + 0.587 * values[3 * k + 1] + 0.114 * values[3 * k + 2];
-    mean += grey;
-    square += grey * grey;
-  }
-  mean /= static_cast<double>(count);
-  return square / static_cast<double>(count) - mean * mean >= texture * texture;
 }
 
 // One photo's verdicts (DistantPixels::masks), counts and rays.

@@ -30,6 +30,8 @@ struct Ground {
   double radius = 0.0;
 
   bool empty() const { return footprint.empty() || !(radius > 0.0); }
+  // Signed distance of `point` from the plane (positive on the cameras' side).
+  double Height(const Eigen::Vector3d& point) const { return normal.dot(point) + offset; }
 };
 
 // The ground as a raster over its plane (cells of a quarter of its radius, or coarser where that

@@ -15,12 +15,10 @@ DistantPixels FindGroundPixels(const std::vector<CalibratedView>& views,
   CHECK(!ground.empty());
   CHECK(clearance >= 0.0);
   const GroundMap map(ground);
-  const Eigen::Vector3d normal = ground.normal.normalized();
-  const double offset = ground.offset / ground.normal.norm();
   const SupposedSurface plane = [&](const Eigen::Vector3d& centre, const Eigen::Vector3d& direction,
                                     double* at, double* clear_to) {
-    const double height = normal.dot(centre) + offset;
-    const double descent = -normal.dot(direction);  // height lost per unit along the ray
+    const double height = ground.Height(centre);
+    const double descent = -ground.normal.dot(direction);  // height lost per unit along the ray
     if (!(height > clearance) || !(descent > 1e-6)) return false;
     *at = height / descent;
     if (map.At(centre + *at * direction) != GroundMap::Foot::kGround) return false;

@@ -69,14 +69,12 @@ std::vector<int64_t> GroundHitVoxels(const std::vector<CalibratedView>& views,
                                      const CarveOptions& options) {
   std::vector<int64_t> voxels;
   if (options.ground.empty()) return voxels;
-  const Eigen::Vector3d normal = options.ground.normal.normalized();
-  const double offset = options.ground.offset / options.ground.normal.norm();
   for (const DistantRay& ray : options.distant_rays) {
-    const double descent = -normal.dot(ray.direction);
+    const double descent = -options.ground.normal.dot(ray.direction);
     if (std::isinf(ray.length) || !(descent > 1e-9)) continue;
     const Eigen::Vector3d& centre = views[ray.view].centre;
     const Eigen::Vector3i voxel =
-        grid.VoxelOf(centre + ((normal.dot(centre) + offset) / descent) * ray.direction);
+        grid.VoxelOf(centre + (options.ground.Height(centre) / descent) * ray.direction);
     if (grid.Contains(voxel)) voxels.push_back(grid.Index(voxel));
   }
   return voxels;

@@ -54,21 +54,27 @@ void CarvePipeline::FindDistant() {
     run_.distant_reason = "--distant_free_space 0";
   } else {
     run_.distant_reason.clear();
-    if (scope_.distant != nullptr) {
-      for (const DistantRay& ray : scope_.distant->rays) {
-        if (ray.view < 0 || ray.view >= static_cast<int>(carved_.size())) {
-          throw InputError("raycarve " + scope_.command + ": the given distant pixels name view " +
-                           std::to_string(ray.view) + " of " + std::to_string(carved_.size()) +
-                           ": not this project's (plan again)");
-        }
+  }
+  if (scope_.distant != nullptr) {
+    // A tile job takes its plan's rays whatever they hold: the plan decided with the same options,
+    // and its rays carry the ground pixels' too (with --distant_free_space 0, only those).
+    for (const DistantRay& ray : scope_.distant->rays) {
+      if (ray.view < 0 || ray.view >= static_cast<int>(carved_.size())) {
+        throw InputError("raycarve " + scope_.command + ": the given distant pixels name view " +
+                         std::to_string(ray.view) + " of " + std::to_string(carved_.size()) +
+                         ": not this project's (plan again)");
       }
+    }
+    distant_rays_ = scope_.distant->rays;
+    if (run_.distant_reason.empty()) {
       run_.distant = *scope_.distant;
-      distant_rays_ = std::move(run_.distant.rays);
       run_.distant.rays.clear();
       run_.distant.seconds = 0.0;
-      LOG(INFO) << distant_rays_.size() << " rays of distant pixels from the tile plan";
-      return;
     }
+    LOG(INFO) << distant_rays_.size() << " rays of distant and ground pixels from the tile plan";
+    return;
+  }
+  if (run_.distant_reason.empty()) {
     DistantOptions options;
     options.num_threads = request_.options.num_threads;
     LOG(INFO) << "looking for pixels that show what lies beyond the volume (sky, far hills) in "

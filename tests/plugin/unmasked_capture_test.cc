@@ -142,6 +142,18 @@ TEST(UnmaskedCapture, WhatStandsInFrontOfTheSubjectIsInTheVolume) {
   EXPECT_GT(JsonNumber(defaults, "mean_psnr_db"), JsonNumber(colour_off, "mean_psnr_db") + 1.5);
   EXPECT_GT(Overall(defaults, "sparse_at_depth_share"), 0.85);
   EXPECT_LT(Overall(defaults, "sparse_hidden_share"), 0.08);
+  // Carved in tiles with the distant pixels off, a job still takes the ground pixels' rays from
+  // its plan (the plan's ray file holds them).
+  ASSERT_EQ(RunRaycarve("tile plan --workspace_path " + scene + " --output_path " + root +
+                            "/tiled --tiles 2 --tile_path " + root + "/tiles --distant_free_space 0",
+                        &output),
+            0)
+      << output;
+  ASSERT_EQ(RunRaycarve("tile run --plan " + root + "/tiles/plan.json --index 0", &output), 0) << output;
+  const size_t taken = output.find(" rays of distant and ground pixels from the tile plan");
+  ASSERT_NE(taken, std::string::npos) << output;
+  const size_t line = output.rfind(']', taken);
+  EXPECT_GT(std::stol(output.substr(line + 1, taken - line - 1)), 1000) << output.substr(line, 80);
 }
 
 // Forward-facing photos (a grid of positions in front of the scene, as before a facade): a scene,

@@ -1,6 +1,7 @@
 #include "calib/bounds.h"
 
 #include <algorithm>
+#include <tuple>
 #include <array>
 #include <map>
 #include <set>
@@ -210,6 +211,118 @@ std::string CaptureLayout::Summary() const {
   return text.str();
 }
 
+namespace {
+
+// The values' range with a fiftieth left out at each end; sorts them.
+std::pair<double, double> TrimmedRange(std::vector<double>* values) {
+  std::sort(values->begin(), values->end());
+  const size_t trim = values->size() / 50;
+  return {(*values)[trim], (*values)[values->size() - 1 - trim]};
+}
+
+// The point nearest every optical axis (least squares: the sum over cameras of
+// (I - a a^T) (x - c) = 0); false where the axes are all parallel.
+bool NearestToAxes(const std::vector<Eigen::Vector3d>& centres,
+                   const std::vector<Eigen::Vector3d>& axes, Eigen::Vector3d* focus) {
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d right = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < centres.size(); ++i) {
+    const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - axes[i] * axes[i].transpose();
+    normal += across;
+    right += across * centres[i];
+  }
+  // Symmetric and positive semi-definite: singular only when every axis is parallel.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normal);
+  if (!(eigen.eigenvalues()(0) > 1e-6 * eigen.eigenvalues()(2))) return false;
+  *focus = normal.ldlt().solve(right);
+  return true;
+}
+
+// The cameras as seen from the focus: their median distance, the cone their directions fill
+// and the widest gap between their azimuths around its axis, how many have the focus in front;
+// from these whether the capture is object-centred.
+void DescribeDirections(const std::vector<Eigen::Vector3d>& centres,
+                        const std::vector<Eigen::Vector3d>& axes, CaptureLayout* layout) {
+  std::vector<double> distances;
+  std::vector<Eigen::Vector3d> directions;
+  Eigen::Vector3d direction_sum = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < centres.size(); ++i) {
+    const Eigen::Vector3d to_camera = centres[i] - layout->focus;
+    distances.push_back(to_camera.norm());
+    if (to_camera.norm() > 0.0) {
+      directions.push_back(to_camera.normalized());
+      direction_sum += directions.back();
+    }
+    layout->focus_in_front += axes[i].dot(layout->focus - centres[i]) > 0.0;
+  }
+  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+  layout->camera_distance = distances[distances.size() / 2];
+  // The directions about their mean: the cone's half angle, and their azimuths around it.
+  const double kDegrees = 180.0 / M_PI;
+  const Eigen::Vector3d mean =
+      direction_sum.norm() > 1e-9 ? direction_sum.normalized() : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d u = mean.unitOrthogonal(), v = mean.cross(u);
+  std::vector<double> azimuths;
+  for (const Eigen::Vector3d& d : directions) {
+    layout->cone_half_angle_degrees = std::max(
+        layout->cone_half_angle_degrees, std::acos(std::clamp(d.dot(mean), -1.0, 1.0)) * kDegrees);
+    const Eigen::Vector3d across = d - d.dot(mean) * mean;
+    if (across.norm() > 1e-9) azimuths.push_back(std::atan2(across.dot(v), across.dot(u)) * kDegrees);
+  }
+  std::sort(azimuths.begin(), azimuths.end());
+  if (azimuths.size() >= 2) {
+    layout->largest_gap_degrees = 360.0 - (azimuths.back() - azimuths.front());
+    for (size_t i = 1; i < azimuths.size(); ++i) {
+      layout->largest_gap_degrees = std::max(layout->largest_gap_degrees, azimuths[i] - azimuths[i - 1]);
+    }
+  }
+  const bool ring = layout->largest_gap_degrees <= kMaxObjectGapDegrees &&
+                    layout->cone_half_angle_degrees >= kMinRingConeDegrees;
+  const bool arc = layout->cone_half_angle_degrees >= kMinArcConeDegrees;
+  layout->object_centred = layout->focus_in_front == layout->cameras && (ring || arc);
+}
+
+// The box of the sparse points (seen twice or more) that a photo centred on the focus frames
+// (`half_fields`: the photos' half fields of view), grown to hold the points that stand in front
+// of the subject.
+void FindFocusBox(const Reconstruction& reconstruction, std::vector<double> half_fields,
+                  CaptureLayout* layout) {
+  double half_field = 0.5;
+  if (!half_fields.empty()) {
+    std::nth_element(half_fields.begin(), half_fields.begin() + half_fields.size() / 2,
+                     half_fields.end());
+    half_field = half_fields[half_fields.size() / 2];
+  }
+  const double radius = layout->camera_distance * std::tan(half_field);
+  std::array<std::vector<double>, 3> coordinates;
+  for (const auto& [id, point] : reconstruction.points3D) {
+    if (point.track.size() < 2 || (point.xyz - layout->focus).norm() > radius) continue;
+    for (int axis = 0; axis < 3; ++axis) coordinates[axis].push_back(point.xyz[axis]);
+  }
+  layout->focus_box_points = static_cast<int>(coordinates[0].size());
+  if (layout->focus_box_points < 20) return;
+  Eigen::Vector3d low, high;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::tie(low[axis], high[axis]) = TrimmedRange(&coordinates[axis]);
+  }
+  const double margin = 0.1 * (high - low).maxCoeff();
+  layout->focus_box = Eigen::AlignedBox3d(low.array() - margin, high.array() + margin);
+  const std::vector<Eigen::Vector3d> occluders = FindOccluders(reconstruction, layout->focus_box);
+  layout->occluder_points = static_cast<int>(occluders.size());
+  if (layout->occluder_points < kMinOccluderPoints) return;
+  // The box grows to hold them (trimmed as the focus points are), so that the carve sees what
+  // stands in front of the subject instead of painting the subject with it.
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<double> values;
+    for (const Eigen::Vector3d& point : occluders) values.push_back(point[axis]);
+    const auto [low_value, high_value] = TrimmedRange(&values);
+    layout->focus_box.min()[axis] = std::min(layout->focus_box.min()[axis], low_value - margin);
+    layout->focus_box.max()[axis] = std::max(layout->focus_box.max()[axis], high_value + margin);
+  }
+}
+
+}  // namespace
+
 CaptureLayout DescribeCapture(const Reconstruction& reconstruction) {
   CaptureLayout layout;
   std::vector<Eigen::Vector3d> centres, axes;
@@ -229,97 +342,9 @@ CaptureLayout DescribeCapture(const Reconstruction& reconstruction) {
     }
   }
   layout.cameras = static_cast<int>(centres.size());
-  if (centres.size() < 2) return layout;
-  // Least squares: sum over cameras of (I - a a^T) (x - c) = 0.
-  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d right = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < centres.size(); ++i) {
-    const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - axes[i] * axes[i].transpose();
-    normal += across;
-    right += across * centres[i];
-  }
-  // Symmetric and positive semi-definite: singular only when every axis is parallel.
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normal);
-  if (!(eigen.eigenvalues()(0) > 1e-6 * eigen.eigenvalues()(2))) return layout;
-  layout.focus = normal.ldlt().solve(right);
-  std::vector<double> distances;
-  std::vector<Eigen::Vector3d> directions;
-  Eigen::Vector3d direction_sum = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < centres.size(); ++i) {
-    const Eigen::Vector3d to_camera = centres[i] - layout.focus;
-    distances.push_back(to_camera.norm());
-    if (to_camera.norm() > 0.0) {
-      directions.push_back(to_camera.normalized());
-      direction_sum += directions.back();
-    }
-    layout.focus_in_front += axes[i].dot(layout.focus - centres[i]) > 0.0;
-  }
-  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
-  layout.camera_distance = distances[distances.size() / 2];
-  // The directions about their mean: the cone's half angle, and their azimuths around it.
-  const double kDegrees = 180.0 / M_PI;
-  const Eigen::Vector3d mean =
-      direction_sum.norm() > 1e-9 ? direction_sum.normalized() : Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d u = mean.unitOrthogonal(), v = mean.cross(u);
-  std::vector<double> azimuths;
-  for (const Eigen::Vector3d& d : directions) {
-    layout.cone_half_angle_degrees = std::max(
-        layout.cone_half_angle_degrees, std::acos(std::clamp(d.dot(mean), -1.0, 1.0)) * kDegrees);
-    const Eigen::Vector3d across = d - d.dot(mean) * mean;
-    if (across.norm() > 1e-9) azimuths.push_back(std::atan2(across.dot(v), across.dot(u)) * kDegrees);
-  }
-  std::sort(azimuths.begin(), azimuths.end());
-  if (azimuths.size() >= 2) {
-    layout.largest_gap_degrees = 360.0 - (azimuths.back() - azimuths.front());
-    for (size_t i = 1; i < azimuths.size(); ++i) {
-      layout.largest_gap_degrees = std::max(layout.largest_gap_degrees, azimuths[i] - azimuths[i - 1]);
-    }
-  }
-  const bool ring = layout.largest_gap_degrees <= kMaxObjectGapDegrees &&
-                    layout.cone_half_angle_degrees >= kMinRingConeDegrees;
-  const bool arc = layout.cone_half_angle_degrees >= kMinArcConeDegrees;
-  layout.object_centred = layout.focus_in_front == layout.cameras && (ring || arc);
-  // The points a photo centred on the focus frames.
-  double half_field = 0.5;
-  if (!half_fields.empty()) {
-    std::nth_element(half_fields.begin(), half_fields.begin() + half_fields.size() / 2,
-                     half_fields.end());
-    half_field = half_fields[half_fields.size() / 2];
-  }
-  const double radius = layout.camera_distance * std::tan(half_field);
-  std::array<std::vector<double>, 3> coordinates;
-  for (const auto& [id, point] : reconstruction.points3D) {
-    if (point.track.size() < 2 || (point.xyz - layout.focus).norm() > radius) continue;
-    for (int axis = 0; axis < 3; ++axis) coordinates[axis].push_back(point.xyz[axis]);
-  }
-  layout.focus_box_points = static_cast<int>(coordinates[0].size());
-  if (layout.focus_box_points < 20) return layout;
-  Eigen::Vector3d low, high;
-  for (int axis = 0; axis < 3; ++axis) {
-    std::vector<double>& values = coordinates[axis];
-    std::sort(values.begin(), values.end());
-    const size_t trim = values.size() / 50;
-    low[axis] = values[trim];
-    high[axis] = values[values.size() - 1 - trim];
-  }
-  const double margin = 0.1 * (high - low).maxCoeff();
-  layout.focus_box = Eigen::AlignedBox3d(low.array() - margin, high.array() + margin);
-  const std::vector<Eigen::Vector3d> occluders = FindOccluders(reconstruction, layout.focus_box);
-  layout.occluder_points = static_cast<int>(occluders.size());
-  if (layout.occluder_points >= kMinOccluderPoints) {
-    // The box grows to hold them (trimmed as the focus points are), so that the carve sees what
-    // stands in front of the subject instead of painting the subject with it.
-    for (int axis = 0; axis < 3; ++axis) {
-      std::vector<double> values;
-      for (const Eigen::Vector3d& point : occluders) values.push_back(point[axis]);
-      std::sort(values.begin(), values.end());
-      const size_t trim = values.size() / 50;
-      layout.focus_box.min()[axis] =
-          std::min(layout.focus_box.min()[axis], values[trim] - margin);
-      layout.focus_box.max()[axis] =
-          std::max(layout.focus_box.max()[axis], values[values.size() - 1 - trim] + margin);
-    }
-  }
+  if (centres.size() < 2 || !NearestToAxes(centres, axes, &layout.focus)) return layout;
+  DescribeDirections(centres, axes, &layout);
+  FindFocusBox(reconstruction, std::move(half_fields), &layout);
   return layout;
 }
 

@@ -132,12 +132,158 @@ void RemoveComponents(const CarveOptions& options, IncrementalCarver* carver, Ca
   }
 }
 
+// The level's worker threads' times, added to the carve's.
+void AddWorkerTimes(const IncrementalCarver& carver, CarveStatistics* statistics) {
+  const ViewWorkers::Times times = carver.worker_times();
+  statistics->parallel_seconds += times.wall_seconds;
+  statistics->parallel_runs += times.runs;
+  statistics->inline_runs += times.inline_runs;
+  if (statistics->thread_work_seconds.size() < times.busy_seconds.size()) {
+    statistics->thread_work_seconds.resize(times.busy_seconds.size(), 0.0);
+  }
+  for (size_t t = 0; t < times.busy_seconds.size(); ++t) {
+    statistics->thread_work_seconds[t] += times.busy_seconds[t];
+  }
+}
+
+// The photos a level carves: `photos` scaled as the level says (into `scaled`). A tile's views
+// (carve/tiling.h: TileViews) are the carve's photos with the pixels it leaves out marked
+// invalid, though they hold photo colours: enlarged, the photos are, and an enlarged pixel is
+// left out where its nearest photo pixel is (not where it blends one).
+const std::vector<CalibratedView>& LevelViews(const std::vector<CalibratedView>& views,
+                                              const std::vector<CalibratedView>& photos,
+                                              ImageScale image_scale,
+                                              std::vector<CalibratedView>* scaled) {
+  const bool enlarged_tile = &photos != &views && image_scale.enlarge > 1;
+  const std::vector<CalibratedView>& level_views =
+      ScaleViews(enlarged_tile ? views : photos, image_scale, scaled);
+  for (size_t v = 0; enlarged_tile && v < views.size(); ++v) {
+    cv::Mat kept;
+    cv::resize(photos[v].valid, kept, (*scaled)[v].valid.size(), 0, 0, cv::INTER_NEAREST);
+    (*scaled)[v].valid &= kept;
+  }
+  return level_views;
+}
+
+// A level's options: the carve's at the level's resolution, one level, its threshold scaled.
+CarveOptions LevelOptions(const CarveOptions& options, int level_resolution, int level,
+                          int num_levels, bool correct_view_count) {
+  CarveOptions level_options = options;
+  level_options.correct_view_count = correct_view_count;
+  level_options.resolution = level_resolution;
+  level_options.lod_levels = 1;
+  if (level + 1 < num_levels) level_options.distant_rays.clear();  // see CarveOptions
+  level_options.threshold =
+      options.threshold * std::pow(options.lod_threshold_scale, num_levels - 1 - level);
+  return level_options;
+}
+
+// A level's set-up into its statistics.
+void RecordLevelStart(const IncrementalCarver& carver, const CarveOptions& level_options,
+                      ImageScale image_scale, double setup_seconds,
+                      LevelStatistics* level_statistics) {
+  level_statistics->resolution = level_options.resolution;
+  level_statistics->image_factor = image_scale.reduce;
+  level_statistics->image_enlargement = image_scale.enlarge;
+  level_statistics->threshold = level_options.threshold;
+  level_statistics->pattern_threshold = level_options.pattern_threshold;
+  level_statistics->dimensions = carver.volume().grid().dimensions();
+  level_statistics->start_solid = carver.volume().num_solid();
+  level_statistics->setup_seconds = setup_seconds;
+}
+
+// What the first level's set-up did (visibility, visual hull, free space) into `statistics`;
+// returns the voxels the visual hull carved, in final voxels (`scale` a level voxel).
+int64_t RecordFirstLevel(IncrementalCarver& carver, const CarveOptions& options,
+                         const VoxelGrid& final_grid, int64_t scale, double setup_seconds,
+                         CarveStatistics* statistics) {
+  statistics->visibility = carver.visibility().Name();
+  if (options.method == CarveMethod::kRay) {
+    statistics->visibility += " (" + VisLookupToString(options.vis_lookup) + ")";
+  }
+  statistics->initial_surface = carver.volume().num_surface();
+  statistics->views_with_masks = carver.visual_hull().views_with_masks;
+  statistics->visual_hull_carved = carver.visual_hull().carved;
+  statistics->visual_hull_seconds = carver.visual_hull().seconds;
+  statistics->free_space_level0_carved = carver.free_space().carved;
+  statistics->setup_seconds = setup_seconds;
+  if (options.decision == CarveDecision::kReprojection) {
+    statistics->reprojection_error_before = carver.MeanReprojectionError();
+  }
+  return std::min(final_grid.num_voxels(), carver.visual_hull().carved * scale);
+}
+
+// A finished level's counts into its statistics and the carve's.
+void RecordLevelEnd(const IncrementalCarver& carver, LevelStatistics* level_statistics,
+                    CarveStatistics* statistics) {
+  level_statistics->carved =
+      carver.carved() + carver.visual_hull().carved + carver.free_space().carved +
+      carver.distant().carved + carver.ground_seen().carved + carver.beyond_ground_carved();
+  level_statistics->free_space_carved = carver.free_space().carved;
+  statistics->free_space_carved += carver.free_space().carved;
+  statistics->free_space_sight_lines = carver.free_space().sight_lines;
+  statistics->free_space_seconds += carver.free_space().seconds;
+  statistics->distant_carved += carver.distant().carved;
+  statistics->distant_rays = carver.distant().sight_lines;
+  statistics->ground_seen_carved += carver.ground_seen().carved;
+  statistics->ground_seen_rays = carver.ground_seen().sight_lines;
+  level_statistics->evaluated = carver.evaluated();
+  level_statistics->protected_kept = carver.protected_kept();
+  statistics->ground_voxels = carver.ground_voxels();
+  statistics->beyond_ground_carved += carver.beyond_ground_carved();
+  level_statistics->final_solid = carver.volume().num_solid();
+  statistics->evaluated += carver.evaluated();
+  statistics->passes = std::max(statistics->passes, carver.passes());
+  statistics->threads = carver.threads();
+  statistics->peak_memory_bytes = std::max(statistics->peak_memory_bytes, carver.MemoryBytes());
+}
+
+// The carving curve's samples and the progress reports across the levels.
+struct LevelsClock {
+  Clock::time_point start;  // when the first level's carving began
+  double next_report = 0.0;
+  double next_sample = 0.0;
+  int64_t hull_carved = 0;  // the first level's visual hull, in final voxels
+};
+
+// One sample of the carving curve: voxels removed, in final voxels (`scale` a level voxel), less
+// what the visual hull carved.
+void SampleCurve(const IncrementalCarver& carver, int64_t scale, const VoxelGrid& final_grid,
+                 const LevelsClock& clock, CarveStatistics* statistics) {
+  const int64_t removed = std::max<int64_t>(
+      0, final_grid.num_voxels() - std::min(final_grid.num_voxels(),
+                                            carver.volume().num_solid() * scale));
+  statistics->curve.push_back({SecondsSince(clock.start),
+                               std::max<int64_t>(0, removed - clock.hull_carved),
+                               statistics->evaluated + carver.evaluated()});
+}
+
+// Runs the level's carver to the end, sampling the curve and reporting progress.
+void RunLevel(int level, int num_levels, int64_t scale, const VoxelGrid& final_grid,
+              const std::function<void(const CarveProgress&)>& progress,
+              double progress_interval_seconds, IncrementalCarver* carver, LevelsClock* clock,
+              CarveStatistics* statistics) {
+  SampleCurve(*carver, scale, final_grid, *clock, statistics);
+  for (int64_t next_check = 1024; carver->Step();) {
+    if (carver->evaluated() < next_check) continue;
+    next_check = carver->evaluated() + 1024;
+    const double seconds = SecondsSince(clock->start);
+    if (seconds >= clock->next_sample) {
+      SampleCurve(*carver, scale, final_grid, *clock, statistics);
+      clock->next_sample = seconds + 0.05;
+    }
+    if (progress && seconds >= clock->next_report) {
+      progress({level, num_levels, statistics->evaluated + carver->evaluated(), carver->carved(),
+                static_cast<int64_t>(carver->queue_size()), seconds});
+      clock->next_report = seconds + progress_interval_seconds;
+    }
+  }
+}
+
 // With masks: each photo's object pixels get back the model carving took from their rays; the
 // restored voxels are final, so a new carver over the repaired volume only colours it.
-template <typename AddWorkerTimes>
 void RepairSilhouettesAndRecolour(const std::vector<CalibratedView>& views,
                                   const CarveOptions& options,
-                                  AddWorkerTimes& add_worker_times,
                                   std::unique_ptr<IncrementalCarver>* carver,
                                   CarveStatistics* statistics) {
   if (!options.repair_silhouettes || statistics->views_with_masks == 0) return;
@@ -153,9 +299,42 @@ void RepairSilhouettesAndRecolour(const std::vector<CalibratedView>& views,
   colouring.min_component_voxels = 0;
   colouring.unsupported_component_points = 0.0;
   statistics->peak_memory_bytes = std::max(statistics->peak_memory_bytes, (*carver)->MemoryBytes());
-  add_worker_times(**carver);
+  AddWorkerTimes(**carver, statistics);
   carver->reset();
   *carver = std::make_unique<IncrementalCarver>(views, std::move(repaired), colouring);
+}
+
+// The carve's end: its statistics, and with `stages.finish` the surface coloured.
+CarveResult FinishLevels(const CarveStages& stages, int last_level, int num_levels,
+                         const std::function<void(const CarveProgress&)>& progress,
+                         const LevelsClock& clock, IncrementalCarver* carver,
+                         CarveStatistics statistics) {
+  statistics.carve_seconds = SecondsSince(clock.start);
+  statistics.dimensions = carver->volume().grid().dimensions();
+  statistics.voxel_size = carver->volume().grid().voxel_size();
+  statistics.num_voxels = carver->volume().grid().num_voxels();
+  statistics.carved = statistics.num_voxels - carver->volume().num_solid();
+
+  const Clock::time_point colour_start = Clock::now();
+  CarveResult result{carver->volume().grid()};
+  if (stages.finish) {
+    result.surface = carver->ColourSurface();
+    statistics.reprojection_error_after = carver->surface_reprojection_error();
+    for (const ColouredVoxel& voxel : result.surface) {
+      if (voxel.num_pixels > 0) ++statistics.visible_surface;
+    }
+    statistics.colour_seconds = SecondsSince(colour_start);
+    AddWorkerTimes(*carver, &statistics);
+  }
+  statistics.final_surface = carver->volume().num_surface();
+  statistics.final_solid = carver->volume().num_solid();
+  result.volume = std::move(*carver->mutable_volume());
+  result.statistics = std::move(statistics);
+  if (progress) {
+    progress({last_level, num_levels, result.statistics.evaluated, result.statistics.carved,
+              0, result.statistics.carve_seconds});
+  }
+  return result;
 }
 
 }  // namespace
@@ -181,25 +360,11 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
   const VoxelGrid final_grid(box, options.resolution);
 
   CarveStatistics statistics;
-  Clock::time_point start;  // when the first level's carving began
-  double next_report = progress_interval_seconds;
-  double next_sample = 0.0;
-  int64_t hull_carved = 0;  // the first level's visual hull, in final voxels
+  LevelsClock clock;
+  clock.next_report = progress_interval_seconds;
   std::unique_ptr<IncrementalCarver> carver;
   std::vector<CalibratedView> scaled_views;  // a level's photos, when reduced or enlarged
   const int supersample = FinalSupersample(views, box, options);
-  auto add_worker_times = [&statistics](const IncrementalCarver& level_carver) {
-    const ViewWorkers::Times times = level_carver.worker_times();
-    statistics.parallel_seconds += times.wall_seconds;
-    statistics.parallel_runs += times.runs;
-    statistics.inline_runs += times.inline_runs;
-    if (statistics.thread_work_seconds.size() < times.busy_seconds.size()) {
-      statistics.thread_work_seconds.resize(times.busy_seconds.size(), 0.0);
-    }
-    for (size_t t = 0; t < times.busy_seconds.size(); ++t) {
-      statistics.thread_work_seconds[t] += times.busy_seconds[t];
-    }
-  };
   // Only where the threshold comes from the same corrected errors: a --threshold given as a
   // number is on the seed paper's scale.
   const bool correct_view_count =
@@ -209,13 +374,8 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
   for (int level = first_level; level <= last_level; ++level) {
     const Clock::time_point level_start = Clock::now();
     const bool final_level = level + 1 == num_levels;
-    CarveOptions level_options = options;
-    level_options.correct_view_count = correct_view_count;
-    level_options.resolution = resolutions[level];
-    level_options.lod_levels = 1;
-    if (level + 1 < num_levels) level_options.distant_rays.clear();  // see CarveOptions
-    level_options.threshold =
-        options.threshold * std::pow(options.lod_threshold_scale, num_levels - 1 - level);
+    CarveOptions level_options =
+        LevelOptions(options, resolutions[level], level, num_levels, correct_view_count);
     const ImageScale image_scale =
         LevelImageScale(views, resolutions[level], options, supersample);
     std::unique_ptr<Volume> start_volume;
@@ -229,17 +389,8 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
     scaled_views.clear();  // the last level's go before this one's are made
     const std::vector<CalibratedView>& photos =
         final_level && stages.final_views ? *stages.final_views : views;
-    // A tile's views (carve/tiling.h: TileViews) are the carve's photos with the pixels it
-    // leaves out marked invalid, though they hold photo colours: enlarged, the photos are, and an
-    // enlarged pixel is left out where its nearest photo pixel is (not where it blends one).
-    const bool enlarged_tile = &photos != &views && image_scale.enlarge > 1;
     const std::vector<CalibratedView>& level_views =
-        ScaleViews(enlarged_tile ? views : photos, image_scale, &scaled_views);
-    for (size_t v = 0; enlarged_tile && v < views.size(); ++v) {
-      cv::Mat kept;
-      cv::resize(photos[v].valid, kept, scaled_views[v].valid.size(), 0, 0, cv::INTER_NEAREST);
-      scaled_views[v].valid &= kept;
-    }
+        LevelViews(views, photos, image_scale, &scaled_views);
     LevelStatistics level_statistics;
     if (final_level && stages.final_thresholds_given) {
       level_options.threshold = stages.final_threshold;
@@ -258,110 +409,27 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
     }
     // A voxel of this level holds `scale` final voxels (up to the grid's edge).
     const int64_t scale = int64_t{1} << (3 * (num_levels - 1 - level));
-    level_statistics.resolution = resolutions[level];
-    level_statistics.image_factor = image_scale.reduce;
-    level_statistics.image_enlargement = image_scale.enlarge;
-    level_statistics.threshold = level_options.threshold;
-    level_statistics.pattern_threshold = level_options.pattern_threshold;
-    level_statistics.dimensions = carver->volume().grid().dimensions();
-    level_statistics.start_solid = carver->volume().num_solid();
-    level_statistics.setup_seconds = SecondsSince(level_start);
+    RecordLevelStart(*carver, level_options, image_scale, SecondsSince(level_start),
+                     &level_statistics);
     if (level == first_level) {
-      statistics.visibility = carver->visibility().Name();
-      if (options.method == CarveMethod::kRay) {
-        statistics.visibility += " (" + VisLookupToString(options.vis_lookup) + ")";
-      }
-      statistics.initial_surface = carver->volume().num_surface();
-      statistics.views_with_masks = carver->visual_hull().views_with_masks;
-      statistics.visual_hull_carved = carver->visual_hull().carved;
-      statistics.visual_hull_seconds = carver->visual_hull().seconds;
-      statistics.free_space_level0_carved = carver->free_space().carved;
-      statistics.setup_seconds = SecondsSince(level_start);
       // The curve leaves out what the visual hull carved; the sparse points' sight lines are in
       // its first value.
-      hull_carved = std::min(final_grid.num_voxels(), carver->visual_hull().carved * scale);
-      if (options.decision == CarveDecision::kReprojection) {
-        statistics.reprojection_error_before = carver->MeanReprojectionError();
-      }
-      start = Clock::now();
+      clock.hull_carved = RecordFirstLevel(*carver, options, final_grid, scale,
+                                           SecondsSince(level_start), &statistics);
+      clock.start = Clock::now();
     }
-    auto sample = [&](double seconds) {
-      const int64_t removed = std::max<int64_t>(
-          0, final_grid.num_voxels() - std::min(final_grid.num_voxels(),
-                                                carver->volume().num_solid() * scale));
-      statistics.curve.push_back({seconds, std::max<int64_t>(0, removed - hull_carved),
-                                  statistics.evaluated + carver->evaluated()});
-    };
-    sample(SecondsSince(start));
-    for (int64_t next_check = 1024; carver->Step();) {
-      if (carver->evaluated() < next_check) continue;
-      next_check = carver->evaluated() + 1024;
-      const double seconds = SecondsSince(start);
-      if (seconds >= next_sample) {
-        sample(seconds);
-        next_sample = seconds + 0.05;
-      }
-      if (progress && seconds >= next_report) {
-        progress({level, num_levels, statistics.evaluated + carver->evaluated(), carver->carved(),
-                  static_cast<int64_t>(carver->queue_size()), seconds});
-        next_report = seconds + progress_interval_seconds;
-      }
-    }
+    RunLevel(level, num_levels, scale, final_grid, progress, progress_interval_seconds,
+             carver.get(), &clock, &statistics);
     if (final_level && stages.finish) RemoveComponents(options, carver.get(), &statistics);
-    sample(SecondsSince(start));
-    level_statistics.carved =
-        carver->carved() + carver->visual_hull().carved + carver->free_space().carved +
-        carver->distant().carved + carver->ground_seen().carved + carver->beyond_ground_carved();
-    level_statistics.free_space_carved = carver->free_space().carved;
-    statistics.free_space_carved += carver->free_space().carved;
-    statistics.free_space_sight_lines = carver->free_space().sight_lines;
-    statistics.free_space_seconds += carver->free_space().seconds;
-    statistics.distant_carved += carver->distant().carved;
-    statistics.distant_rays = carver->distant().sight_lines;
-    statistics.ground_seen_carved += carver->ground_seen().carved;
-    statistics.ground_seen_rays = carver->ground_seen().sight_lines;
-    level_statistics.evaluated = carver->evaluated();
-    level_statistics.protected_kept = carver->protected_kept();
-    statistics.ground_voxels = carver->ground_voxels();
-    statistics.beyond_ground_carved += carver->beyond_ground_carved();
-    level_statistics.final_solid = carver->volume().num_solid();
+    SampleCurve(*carver, scale, final_grid, clock, &statistics);
     level_statistics.seconds = SecondsSince(level_start);
+    RecordLevelEnd(*carver, &level_statistics, &statistics);
     statistics.levels.push_back(level_statistics);
-    statistics.evaluated += carver->evaluated();
-    statistics.passes = std::max(statistics.passes, carver->passes());
-    statistics.threads = carver->threads();
-    statistics.peak_memory_bytes = std::max(statistics.peak_memory_bytes, carver->MemoryBytes());
-    if (level < last_level || !stages.finish) add_worker_times(*carver);
+    if (level < last_level || !stages.finish) AddWorkerTimes(*carver, &statistics);
   }
-  if (stages.finish) {
-    RepairSilhouettesAndRecolour(views, options, add_worker_times, &carver, &statistics);
-  }
-  statistics.carve_seconds = SecondsSince(start);
-  statistics.dimensions = carver->volume().grid().dimensions();
-  statistics.voxel_size = carver->volume().grid().voxel_size();
-  statistics.num_voxels = carver->volume().grid().num_voxels();
-  statistics.carved = statistics.num_voxels - carver->volume().num_solid();
-
-  const Clock::time_point colour_start = Clock::now();
-  CarveResult result{carver->volume().grid()};
-  if (stages.finish) {
-    result.surface = carver->ColourSurface();
-    statistics.reprojection_error_after = carver->surface_reprojection_error();
-    for (const ColouredVoxel& voxel : result.surface) {
-      if (voxel.num_pixels > 0) ++statistics.visible_surface;
-    }
-    statistics.colour_seconds = SecondsSince(colour_start);
-    add_worker_times(*carver);
-  }
-  statistics.final_surface = carver->volume().num_surface();
-  statistics.final_solid = carver->volume().num_solid();
-  result.volume = std::move(*carver->mutable_volume());
-  result.statistics = std::move(statistics);
-  if (progress) {
-    progress({last_level, num_levels, result.statistics.evaluated, result.statistics.carved,
-              0, result.statistics.carve_seconds});
-  }
-  return result;
+  if (stages.finish) RepairSilhouettesAndRecolour(views, options, &carver, &statistics);
+  return FinishLevels(stages, last_level, num_levels, progress, clock, carver.get(),
+                      std::move(statistics));
 }
 
 CarveResult CarveVolume(const std::vector<CalibratedView>& views,

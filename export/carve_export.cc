@@ -253,6 +253,113 @@ std::string FinalSmoothingSummary(const ModelMesh& model, const ModelMeshOptions
   return text;
 }
 
+namespace {
+
+void Tell(const ModelMeshOptions& options, const std::string& line) {
+  if (options.progress) options.progress(line);
+}
+
+// The iso-surface's positions (`iso_surface`, one per vertex of `meshed`, the mesh as
+// MeshSolidVoxels made it) of the vertices `mesh` keeps after removals, found by the smoothed
+// position (which the removals copy bit for bit); `mesh`'s own positions where any is not found.
+std::vector<Eigen::Vector3f> IsoSurfaceOf(const std::vector<Eigen::Vector3f>& iso_surface,
+                                          const std::vector<Eigen::Vector3f>& meshed,
+                                          const TriangleMesh& mesh) {
+  std::vector<Eigen::Vector3f> unrefined = mesh.vertices;
+  if (iso_surface.size() != meshed.size() || iso_surface.empty()) return unrefined;
+  std::map<std::array<float, 3>, Eigen::Vector3f> iso_surface_at;
+  for (size_t v = 0; v < iso_surface.size(); ++v) {
+    const Eigen::Vector3f& p = meshed[v];
+    iso_surface_at.emplace(std::array<float, 3>{p.x(), p.y(), p.z()}, iso_surface[v]);
+  }
+  for (Eigen::Vector3f& p : unrefined) {
+    const auto found = iso_surface_at.find({p.x(), p.y(), p.z()});
+    if (found == iso_surface_at.end()) return mesh.vertices;
+    p = found->second;
+  }
+  return unrefined;
+}
+
+// Refinement from the photos, then the final smoothing where the photos leave the position open.
+void RefineModel(const std::vector<CalibratedView>& views, const VoxelGrid& grid,
+                 const ModelMeshOptions& options, double smoothing_pass_band, ModelMesh* model) {
+  MeshRefinementOptions refinement;
+  refinement.passes = options.refine_passes;
+  refinement.converged_offset = options.refine_converged_voxels * grid.voxel_size();
+  refinement.search_range = grid.voxel_size();
+  refinement.patch_radius = 0.5 * grid.voxel_size();
+  refinement.depth_tolerance = grid.voxel_size();
+  refinement.voxel_size = grid.voxel_size();
+  refinement.min_views = std::max(2, options.min_views);
+  refinement.num_threads = options.num_threads;
+  if (refinement.passes == 0) return;
+  Tell(options, "mesh refinement: at most " + std::to_string(refinement.passes) + " passes over " +
+                    std::to_string(model->mesh.vertices.size()) + " vertices, from " +
+                    std::to_string(views.size()) + " photos ...");
+  model->refinement = RefineMeshFromPhotos(views, refinement, &model->mesh);
+  Tell(options, model->refinement.Summary());
+  if (options.final_smoothing_iterations == 0) return;
+  // Smoothed where the photos leave the position open, kept where they pin it.
+  TriangleMesh smooth = model->mesh;
+  SmoothMesh(options.final_smoothing_iterations, smoothing_pass_band, &smooth);
+  double moved = 0.0;
+  for (size_t i = 0; i < model->mesh.vertices.size(); ++i) {
+    const float open = 1.0f - model->refinement.pinned[i];
+    const Eigen::Vector3f step = open * (smooth.vertices[i] - model->mesh.vertices[i]);
+    model->mesh.vertices[i] += step;
+    moved += step.norm();
+  }
+  model->final_smoothing_mean_move = moved / static_cast<double>(model->mesh.vertices.size());
+  ComputeVertexNormals(&model->mesh);
+  Tell(options, FinalSmoothingSummary(*model, options));
+}
+
+// The walls are found on the final geometry and left out before colouring, so that the colour
+// figures describe the mesh written.
+void MarkAndRemoveWalls(const VoxelGrid& grid, const ModelMeshOptions& options, ModelMesh* model) {
+  model->on_grid_wall = GridWallVertices(model->mesh, grid);
+  model->grid_wall_vertices =
+      std::count(model->on_grid_wall.begin(), model->on_grid_wall.end(), uint8_t{1});
+  if (!options.remove_grid_walls) return;
+  const std::vector<uint8_t> fill =
+      GroundFillVertices(model->mesh, options.ground, grid.voxel_size());
+  for (const Eigen::Vector3i& t : model->mesh.triangles) {
+    const bool on_wall =
+        model->on_grid_wall[t[0]] && model->on_grid_wall[t[1]] && model->on_grid_wall[t[2]];
+    model->ground_fill_triangles_removed += !on_wall && fill[t[0]] && fill[t[1]] && fill[t[2]];
+  }
+  for (size_t i = 0; i < fill.size(); ++i) model->on_grid_wall[i] |= fill[i];
+  RemoveGridWalls(model, options.sparse_points, 1.5 * grid.voxel_size());
+  if (model->wall_sliver_triangles_removed > 0 || model->ground_fill_triangles_removed > 0) {
+    Tell(options, "mesh walls: " + std::to_string(model->wall_triangles_removed) +
+                      " triangles on the volume box's walls left out (" +
+                      std::to_string(model->ground_fill_triangles_removed) +
+                      " more of the held ground's sides and underside), then " +
+                      std::to_string(model->wall_sliver_triangles_removed) +
+                      " triangles of slivers only the walls held to the model (no sparse point "
+                      "on them)");
+  }
+}
+
+// Vertex colours from the photos, then the texture atlas.
+void ColourModel(const std::vector<CalibratedView>& views, const VoxelGrid& grid,
+                 const ModelMeshOptions& options, ModelMesh* model) {
+  MeshColouringOptions colouring;
+  colouring.min_views = options.min_views;
+  colouring.depth_tolerance = grid.voxel_size();
+  colouring.num_threads = options.num_threads;
+  model->colouring = ColourMeshFromPhotos(views, colouring, &model->mesh, &model->seen_by);
+  Tell(options, model->colouring.Summary());
+  if (options.texture && !model->mesh.empty()) {
+    MeshTextureOptions texture = options.texture_options;
+    texture.num_threads = options.num_threads;
+    model->texture = TextureMeshFromPhotos(views, model->seen_by, texture, &model->mesh);
+    Tell(options, model->texture.Summary());
+  }
+}
+
+}  // namespace
+
 ModelMesh MeshCarvedModel(const CarveResult& result,
                           const std::vector<CalibratedView>& views,
                           const ModelMeshOptions& options) {
@@ -267,71 +374,20 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     geometry.max_edge_length = std::max(0.25 * grid.voxel_size(), options.edge_pixels * pixel);
   }
   ModelMesh model;
-  const auto tell = [&options](const std::string& line) {
-    if (options.progress) options.progress(line);
-  };
   std::vector<Eigen::Vector3f> iso_surface;
   model.mesh = MeshSolidVoxels(result.volume, geometry, &model.geometry, &iso_surface);
-  // The iso-surface's positions follow the vertices through the removals below by the smoothed
-  // position (which the removals copy bit for bit).
-  std::map<std::array<float, 3>, Eigen::Vector3f> iso_surface_at;
-  if (iso_surface.size() == model.mesh.vertices.size()) {
-    for (size_t v = 0; v < iso_surface.size(); ++v) {
-      const Eigen::Vector3f& p = model.mesh.vertices[v];
-      iso_surface_at.emplace(std::array<float, 3>{p.x(), p.y(), p.z()}, iso_surface[v]);
-    }
-  }
+  const std::vector<Eigen::Vector3f> meshed = model.mesh.vertices;
   model.small_components_removed =
       RemoveSmallComponents(options.min_component_vertices, &model.mesh);
-  tell(model.geometry.Summary());
+  Tell(options, model.geometry.Summary());
   model.parts = RemoveUnneededParts(views, options.part_min_views, options.sparse_points,
                                     1.5 * grid.voxel_size(), options.num_threads, &model.mesh);
-  if (model.parts.removed > 0 || model.parts.anchored > 0) tell(model.parts.Summary());
+  if (model.parts.removed > 0 || model.parts.anchored > 0) Tell(options, model.parts.Summary());
   if (model.mesh.empty()) return model;
   // What UndoSelfIntersections returns vertices towards: the iso-surface before smoothing, which
   // never folds through itself; else (splitting or decimation) the smoothed one.
-  std::vector<Eigen::Vector3f> unrefined = model.mesh.vertices;
-  if (!iso_surface_at.empty()) {
-    for (Eigen::Vector3f& p : unrefined) {
-      const auto found = iso_surface_at.find({p.x(), p.y(), p.z()});
-      if (found == iso_surface_at.end()) {
-        unrefined = model.mesh.vertices;
-        break;
-      }
-      p = found->second;
-    }
-  }
-  MeshRefinementOptions refinement;
-  refinement.passes = options.refine_passes;
-  refinement.converged_offset = options.refine_converged_voxels * grid.voxel_size();
-  refinement.search_range = grid.voxel_size();
-  refinement.patch_radius = 0.5 * grid.voxel_size();
-  refinement.depth_tolerance = grid.voxel_size();
-  refinement.voxel_size = grid.voxel_size();
-  refinement.min_views = std::max(2, options.min_views);
-  refinement.num_threads = options.num_threads;
-  if (refinement.passes > 0) {
-    tell("mesh refinement: at most " + std::to_string(refinement.passes) + " passes over " +
-         std::to_string(model.mesh.vertices.size()) + " vertices, from " +
-         std::to_string(views.size()) + " photos ...");
-    model.refinement = RefineMeshFromPhotos(views, refinement, &model.mesh);
-    tell(model.refinement.Summary());
-    if (options.final_smoothing_iterations > 0) {
-      // Smoothed where the photos leave the position open, kept where they pin it.
-      TriangleMesh smooth = model.mesh;
-      SmoothMesh(options.final_smoothing_iterations, geometry.smoothing_pass_band, &smooth);
-      double moved = 0.0;
-      for (size_t i = 0; i < model.mesh.vertices.size(); ++i) {
-        const float open = 1.0f - model.refinement.pinned[i];
-        const Eigen::Vector3f step = open * (smooth.vertices[i] - model.mesh.vertices[i]);
-        model.mesh.vertices[i] += step;
-        moved += step.norm();
-      }
-      model.final_smoothing_mean_move = moved / static_cast<double>(model.mesh.vertices.size());
-      ComputeVertexNormals(&model.mesh);
-      tell(FinalSmoothingSummary(model, options));
-    }
-  }
+  const std::vector<Eigen::Vector3f> unrefined = IsoSurfaceOf(iso_surface, meshed, model.mesh);
+  RefineModel(views, grid, options, geometry.smoothing_pass_band, &model);
   if (options.silhouette_passes > 0) {
     SilhouetteFitOptions fit;
     fit.passes = options.silhouette_passes;
@@ -339,47 +395,14 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     fit.depth_tolerance = grid.voxel_size();
     fit.num_threads = options.num_threads;
     model.silhouettes = FitMeshToSilhouettes(views, fit, &model.mesh);
-    if (model.silhouettes.passes > 0) tell(model.silhouettes.Summary());
+    if (model.silhouettes.passes > 0) Tell(options, model.silhouettes.Summary());
   }
   if (options.undo_self_intersections) {
     model.self_intersections = UndoSelfIntersections(unrefined, &model.mesh);
-    tell("mesh self-intersections: " + model.self_intersections.Summary());
+    Tell(options, "mesh self-intersections: " + model.self_intersections.Summary());
   }
-  // The walls are found on the final geometry and left out before colouring, so that the colour
-  // figures describe the mesh written.
-  model.on_grid_wall = GridWallVertices(model.mesh, grid);
-  model.grid_wall_vertices =
-      std::count(model.on_grid_wall.begin(), model.on_grid_wall.end(), uint8_t{1});
-  if (options.remove_grid_walls) {
-    const std::vector<uint8_t> fill =
-        GroundFillVertices(model.mesh, options.ground, grid.voxel_size());
-    for (const Eigen::Vector3i& t : model.mesh.triangles) {
-      const bool on_wall =
-          model.on_grid_wall[t[0]] && model.on_grid_wall[t[1]] && model.on_grid_wall[t[2]];
-      model.ground_fill_triangles_removed += !on_wall && fill[t[0]] && fill[t[1]] && fill[t[2]];
-    }
-    for (size_t i = 0; i < fill.size(); ++i) model.on_grid_wall[i] |= fill[i];
-    RemoveGridWalls(&model, options.sparse_points, 1.5 * grid.voxel_size());
-    if (model.wall_sliver_triangles_removed > 0 || model.ground_fill_triangles_removed > 0) {
-      tell("mesh walls: " + std::to_string(model.wall_triangles_removed) + " triangles on the " +
-           "volume box's walls left out (" + std::to_string(model.ground_fill_triangles_removed) +
-           " more of the held ground's sides and underside), then " +
-           std::to_string(model.wall_sliver_triangles_removed) + " triangles of slivers only the " +
-           "walls held to the model (no sparse point on them)");
-    }
-  }
-  MeshColouringOptions colouring;
-  colouring.min_views = options.min_views;
-  colouring.depth_tolerance = grid.voxel_size();
-  colouring.num_threads = options.num_threads;
-  model.colouring = ColourMeshFromPhotos(views, colouring, &model.mesh, &model.seen_by);
-  tell(model.colouring.Summary());
-  if (options.texture && !model.mesh.empty()) {
-    MeshTextureOptions texture = options.texture_options;
-    texture.num_threads = options.num_threads;
-    model.texture = TextureMeshFromPhotos(views, model.seen_by, texture, &model.mesh);
-    tell(model.texture.Summary());
-  }
+  MarkAndRemoveWalls(grid, options, &model);
+  ColourModel(views, grid, options, &model);
   return model;
 }
 

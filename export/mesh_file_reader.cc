@@ -226,17 +226,13 @@ struct Gathered {
   bool any_colours = false;
 };
 
-void AddPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& primitive,
-                  const Eigen::Matrix4d& transform, const std::map<int, cv::Mat>& images,
-                  const std::string& path, Gathered* out) {
-  if (primitive.mode != TINYGLTF_MODE_TRIANGLES && primitive.mode != -1) return;
-  const auto position = primitive.attributes.find("POSITION");
-  if (position == primitive.attributes.end()) return;
-  const std::vector<double> xyz = ReadAccessor(model, position->second, 3, "POSITION", path);
+// The primitive's `n` vertices (as `xyz`) moved by `transform`, and their normals (turned by its
+// inverse transpose) where it has them.
+void AddVertices(const tinygltf::Model& model, const tinygltf::Primitive& primitive,
+                 const std::vector<double>& xyz, const Eigen::Matrix4d& transform,
+                 const std::string& path, Gathered* out) {
   const size_t n = xyz.size() / 3;
   TriangleMesh& mesh = out->mesh;
-  const size_t base = mesh.vertices.size();
-  if (base + n > kMaxElements) throw InputError(path + ": more vertices than raycarve reads");
   const Eigen::Matrix3d normal_transform = transform.topLeftCorner<3, 3>().inverse().transpose();
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector4d p = transform * Eigen::Vector4d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2], 1.0);
@@ -248,66 +244,104 @@ void AddPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& primi
     mesh.vertices.push_back(v);
   }
   const auto normal = primitive.attributes.find("NORMAL");
-  if (normal != primitive.attributes.end()) {
-    const std::vector<double> v = ReadAccessor(model, normal->second, 3, "NORMAL", path);
-    if (v.size() != xyz.size()) throw InputError(path + ": NORMAL: its count differs from POSITION's");
-    for (size_t i = 0; i < n; ++i) {
-      const Eigen::Vector3d d = normal_transform * Eigen::Vector3d(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
-      mesh.normals.push_back(d.norm() > 0.0 ? Eigen::Vector3f(d.normalized().cast<float>()) : Eigen::Vector3f::Zero());
-    }
-  } else {
+  if (normal == primitive.attributes.end()) {
     out->any_normals = false;
     mesh.normals.resize(mesh.vertices.size(), Eigen::Vector3f::Zero());
+    return;
   }
+  const std::vector<double> v = ReadAccessor(model, normal->second, 3, "NORMAL", path);
+  if (v.size() != xyz.size()) throw InputError(path + ": NORMAL: its count differs from POSITION's");
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d d = normal_transform * Eigen::Vector3d(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+    mesh.normals.push_back(d.norm() > 0.0 ? Eigen::Vector3f(d.normalized().cast<float>()) : Eigen::Vector3f::Zero());
+  }
+}
+
+// The primitive's `n` vertex colours (linear in glTF, sRGB bytes in the mesh); white without.
+void AddColours(const tinygltf::Model& model, const tinygltf::Primitive& primitive, size_t base,
+                size_t n, const std::string& path, Gathered* out) {
+  TriangleMesh& mesh = out->mesh;
   const auto colour = primitive.attributes.find("COLOR_0");
   mesh.colours.resize(base, Eigen::Matrix<uint8_t, 3, 1>::Constant(255));
-  if (colour != primitive.attributes.end()) {
-    const bool known = colour->second >= 0 && colour->second < static_cast<int>(model.accessors.size());
-    const int components = known && model.accessors[colour->second].type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
-    const std::vector<double> v = ReadAccessor(model, colour->second, components, "COLOR_0", path);
-    if (v.size() / components != n) throw InputError(path + ": COLOR_0: its count differs from POSITION's");
-    for (size_t i = 0; i < n; ++i) {
-      mesh.colours.emplace_back(SrgbByteFromLinear(v[components * i]),
-                                SrgbByteFromLinear(v[components * i + 1]),
-                                SrgbByteFromLinear(v[components * i + 2]));
-    }
-    out->any_colours = true;
-  } else {
+  if (colour == primitive.attributes.end()) {
     mesh.colours.resize(mesh.vertices.size(), Eigen::Matrix<uint8_t, 3, 1>::Constant(255));
+    return;
   }
-  // The texture: the material's base colour texture, with its coordinates.
-  int texture_image = -1;
-  std::vector<double> uv;
-  if (primitive.material >= 0 && primitive.material < static_cast<int>(model.materials.size())) {
-    const tinygltf::TextureInfo& info =
-        model.materials[primitive.material].pbrMetallicRoughness.baseColorTexture;
-    const auto coordinates = primitive.attributes.find("TEXCOORD_" + std::to_string(std::max(0, info.texCoord)));
-    if (info.index >= 0 && info.index < static_cast<int>(model.textures.size()) &&
-        coordinates != primitive.attributes.end() && images.count(model.textures[info.index].source)) {
-      texture_image = model.textures[info.index].source;
-      uv = ReadAccessor(model, coordinates->second, 2, "TEXCOORD", path);
-      if (uv.size() / 2 != n) throw InputError(path + ": TEXCOORD: its count differs from POSITION's");
-      for (size_t i = 0; i < uv.size(); ++i) {
-        // Beyond a million repeats of the texture a float no longer tells texels apart.
-        if (!(std::abs(uv[i]) < 1e6)) {
-          throw InputError(path + ": TEXCOORD: coordinate " + std::to_string(i / 2) + " is not a finite texture position");
-        }
-      }
+  const bool known = colour->second >= 0 && colour->second < static_cast<int>(model.accessors.size());
+  const int components = known && model.accessors[colour->second].type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+  const std::vector<double> v = ReadAccessor(model, colour->second, components, "COLOR_0", path);
+  if (v.size() / components != n) throw InputError(path + ": COLOR_0: its count differs from POSITION's");
+  for (size_t i = 0; i < n; ++i) {
+    mesh.colours.emplace_back(SrgbByteFromLinear(v[components * i]),
+                              SrgbByteFromLinear(v[components * i + 1]),
+                              SrgbByteFromLinear(v[components * i + 2]));
+  }
+  out->any_colours = true;
+}
+
+// The primitive's texture: its material's base colour texture (the image's index; -1 without),
+// with the coordinates of its `n` vertices into `uv`.
+int PrimitiveTexture(const tinygltf::Model& model, const tinygltf::Primitive& primitive, size_t n,
+                     const std::map<int, cv::Mat>& images, const std::string& path,
+                     std::vector<double>* uv) {
+  if (primitive.material < 0 || primitive.material >= static_cast<int>(model.materials.size())) {
+    return -1;
+  }
+  const tinygltf::TextureInfo& info =
+      model.materials[primitive.material].pbrMetallicRoughness.baseColorTexture;
+  const auto coordinates = primitive.attributes.find("TEXCOORD_" + std::to_string(std::max(0, info.texCoord)));
+  if (info.index < 0 || info.index >= static_cast<int>(model.textures.size()) ||
+      coordinates == primitive.attributes.end() || !images.count(model.textures[info.index].source)) {
+    return -1;
+  }
+  *uv = ReadAccessor(model, coordinates->second, 2, "TEXCOORD", path);
+  if (uv->size() / 2 != n) throw InputError(path + ": TEXCOORD: its count differs from POSITION's");
+  for (size_t i = 0; i < uv->size(); ++i) {
+    // Beyond a million repeats of the texture a float no longer tells texels apart.
+    if (!(std::abs((*uv)[i]) < 1e6)) {
+      throw InputError(path + ": TEXCOORD: coordinate " + std::to_string(i / 2) + " is not a finite texture position");
     }
   }
+  return model.textures[info.index].source;
+}
+
+// The primitive's vertex indices, three a triangle: its index accessor's, or its vertices in
+// order.
+std::vector<double> PrimitiveIndices(const tinygltf::Model& model,
+                                     const tinygltf::Primitive& primitive, size_t n,
+                                     const std::string& path) {
   std::vector<double> indices;
-  if (primitive.indices >= 0) {
-    indices = ReadAccessor(model, primitive.indices, 1, "indices", path);
-    const int type = model.accessors[primitive.indices].componentType;  // known: read above
-    if (type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-        type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
-      throw InputError(path + ": indices (accessor " + std::to_string(primitive.indices) +
-                       "): field 'componentType' is not an unsigned integer type");
-    }
-  } else {
+  if (primitive.indices < 0) {
     indices.resize(n - n % 3);
     for (size_t i = 0; i < indices.size(); ++i) indices[i] = static_cast<double>(i);
+    return indices;
   }
+  indices = ReadAccessor(model, primitive.indices, 1, "indices", path);
+  const int type = model.accessors[primitive.indices].componentType;  // known: read above
+  if (type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+      type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
+    throw InputError(path + ": indices (accessor " + std::to_string(primitive.indices) +
+                     "): field 'componentType' is not an unsigned integer type");
+  }
+  return indices;
+}
+
+void AddPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& primitive,
+                  const Eigen::Matrix4d& transform, const std::map<int, cv::Mat>& images,
+                  const std::string& path, Gathered* out) {
+  if (primitive.mode != TINYGLTF_MODE_TRIANGLES && primitive.mode != -1) return;
+  const auto position = primitive.attributes.find("POSITION");
+  if (position == primitive.attributes.end()) return;
+  const std::vector<double> xyz = ReadAccessor(model, position->second, 3, "POSITION", path);
+  const size_t n = xyz.size() / 3;
+  TriangleMesh& mesh = out->mesh;
+  const size_t base = mesh.vertices.size();
+  if (base + n > kMaxElements) throw InputError(path + ": more vertices than raycarve reads");
+  AddVertices(model, primitive, xyz, transform, path, out);
+  AddColours(model, primitive, base, n, path, out);
+  std::vector<double> uv;
+  const int texture_image = PrimitiveTexture(model, primitive, n, images, path, &uv);
+  const std::vector<double> indices = PrimitiveIndices(model, primitive, n, path);
   if (mesh.triangles.size() + indices.size() / 3 > kMaxElements) {
     throw InputError(path + ": more triangles than raycarve reads");
   }
@@ -431,40 +465,33 @@ TriangleMesh ReadGltf(const std::string& path) {
   return std::move(gathered.mesh);
 }
 
-TriangleMesh ReadObj(const std::string& path) {
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = true;
-  config.vertex_color = true;
-  config.mtl_search_path = std::filesystem::path(path).parent_path().string();
-  tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path, config)) {
-    std::string error = reader.Error();
-    std::replace(error.begin(), error.end(), '\n', ' ');
-    throw InputError(path + ": not a readable OBJ file: " + (error.empty() ? "unknown error" : error));
-  }
-  const tinyobj::attrib_t& attrib = reader.GetAttrib();
-  Gathered gathered;
-  TriangleMesh& mesh = gathered.mesh;
+namespace {
+
+// The OBJ's vertices and their colours (`coloured`: any not white).
+void AddObjVertices(const tinyobj::attrib_t& attrib, const std::string& path, TriangleMesh* mesh,
+                    bool* coloured) {
   const size_t n = attrib.vertices.size() / 3;
   if (n > kMaxElements) throw InputError(path + ": more vertices than raycarve reads");
-  bool coloured = false;
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3f v(attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]);
     if (!v.allFinite()) throw InputError(path + ": vertex " + std::to_string(i + 1) + " is not a finite point");
-    mesh.vertices.push_back(v);
+    mesh->vertices.push_back(v);
     Eigen::Matrix<uint8_t, 3, 1> rgb = Eigen::Matrix<uint8_t, 3, 1>::Constant(255);
     if (attrib.colors.size() == attrib.vertices.size()) {
       for (int c = 0; c < 3; ++c) {
         const double value = attrib.colors[3 * i + c];
         rgb[c] = static_cast<uint8_t>(std::lround(255.0 * (value > 0.0 ? std::min(value, 1.0) : 0.0)));
-        coloured = coloured || value != 1.0;
+        *coloured = *coloured || value != 1.0;
       }
     }
-    mesh.colours.push_back(rgb);
+    mesh->colours.push_back(rgb);
   }
-  // The materials' diffuse maps, read once each (the texture images, by material).
-  std::map<int, cv::Mat> images;
-  const std::vector<tinyobj::material_t>& materials = reader.GetMaterials();
+}
+
+// The materials' diffuse maps, read once each, into `images`; returns each material's image
+// (-1: none).
+std::vector<int> ReadObjTextures(const std::vector<tinyobj::material_t>& materials,
+                                 const std::string& path, std::map<int, cv::Mat>* images) {
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   std::map<std::string, int> image_of_file;
   std::vector<int> image_of_material(materials.size(), -1);
@@ -483,47 +510,80 @@ TriangleMesh ReadObj(const std::string& path) {
     if (bgr.empty()) throw InputError(file + ": the texture of " + path + " cannot be decoded");
     cv::Mat rgb;
     cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-    const int index = static_cast<int>(images.size());
-    images[index] = rgb;
+    const int index = static_cast<int>(images->size());
+    (*images)[index] = rgb;
     image_of_file[file] = index;
     image_of_material[m] = index;
   }
-  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
-    const std::vector<tinyobj::index_t>& indices = shape.mesh.indices;
-    for (size_t f = 0; f + 2 < indices.size(); f += 3) {
-      if (mesh.triangles.size() >= kMaxElements) throw InputError(path + ": more triangles than raycarve reads");
-      Eigen::Vector3i triangle;
-      bool uv_known = true;
-      for (int k = 0; k < 3; ++k) {
-        const int v = indices[f + k].vertex_index;
-        if (v < 0 || static_cast<size_t>(v) >= n) {
-          throw InputError(path + ": face " + std::to_string(mesh.triangles.size() + 1) +
-                           ": vertex " + std::to_string(v + 1) + " is past the file's " +
-                           std::to_string(n) + " vertices");
-        }
-        triangle[k] = v;
-        const int t = indices[f + k].texcoord_index;
-        uv_known = uv_known && t >= 0 && static_cast<size_t>(2 * t + 1) < attrib.texcoords.size();
+  return image_of_material;
+}
+
+// The shape's triangles (already triangulated), each with its material's image and corners'
+// texture coordinates where it has both.
+void AddObjFaces(const tinyobj::attrib_t& attrib, const tinyobj::shape_t& shape,
+                 const std::vector<int>& image_of_material, const std::string& path,
+                 Gathered* gathered) {
+  TriangleMesh& mesh = gathered->mesh;
+  const size_t n = attrib.vertices.size() / 3;
+  const std::vector<tinyobj::index_t>& indices = shape.mesh.indices;
+  for (size_t f = 0; f + 2 < indices.size(); f += 3) {
+    if (mesh.triangles.size() >= kMaxElements) throw InputError(path + ": more triangles than raycarve reads");
+    Eigen::Vector3i triangle;
+    bool uv_known = true;
+    for (int k = 0; k < 3; ++k) {
+      const int v = indices[f + k].vertex_index;
+      if (v < 0 || static_cast<size_t>(v) >= n) {
+        throw InputError(path + ": face " + std::to_string(mesh.triangles.size() + 1) +
+                         ": vertex " + std::to_string(v + 1) + " is past the file's " +
+                         std::to_string(n) + " vertices");
       }
-      const size_t face = f / 3;
-      const int material = face < shape.mesh.material_ids.size() ? shape.mesh.material_ids[face] : -1;
-      const int image = material >= 0 && static_cast<size_t>(material) < image_of_material.size() && uv_known
-                            ? image_of_material[material] : -1;
-      mesh.triangles.push_back(triangle);
-      gathered.triangle_texture.push_back(image);
-      for (int k = 0; k < 3; ++k) {
-        if (image < 0) {
-          gathered.corner_uvs.push_back(Eigen::Vector2f::Zero());
-          continue;
-        }
-        const int t = indices[f + k].texcoord_index;
-        const Eigen::Vector2f uv(attrib.texcoords[2 * t], 1.0f - attrib.texcoords[2 * t + 1]);  // v down
-        if (!(std::abs(uv.x()) < 1e6f && std::abs(uv.y()) < 1e6f)) {
-          throw InputError(path + ": texture coordinate " + std::to_string(t + 1) + " is not a finite texture position");
-        }
-        gathered.corner_uvs.push_back(uv);
-      }
+      triangle[k] = v;
+      const int t = indices[f + k].texcoord_index;
+      uv_known = uv_known && t >= 0 && static_cast<size_t>(2 * t + 1) < attrib.texcoords.size();
     }
+    const size_t face = f / 3;
+    const int material = face < shape.mesh.material_ids.size() ? shape.mesh.material_ids[face] : -1;
+    const int image = material >= 0 && static_cast<size_t>(material) < image_of_material.size() && uv_known
+                          ? image_of_material[material] : -1;
+    mesh.triangles.push_back(triangle);
+    gathered->triangle_texture.push_back(image);
+    for (int k = 0; k < 3; ++k) {
+      if (image < 0) {
+        gathered->corner_uvs.push_back(Eigen::Vector2f::Zero());
+        continue;
+      }
+      const int t = indices[f + k].texcoord_index;
+      const Eigen::Vector2f uv(attrib.texcoords[2 * t], 1.0f - attrib.texcoords[2 * t + 1]);  // v down
+      if (!(std::abs(uv.x()) < 1e6f && std::abs(uv.y()) < 1e6f)) {
+        throw InputError(path + ": texture coordinate " + std::to_string(t + 1) + " is not a finite texture position");
+      }
+      gathered->corner_uvs.push_back(uv);
+    }
+  }
+}
+
+}  // namespace
+
+TriangleMesh ReadObj(const std::string& path) {
+  tinyobj::ObjReaderConfig config;
+  config.triangulate = true;
+  config.vertex_color = true;
+  config.mtl_search_path = std::filesystem::path(path).parent_path().string();
+  tinyobj::ObjReader reader;
+  if (!reader.ParseFromFile(path, config)) {
+    std::string error = reader.Error();
+    std::replace(error.begin(), error.end(), '\n', ' ');
+    throw InputError(path + ": not a readable OBJ file: " + (error.empty() ? "unknown error" : error));
+  }
+  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  Gathered gathered;
+  TriangleMesh& mesh = gathered.mesh;
+  bool coloured = false;
+  AddObjVertices(attrib, path, &mesh, &coloured);
+  std::map<int, cv::Mat> images;
+  const std::vector<int> image_of_material = ReadObjTextures(reader.GetMaterials(), path, &images);
+  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    AddObjFaces(attrib, shape, image_of_material, path, &gathered);
   }
   if (mesh.triangles.empty()) throw InputError(path + ": no faces");
   if (!coloured) mesh.colours.clear();

@@ -140,50 +140,54 @@ void WriteObjFiles(const TriangleMesh& mesh, const std::string& obj_path, const 
   WriteBytes(obj_path, "the mesh", bytes.data(), bytes.size());
 }
 
-// WriteGlb with the corners split and, textured (`png` not null), the atlas encoded already.
-void WriteGlbFile(const TriangleMesh& mesh, const std::string& path, const SplitVertices& split,
-                  const std::vector<uint8_t>* png) {
-  const bool textured = png != nullptr;
-  const size_t n = split.vertex.size();
-  const bool normals = mesh.normals.size() == mesh.vertices.size();
-  const bool colours = !textured && mesh.colours.size() == mesh.vertices.size();
-  tinygltf::Model model;
-  model.asset.version = "2.0";
-  model.asset.generator = "raycarve";
-  if (mesh.triangles.empty()) {
-    // glTF has no empty accessors: an empty carve gives a scene with nothing in it.
-    model.scenes.emplace_back();
-    model.defaultScene = 0;
-    SaveGlb(&model, path);
-    return;
-  }
-  tinygltf::Buffer buffer;
-  auto append = [&buffer](const void* data, size_t bytes) {
-    const size_t offset = buffer.data.size();
-    buffer.data.resize(offset + bytes);
-    if (bytes > 0) std::memcpy(buffer.data.data() + offset, data, bytes);
-    while (buffer.data.size() % 4 != 0) buffer.data.push_back(0);
-    return offset;
-  };
-  auto add_view = [&](size_t offset, size_t bytes, int target) {
+// A GLB's one binary buffer and the views and accessors into it, appended in order.
+class GlbBuffer {
+ public:
+  explicit GlbBuffer(tinygltf::Model* model) : model_(model) {}
+
+  // `bytes` of `data` as a buffer view (4-byte aligned); returns its index.
+  int AddView(const void* data, size_t bytes, int target) {
+    const size_t offset = buffer_.data.size();
+    buffer_.data.resize(offset + bytes);
+    if (bytes > 0) std::memcpy(buffer_.data.data() + offset, data, bytes);
+    while (buffer_.data.size() % 4 != 0) buffer_.data.push_back(0);
     tinygltf::BufferView view;
     view.buffer = 0;
     view.byteOffset = offset;
     view.byteLength = bytes;
     view.target = target;
-    model.bufferViews.push_back(view);
-    return static_cast<int>(model.bufferViews.size() - 1);
-  };
-  auto add_accessor = [&](int view, int component, int type, size_t count, bool normalized) {
+    model_->bufferViews.push_back(view);
+    return static_cast<int>(model_->bufferViews.size() - 1);
+  }
+
+  // `values` as a view and an accessor of `count` elements; returns the accessor's index.
+  template <typename T>
+  int AddAccessor(const std::vector<T>& values, int target, int component, int type,
+                  size_t count, bool normalized) {
     tinygltf::Accessor accessor;
-    accessor.bufferView = view;
+    accessor.bufferView = AddView(values.data(), values.size() * sizeof(T), target);
     accessor.componentType = component;
     accessor.type = type;
     accessor.count = count;
     accessor.normalized = normalized;
-    model.accessors.push_back(accessor);
-    return static_cast<int>(model.accessors.size() - 1);
-  };
+    model_->accessors.push_back(accessor);
+    return static_cast<int>(model_->accessors.size() - 1);
+  }
+
+  void Finish() { model_->buffers.push_back(std::move(buffer_)); }
+
+ private:
+  tinygltf::Model* model_;
+  tinygltf::Buffer buffer_;
+};
+
+// The mesh's attributes and indices, one vertex per split corner: positions, normals where the
+// mesh has them, linear colours (untextured) or texture coordinates (textured).
+tinygltf::Primitive GlbPrimitive(const TriangleMesh& mesh, const SplitVertices& split,
+                                 bool textured, tinygltf::Model* model, GlbBuffer* buffer) {
+  const size_t n = split.vertex.size();
+  const bool normals = mesh.normals.size() == mesh.vertices.size();
+  const bool colours = !textured && mesh.colours.size() == mesh.vertices.size();
   std::vector<float> positions, normal_values, uvs;
   std::vector<uint16_t> colour_values;  // linear, as glTF's COLOR_0 is (the PLY's are sRGB)
   Eigen::Vector3f low = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
@@ -201,65 +205,80 @@ void WriteGlbFile(const TriangleMesh& mesh, const std::string& path, const Split
     }
   }
   for (const Eigen::Vector2f& uv : split.uv) uvs.insert(uvs.end(), {uv.x(), uv.y()});
-  std::vector<uint32_t> indices(split.corner.begin(), split.corner.end());
+  const std::vector<uint32_t> indices(split.corner.begin(), split.corner.end());
+  constexpr int kArray = TINYGLTF_TARGET_ARRAY_BUFFER;
   tinygltf::Primitive primitive;
   primitive.mode = TINYGLTF_MODE_TRIANGLES;
-  const int position_accessor = add_accessor(
-      add_view(append(positions.data(), positions.size() * 4), positions.size() * 4,
-               TINYGLTF_TARGET_ARRAY_BUFFER),
-      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, false);
+  const int position_accessor = buffer->AddAccessor(
+      positions, kArray, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, false);
   if (n > 0) {
-    model.accessors[position_accessor].minValues = {low.x(), low.y(), low.z()};
-    model.accessors[position_accessor].maxValues = {high.x(), high.y(), high.z()};
+    model->accessors[position_accessor].minValues = {low.x(), low.y(), low.z()};
+    model->accessors[position_accessor].maxValues = {high.x(), high.y(), high.z()};
   }
   primitive.attributes["POSITION"] = position_accessor;
   if (normals) {
-    primitive.attributes["NORMAL"] = add_accessor(
-        add_view(append(normal_values.data(), normal_values.size() * 4), normal_values.size() * 4,
-                 TINYGLTF_TARGET_ARRAY_BUFFER),
-        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, false);
+    primitive.attributes["NORMAL"] = buffer->AddAccessor(
+        normal_values, kArray, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, false);
   }
   if (colours) {
-    primitive.attributes["COLOR_0"] = add_accessor(
-        add_view(append(colour_values.data(), colour_values.size() * 2), colour_values.size() * 2,
-                 TINYGLTF_TARGET_ARRAY_BUFFER),
-        TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, n, true);
+    primitive.attributes["COLOR_0"] = buffer->AddAccessor(
+        colour_values, kArray, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, n, true);
   }
   if (textured) {
-    primitive.attributes["TEXCOORD_0"] = add_accessor(
-        add_view(append(uvs.data(), uvs.size() * 4), uvs.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, n, false);
+    primitive.attributes["TEXCOORD_0"] = buffer->AddAccessor(
+        uvs, kArray, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, n, false);
   }
-  primitive.indices = add_accessor(
-      add_view(append(indices.data(), indices.size() * 4), indices.size() * 4,
-               TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
-      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size(), false);
+  primitive.indices = buffer->AddAccessor(indices, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER,
+                                          TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                          TINYGLTF_TYPE_SCALAR, indices.size(), false);
+  primitive.material = 0;
+  return primitive;
+}
+
+// The one material: matte, with the atlas (`png`, when not null) as its base colour.
+void AddGlbMaterial(const std::vector<uint8_t>* png, tinygltf::Model* model, GlbBuffer* buffer) {
   tinygltf::Material material;
   material.name = "raycarve";
   material.pbrMetallicRoughness.metallicFactor = 0.0;
   material.pbrMetallicRoughness.roughnessFactor = 1.0;
-  if (textured) {
+  if (png != nullptr) {
     tinygltf::Image image;
     image.mimeType = "image/png";
-    image.bufferView = add_view(append(png->data(), png->size()), png->size(), 0);
-    model.images.push_back(image);
+    image.bufferView = buffer->AddView(png->data(), png->size(), 0);
+    model->images.push_back(image);
     tinygltf::Sampler sampler;
     sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
     sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
     sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
     sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-    model.samplers.push_back(sampler);
+    model->samplers.push_back(sampler);
     tinygltf::Texture texture;
     texture.source = 0;
     texture.sampler = 0;
-    model.textures.push_back(texture);
+    model->textures.push_back(texture);
     material.pbrMetallicRoughness.baseColorTexture.index = 0;
   }
-  model.materials.push_back(material);
-  primitive.material = 0;
+  model->materials.push_back(material);
+}
+
+// WriteGlb with the corners split and, textured (`png` not null), the atlas encoded already.
+void WriteGlbFile(const TriangleMesh& mesh, const std::string& path, const SplitVertices& split,
+                  const std::vector<uint8_t>* png) {
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "raycarve";
+  if (mesh.triangles.empty()) {
+    // glTF has no empty accessors: an empty carve gives a scene with nothing in it.
+    model.scenes.emplace_back();
+    model.defaultScene = 0;
+    SaveGlb(&model, path);
+    return;
+  }
+  GlbBuffer buffer(&model);
   tinygltf::Mesh gltf_mesh;
   gltf_mesh.name = "raycarve";
-  gltf_mesh.primitives.push_back(primitive);
+  gltf_mesh.primitives.push_back(GlbPrimitive(mesh, split, png != nullptr, &model, &buffer));
+  AddGlbMaterial(png, &model, &buffer);
   model.meshes.push_back(gltf_mesh);
   tinygltf::Node node;
   node.mesh = 0;
@@ -268,9 +287,7 @@ void WriteGlbFile(const TriangleMesh& mesh, const std::string& path, const Split
   scene.nodes.push_back(0);
   model.scenes.push_back(scene);
   model.defaultScene = 0;
-  model.asset.version = "2.0";
-  model.asset.generator = "raycarve";
-  model.buffers.push_back(std::move(buffer));
+  buffer.Finish();
   SaveGlb(&model, path);
 }
 

@@ -230,6 +230,242 @@ void BlendViews(const std::vector<CalibratedView>& views, const TriangleMesh& me
   }
 }
 
+// The view where the triangle covers the most pixels; -1 where none sees it whole.
+int BestView(const std::vector<Candidate>& candidates) {
+  double best = 0.0;
+  int best_view = -1;
+  for (const Candidate& c : candidates) {
+    if (c.area > best) {
+      best = c.area;
+      best_view = c.view;
+    }
+  }
+  return best_view;
+}
+
+// Each triangle's photo: the one where it covers the most pixels, then, over the passes, the
+// photo of most of its neighbours where that one is nearly as good (options.neighbour_share).
+std::vector<int> LabelTriangles(const std::vector<std::vector<Candidate>>& candidates,
+                                const std::vector<std::vector<int>>& neighbours,
+                                const MeshTextureOptions& options) {
+  const int num_triangles = static_cast<int>(candidates.size());
+  std::vector<int> label(num_triangles, -1);
+  for (int t = 0; t < num_triangles; ++t) label[t] = BestView(candidates[t]);
+  for (int pass = 0; pass < options.relabel_passes; ++pass) {
+    std::vector<int> next = label;
+    for (int t = 0; t < num_triangles; ++t) {
+      if (label[t] < 0) continue;
+      std::map<int, int> votes;
+      for (const int u : neighbours[t]) {
+        if (label[u] >= 0 && label[u] != label[t]) ++votes[label[u]];
+      }
+      int own_votes = 0;
+      for (const int u : neighbours[t]) own_votes += label[u] == label[t];
+      double best = 0.0;
+      for (const Candidate& c : candidates[t]) best = std::max(best, c.area);
+      for (const auto& [view, count] : votes) {
+        if (count <= own_votes || count < 2) continue;
+        for (const Candidate& c : candidates[t]) {
+          if (c.view == view && c.area >= options.neighbour_share * best) next[t] = view;
+        }
+      }
+    }
+    label.swap(next);
+  }
+  return label;
+}
+
+// Charts: edge-connected triangles with one photo. The triangles with none go to `flat`.
+std::vector<Chart> GrowCharts(const std::vector<int>& label,
+                              const std::vector<std::vector<int>>& neighbours, Chart* flat) {
+  const int num_triangles = static_cast<int>(label.size());
+  std::vector<int> chart_of(num_triangles, -1);
+  std::vector<Chart> charts;
+  for (int t = 0; t < num_triangles; ++t) {
+    if (label[t] < 0) {
+      flat->triangles.push_back(t);
+      continue;
+    }
+    if (chart_of[t] >= 0) continue;
+    Chart chart;
+    chart.view = label[t];
+    std::vector<int> stack = {t};
+    chart_of[t] = static_cast<int>(charts.size());
+    while (!stack.empty()) {
+      const int u = stack.back();
+      stack.pop_back();
+      chart.triangles.push_back(u);
+      for (const int w : neighbours[u]) {
+        if (chart_of[w] < 0 && label[w] == chart.view) {
+          chart_of[w] = chart_of[t];
+          stack.push_back(w);
+        }
+      }
+    }
+    charts.push_back(std::move(chart));
+  }
+  return charts;
+}
+
+// The chart's piece of its photo (its triangles' corners' pixels into `corner_pixels`), blended
+// across the candidate photos or levelled to the vertices' colours (single photos only: the
+// gain of the sums of the vertices' and the photo's colours at the corners).
+void MakeChartPatch(const std::vector<CalibratedView>& views, const TriangleMesh& mesh,
+                    const std::vector<std::vector<Candidate>>& candidates,
+                    const MeshTextureOptions& options, Chart* chart,
+                    std::vector<std::array<Eigen::Vector2d, 3>>* corner_pixels) {
+  const bool level = !options.blend_views && options.level_colours;
+  const CalibratedView& view = views[chart->view];
+  Eigen::Vector2d low(1e300, 1e300), high(-1e300, -1e300);
+  Eigen::Vector3d vertex_sum = Eigen::Vector3d::Zero(), photo_sum = Eigen::Vector3d::Zero();
+  for (const int t : chart->triangles) {
+    for (int corner = 0; corner < 3; ++corner) {
+      const int vertex = mesh.triangles[t][corner];
+      const Eigen::Vector2d pixel = view.Project(mesh.vertices[vertex].cast<double>());
+      (*corner_pixels)[t][corner] = pixel;
+      low = low.cwiseMin(pixel);
+      high = high.cwiseMax(pixel);
+      Eigen::Vector3f colour;
+      if (level && SampleBilinear(view.image, pixel, &colour)) {
+        photo_sum += colour.cast<double>();
+        vertex_sum += mesh.colours[vertex].cast<double>();
+      }
+    }
+  }
+  const int x0 = std::max(0, static_cast<int>(std::floor(low.x())) - options.padding);
+  const int y0 = std::max(0, static_cast<int>(std::floor(low.y())) - options.padding);
+  const int x1 = std::min(view.width, static_cast<int>(std::ceil(high.x())) + options.padding);
+  const int y1 = std::min(view.height, static_cast<int>(std::ceil(high.y())) + options.padding);
+  chart->source = cv::Rect(x0, y0, std::max(1, x1 - x0), std::max(1, y1 - y0));
+  chart->patch = view.image(chart->source).clone();
+  if (options.blend_views) {
+    BlendViews(views, mesh, candidates, *chart, *corner_pixels, &chart->patch);
+  } else if (level && photo_sum.minCoeff() > 0.0) {
+    cv::Mat levelled;
+    chart->patch.convertTo(levelled, CV_32FC3);
+    cv::Scalar gain;
+    for (int k = 0; k < 3; ++k) gain[k] = std::clamp(vertex_sum[k] / photo_sum[k], 1.0 / 1.4, 1.4);
+    cv::multiply(levelled, gain, levelled);
+    levelled.convertTo(chart->patch, CV_8UC3);  // saturating
+  }
+}
+
+// The cells of the triangles no photo sees whole, in a square block (`flat->patch`); returns the
+// block's side in cells.
+int MakeFlatPatch(const TriangleMesh& mesh, Chart* flat) {
+  const int flat_count = static_cast<int>(flat->triangles.size());
+  const int flat_side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(flat_count))));
+  if (flat_count == 0) return flat_side;
+  flat->patch = cv::Mat(flat_side * kFlatCell, flat_side * kFlatCell, CV_8UC3, cv::Scalar::all(128));
+  const double span = kFlatCell - 1.0;
+  for (int i = 0; i < flat_count; ++i) {
+    const Eigen::Vector3i& triangle = mesh.triangles[flat->triangles[i]];
+    const int x0 = (i % flat_side) * kFlatCell, y0 = (i / flat_side) * kFlatCell;
+    for (int y = 0; y < kFlatCell; ++y) {
+      for (int x = 0; x < kFlatCell; ++x) {
+        // Barycentric weights of the texel centre, clamped onto the triangle.
+        double w1 = x / span, w2 = y / span;
+        if (w1 + w2 > 1.0) {
+          const double sum = w1 + w2;
+          w1 /= sum;
+          w2 /= sum;
+        }
+        const double w0 = 1.0 - w1 - w2;
+        cv::Vec3b& texel = flat->patch.at<cv::Vec3b>(y0 + y, x0 + x);
+        for (int k = 0; k < 3; ++k) {
+          const double value = w0 * mesh.colours[triangle[0]][k] +
+                               w1 * mesh.colours[triangle[1]][k] +
+                               w2 * mesh.colours[triangle[2]][k];
+          texel[k] = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+        }
+      }
+    }
+  }
+  return flat_side;
+}
+
+struct AtlasSize {
+  bool fits = false;
+  int width = 0;
+  int height = 0;
+  double scale = 1.0;  // of the charts against the photos' resolution
+};
+
+// Packing: an atlas about as wide as tall, the charts scaled down until it fits the longest side
+// allowed (or 40 tries, down to 0.9^39, about 1.6% of the photos' resolution, have failed).
+AtlasSize PackAtlas(int max_atlas_side, std::vector<Chart>* charts, Chart* flat) {
+  double area = 0.0;
+  for (const Chart& chart : *charts) area += static_cast<double>(chart.patch.total());
+  std::vector<cv::Mat> originals;
+  for (const Chart& chart : *charts) originals.push_back(chart.patch);
+  AtlasSize atlas;
+  double scale = 1.0;
+  for (int attempt = 0; attempt < 40; ++attempt) {
+    int width = 64;
+    while (width < max_atlas_side &&
+           static_cast<double>(width) * width < 1.2 * (area * scale * scale + flat->patch.total())) {
+      width *= 2;
+    }
+    for (size_t i = 0; i < charts->size(); ++i) {
+      if (scale < 1.0) {
+        const cv::Size size(std::max(1, static_cast<int>(std::lround(originals[i].cols * scale))),
+                            std::max(1, static_cast<int>(std::lround(originals[i].rows * scale))));
+        cv::resize(originals[i], (*charts)[i].patch, size, 0, 0, cv::INTER_AREA);
+      }
+    }
+    // No narrower than the widest chart.
+    for (const Chart& chart : *charts) width = std::max(width, chart.patch.cols);
+    width = std::max(width, flat->patch.cols);
+    charts->push_back(*flat);
+    atlas.height = Pack(width, charts);
+    *flat = charts->back();
+    charts->pop_back();
+    atlas.width = width;
+    atlas.scale = scale;
+    if (atlas.height <= max_atlas_side && width <= max_atlas_side) {
+      atlas.fits = true;
+      return atlas;
+    }
+    scale *= 0.9;
+  }
+  return atlas;
+}
+
+// The atlas image and every triangle corner's texture coordinates in it.
+void DrawAtlas(const std::vector<Chart>& charts, const Chart& flat, int flat_side,
+               const std::vector<std::array<Eigen::Vector2d, 3>>& corner_pixels,
+               const AtlasSize& atlas, TriangleMesh* mesh) {
+  const int width = atlas.width, height = atlas.height;
+  mesh->texture = cv::Mat(height, width, CV_8UC3, cv::Scalar::all(128));
+  mesh->corner_uvs.assign(3 * mesh->triangles.size(), Eigen::Vector2f::Zero());
+  for (const Chart& chart : charts) {
+    const double sx = static_cast<double>(chart.patch.cols) / chart.source.width;
+    const double sy = static_cast<double>(chart.patch.rows) / chart.source.height;
+    chart.patch.copyTo(mesh->texture(cv::Rect(chart.at, chart.patch.size())));
+    for (const int t : chart.triangles) {
+      for (int corner = 0; corner < 3; ++corner) {
+        const Eigen::Vector2d& pixel = corner_pixels[t][corner];
+        mesh->corner_uvs[3 * t + corner] =
+            Eigen::Vector2f((chart.at.x + (pixel.x() - chart.source.x) * sx) / width,
+                            (chart.at.y + (pixel.y() - chart.source.y) * sy) / height);
+      }
+    }
+  }
+  const int flat_count = static_cast<int>(flat.triangles.size());
+  if (flat_count == 0) return;
+  flat.patch.copyTo(mesh->texture(cv::Rect(flat.at, flat.patch.size())));
+  for (int i = 0; i < flat_count; ++i) {
+    const float x0 = static_cast<float>(flat.at.x + (i % flat_side) * kFlatCell) + 0.5f;
+    const float y0 = static_cast<float>(flat.at.y + (i / flat_side) * kFlatCell) + 0.5f;
+    const float span = kFlatCell - 1.0f;
+    const Eigen::Vector2f corners[3] = {{x0, y0}, {x0 + span, y0}, {x0, y0 + span}};
+    for (int corner = 0; corner < 3; ++corner) {
+      mesh->corner_uvs[3 * flat.triangles[i] + corner] =
+          corners[corner].cwiseQuotient(Eigen::Vector2f(width, height));
+    }
+  }
+}
+
 }  // namespace
 
 TextureSeams MeasureTextureSeams(const TriangleMesh& mesh) {
@@ -322,241 +558,58 @@ MeshTextureSummary TextureMeshFromPhotos(const std::vector<CalibratedView>& view
   mesh->corner_uvs.clear();
   mesh->texture.release();
   if (num_triangles == 0) return summary;
+  const auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
 
-  // Each triangle's photo: the one where it covers the most pixels, then its neighbours' where
-  // that one is nearly as good.
   std::vector<std::vector<Candidate>> candidates(num_triangles);
-  std::vector<int> label(num_triangles, -1);
   for (int t = 0; t < num_triangles; ++t) {
     candidates[t] = CandidatesOf(views, seen_by, *mesh, mesh->triangles[t]);
-    double best = 0.0;
-    for (const Candidate& c : candidates[t]) {
-      if (c.area > best) {
-        best = c.area;
-        label[t] = c.view;
-      }
-    }
   }
   const std::vector<std::vector<int>> neighbours = EdgeNeighbours(*mesh);
-  for (int pass = 0; pass < options.relabel_passes; ++pass) {
-    std::vector<int> next = label;
-    for (int t = 0; t < num_triangles; ++t) {
-      if (label[t] < 0) continue;
-      std::map<int, int> votes;
-      for (const int u : neighbours[t]) {
-        if (label[u] >= 0 && label[u] != label[t]) ++votes[label[u]];
-      }
-      int own_votes = 0;
-      for (const int u : neighbours[t]) own_votes += label[u] == label[t];
-      double best = 0.0;
-      for (const Candidate& c : candidates[t]) best = std::max(best, c.area);
-      for (const auto& [view, count] : votes) {
-        if (count <= own_votes || count < 2) continue;
-        for (const Candidate& c : candidates[t]) {
-          if (c.view == view && c.area >= options.neighbour_share * best) next[t] = view;
-        }
-      }
-    }
-    label.swap(next);
-  }
-
-  // Charts: edge-connected triangles with one photo.
-  std::vector<int> chart_of(num_triangles, -1);
-  std::vector<Chart> charts;
+  const std::vector<int> label = LabelTriangles(candidates, neighbours, options);
   Chart flat;
-  for (int t = 0; t < num_triangles; ++t) {
-    if (label[t] < 0) {
-      flat.triangles.push_back(t);
-      continue;
-    }
-    if (chart_of[t] >= 0) continue;
-    Chart chart;
-    chart.view = label[t];
-    std::vector<int> stack = {t};
-    chart_of[t] = static_cast<int>(charts.size());
-    while (!stack.empty()) {
-      const int u = stack.back();
-      stack.pop_back();
-      chart.triangles.push_back(u);
-      for (const int w : neighbours[u]) {
-        if (chart_of[w] < 0 && label[w] == chart.view) {
-          chart_of[w] = chart_of[t];
-          stack.push_back(w);
-        }
-      }
-    }
-    charts.push_back(std::move(chart));
-  }
+  std::vector<Chart> charts = GrowCharts(label, neighbours, &flat);
   summary.charts = static_cast<int64_t>(charts.size());
   summary.textured = num_triangles - static_cast<int64_t>(flat.triangles.size());
   for (int t = 0; t < num_triangles; ++t) {
-    if (label[t] < 0) continue;
-    double best = 0.0;
-    int best_view = -1;
-    for (const Candidate& c : candidates[t]) {
-      if (c.area > best) {
-        best = c.area;
-        best_view = c.view;
-      }
-    }
-    summary.relabelled += label[t] != best_view;
+    summary.relabelled += label[t] >= 0 && label[t] != BestView(candidates[t]);
   }
 
-  // Each chart's piece of its photo, levelled to the vertices' colours.
-  // Charts are independent (each triangle in one): any thread count gives the same atlas.
+  // Each chart's piece of its photo. Charts are independent (each triangle in one): any thread
+  // count gives the same atlas.
   std::vector<std::array<Eigen::Vector2d, 3>> corner_pixels(num_triangles);
-  // Levelling (single photos only): the sums of the photo's and the vertices' colours.
-  const bool level = !options.blend_views && options.level_colours;
-  const auto make_patch = [&](Chart& chart) {
-    const CalibratedView& view = views[chart.view];
-    Eigen::Vector2d low(1e300, 1e300), high(-1e300, -1e300);
-    Eigen::Vector3d vertex_sum = Eigen::Vector3d::Zero(), photo_sum = Eigen::Vector3d::Zero();
-    for (const int t : chart.triangles) {
-      for (int corner = 0; corner < 3; ++corner) {
-        const int vertex = mesh->triangles[t][corner];
-        const Eigen::Vector2d pixel = view.Project(mesh->vertices[vertex].cast<double>());
-        corner_pixels[t][corner] = pixel;
-        low = low.cwiseMin(pixel);
-        high = high.cwiseMax(pixel);
-        Eigen::Vector3f colour;
-        if (level && SampleBilinear(view.image, pixel, &colour)) {
-          photo_sum += colour.cast<double>();
-          vertex_sum += mesh->colours[vertex].cast<double>();
-        }
-      }
-    }
-    const int x0 = std::max(0, static_cast<int>(std::floor(low.x())) - options.padding);
-    const int y0 = std::max(0, static_cast<int>(std::floor(low.y())) - options.padding);
-    const int x1 = std::min(view.width, static_cast<int>(std::ceil(high.x())) + options.padding);
-    const int y1 = std::min(view.height, static_cast<int>(std::ceil(high.y())) + options.padding);
-    chart.source = cv::Rect(x0, y0, std::max(1, x1 - x0), std::max(1, y1 - y0));
-    chart.patch = view.image(chart.source).clone();
-    if (options.blend_views) {
-      BlendViews(views, *mesh, candidates, chart, corner_pixels, &chart.patch);
-    } else if (level && photo_sum.minCoeff() > 0.0) {
-      cv::Mat levelled;
-      chart.patch.convertTo(levelled, CV_32FC3);
-      cv::Scalar gain;
-      for (int k = 0; k < 3; ++k) gain[k] = std::clamp(vertex_sum[k] / photo_sum[k], 1.0 / 1.4, 1.4);
-      cv::multiply(levelled, gain, levelled);
-      levelled.convertTo(chart.patch, CV_8UC3);  // saturating
-    }
-  };
   ParallelRanges(charts.size(), ResolveNumThreads(options.num_threads), 16,
                  [&](size_t begin, size_t end) {
-                   for (size_t i = begin; i < end; ++i) make_patch(charts[i]);
+                   for (size_t i = begin; i < end; ++i) {
+                     MakeChartPatch(views, *mesh, candidates, options, &charts[i], &corner_pixels);
+                   }
                  });
-  // The cells of the triangles no photo sees whole, in a square block.
-  const int flat_count = static_cast<int>(flat.triangles.size());
-  const int flat_side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(flat_count))));
-  if (flat_count > 0) {
-    flat.patch = cv::Mat(flat_side * kFlatCell, flat_side * kFlatCell, CV_8UC3, cv::Scalar::all(128));
-    const double span = kFlatCell - 1.0;
-    for (int i = 0; i < flat_count; ++i) {
-      const Eigen::Vector3i& triangle = mesh->triangles[flat.triangles[i]];
-      const int x0 = (i % flat_side) * kFlatCell, y0 = (i / flat_side) * kFlatCell;
-      for (int y = 0; y < kFlatCell; ++y) {
-        for (int x = 0; x < kFlatCell; ++x) {
-          // Barycentric weights of the texel centre, clamped onto the triangle.
-          double w1 = x / span, w2 = y / span;
-          if (w1 + w2 > 1.0) {
-            const double sum = w1 + w2;
-            w1 /= sum;
-            w2 /= sum;
-          }
-          const double w0 = 1.0 - w1 - w2;
-          cv::Vec3b& texel = flat.patch.at<cv::Vec3b>(y0 + y, x0 + x);
-          for (int k = 0; k < 3; ++k) {
-            const double value = w0 * mesh->colours[triangle[0]][k] +
-                                 w1 * mesh->colours[triangle[1]][k] +
-                                 w2 * mesh->colours[triangle[2]][k];
-            texel[k] = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
-          }
-        }
-      }
-    }
-  }
+  const int flat_side = MakeFlatPatch(*mesh, &flat);
 
-  // Packing: an atlas about as wide as tall; scaled down until it fits the longest side allowed.
-  double area = 0.0;
-  for (const Chart& chart : charts) area += static_cast<double>(chart.patch.total());
-  std::vector<cv::Mat> originals;
-  for (const Chart& chart : charts) originals.push_back(chart.patch);
-  double scale = 1.0;
-  int width = 0, height = 0;
-  for (int attempt = 0; attempt < 40; ++attempt) {
-    width = 64;
-    while (width < options.max_atlas_side &&
-           static_cast<double>(width) * width < 1.2 * (area * scale * scale + flat.patch.total())) {
-      width *= 2;
-    }
-    for (size_t i = 0; i < charts.size(); ++i) {
-      if (scale < 1.0) {
-        const cv::Size size(std::max(1, static_cast<int>(std::lround(originals[i].cols * scale))),
-                            std::max(1, static_cast<int>(std::lround(originals[i].rows * scale))));
-        cv::resize(originals[i], charts[i].patch, size, 0, 0, cv::INTER_AREA);
-      }
-    }
-    // No narrower than the widest chart.
-    for (const Chart& chart : charts) width = std::max(width, chart.patch.cols);
-    width = std::max(width, flat.patch.cols);
-    charts.push_back(flat);
-    height = Pack(width, &charts);
-    flat = charts.back();
-    charts.pop_back();
-    if (height <= options.max_atlas_side && width <= options.max_atlas_side) break;
-    scale *= 0.9;
-  }
-  if (height > options.max_atlas_side || width > options.max_atlas_side) {
-    // Even at a tenth of the photos' resolution the charts do not fit, or the cells of the
+  const AtlasSize atlas = PackAtlas(options.max_atlas_side, &charts, &flat);
+  if (!atlas.fits) {
+    // Even at the smallest scale tried the charts do not fit, or the cells of the
     // triangles no photo sees whole fill the atlas alone (millions of them on a grid finer than
     // the photos): no texture, the mesh keeps its vertex colours (readers refuse larger images).
     summary.too_large = true;
     summary.textured = 0;
     summary.charts = 0;
     summary.relabelled = 0;
-    summary.needed_width = width;
-    summary.needed_height = height;
-    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    summary.needed_width = atlas.width;
+    summary.needed_height = atlas.height;
+    summary.seconds = elapsed();
     return summary;
   }
-  summary.scale = scale;
-  summary.atlas_width = width;
-  summary.atlas_height = height;
-  mesh->texture = cv::Mat(height, width, CV_8UC3, cv::Scalar::all(128));
-  mesh->corner_uvs.assign(3 * static_cast<size_t>(num_triangles), Eigen::Vector2f::Zero());
-  for (size_t i = 0; i < charts.size(); ++i) {
-    const Chart& chart = charts[i];
-    const double sx = static_cast<double>(chart.patch.cols) / chart.source.width;
-    const double sy = static_cast<double>(chart.patch.rows) / chart.source.height;
-    chart.patch.copyTo(mesh->texture(cv::Rect(chart.at, chart.patch.size())));
-    for (const int t : chart.triangles) {
-      for (int corner = 0; corner < 3; ++corner) {
-        const Eigen::Vector2d& pixel = corner_pixels[t][corner];
-        mesh->corner_uvs[3 * t + corner] =
-            Eigen::Vector2f((chart.at.x + (pixel.x() - chart.source.x) * sx) / width,
-                            (chart.at.y + (pixel.y() - chart.source.y) * sy) / height);
-      }
-    }
-  }
-  if (flat_count > 0) {
-    flat.patch.copyTo(mesh->texture(cv::Rect(flat.at, flat.patch.size())));
-    for (int i = 0; i < flat_count; ++i) {
-      const float x0 = static_cast<float>(flat.at.x + (i % flat_side) * kFlatCell) + 0.5f;
-      const float y0 = static_cast<float>(flat.at.y + (i / flat_side) * kFlatCell) + 0.5f;
-      const float span = kFlatCell - 1.0f;
-      const Eigen::Vector2f corners[3] = {{x0, y0}, {x0 + span, y0}, {x0, y0 + span}};
-      for (int corner = 0; corner < 3; ++corner) {
-        mesh->corner_uvs[3 * flat.triangles[i] + corner] =
-            corners[corner].cwiseQuotient(Eigen::Vector2f(width, height));
-      }
-    }
-  }
+  summary.scale = atlas.scale;
+  summary.atlas_width = atlas.width;
+  summary.atlas_height = atlas.height;
+  DrawAtlas(charts, flat, flat_side, corner_pixels, atlas, mesh);
   const TextureSeams seams = MeasureTextureSeams(*mesh);
   summary.seam_edges = seams.seam_edges;
   summary.seam_step = seams.seam_step;
   summary.inner_step = seams.inner_step;
-  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds = elapsed();
   return summary;
 }
 

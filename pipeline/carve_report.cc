@@ -134,8 +134,8 @@ void WriteColourCalibration(const CarveRequest& request, const CarveRun& run, Js
   }
 }
 
-void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWriter& json) {
-  const CarveStatistics& s = run.result->statistics;
+// The volume's box and the resolution the photos support.
+void WriteBounds(const CarveRun& run, JsonWriter& json) {
   json.Key("bounds").BeginObject()
       .Key("min").Value(JsonArray(run.bounds.box.min()))
       .Key("max").Value(JsonArray(run.bounds.box.max()))
@@ -149,6 +149,12 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
       .Key("supported_resolution").Value(run.supported_resolution)
       .Key("default_lowered_from").Value(run.resolution_lowered_from)
       .EndObject();
+}
+
+// What the capture was found to be: its layout, the supporting plane and the ground held, the
+// distant and ground pixels found.
+void WriteCapture(const CarveRun& run, JsonWriter& json) {
+  const CarveStatistics& s = run.result->statistics;
   const CaptureLayout& layout = run.layout;
   json.Key("capture").BeginObject()
       .Key("kind").Value(std::string(layout.object_centred ? "object" : "scene"))
@@ -206,6 +212,12 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
       .Key("seconds").Value(ground.seconds)
       .EndObject();
   json.EndObject();
+}
+
+void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWriter& json) {
+  const CarveStatistics& s = run.result->statistics;
+  WriteBounds(run, json);
+  WriteCapture(run, json);
   json.Key("statistics").BeginObject()
       .Key("visibility").Value(s.visibility)
       .Key("grid").Value(std::vector<double>{static_cast<double>(s.dimensions.x()),

@@ -165,25 +165,22 @@ std::string CaptureText(const CarveRun& run) {
 }
 
 
-void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string* text) {
+// The summary's line on the sparse points in the volume.
+std::string SparseLine(const CarveRequest& request, const CarveRun& run) {
+  if (!run.has_sparse) return "none in the volume";
+  char text[240];
+  std::snprintf(text, sizeof(text), "%zu in the volume: %.1f%% within 2 voxels of the cloud, 90%% within %.2f voxels%s",
+                run.sparse.num_reconstruction, 100.0 * run.sparse.precision,
+                run.sparse.accuracy / run.result->statistics.voxel_size,
+                request.options.protect_surface_points
+                    ? "\n                  (known surface keeps the reliable ones' voxels: no independent measure)"
+                    : "");
+  return text;
+}
+
+// The lines on the tiles joined and the silhouettes repaired, where there were any.
+std::string TilesAndSilhouettesLines(const CarveRun& run) {
   const CarveStatistics& s = run.result->statistics;
-  std::string sparse_line = "none in the volume";
-  if (run.has_sparse) {
-    char text[240];
-    std::snprintf(text, sizeof(text), "%zu in the volume: %.1f%% within 2 voxels of the cloud, 90%% within %.2f voxels%s",
-                  run.sparse.num_reconstruction, 100.0 * run.sparse.precision,
-                  run.sparse.accuracy / s.voxel_size,
-                  request.options.protect_surface_points
-                      ? "\n                  (known surface keeps the reliable ones' voxels: no independent measure)"
-                      : "");
-    sparse_line = text;
-  }
-  const std::string mask_line =
-      run.backdrop_masks_dropped > 0
-          ? "a backdrop found in " + std::to_string(run.backdrop_masks_dropped) + " of " +
-                std::to_string(run.mask_photos.size()) +
-                " photos only (a minority): not the capture's, every photo used whole"
-          : MaskSummary(run.mask_photos);
   std::string silhouette_line;
   if (s.silhouette_repair.views > 0) {
     silhouette_line = "  silhouettes     " + std::to_string(s.silhouette_repair.lost_pixels) +
@@ -200,10 +197,11 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
                   static_cast<long long>(s.evaluated));
     silhouette_line = tiles + silhouette_line;
   }
-  size_t judged_voxels = 0;
-  for (const ColouredVoxel& voxel : run.result->surface) {
-    judged_voxels += voxel.num_views >= request.options.min_views;
-  }
+  return silhouette_line;
+}
+
+// The levels of detail: each one's resolution and threshold.
+std::string LevelsText(const CarveRequest& request, const CarveStatistics& s) {
   std::string level_line;
   for (const LevelStatistics& level : s.levels) {
     char text[96];
@@ -220,6 +218,24 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
       level_line += " (photos enlarged " + std::to_string(level.image_enlargement) + "x)";
     }
   }
+  return level_line;
+}
+
+void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string* text) {
+  const CarveStatistics& s = run.result->statistics;
+  const std::string sparse_line = SparseLine(request, run);
+  const std::string mask_line =
+      run.backdrop_masks_dropped > 0
+          ? "a backdrop found in " + std::to_string(run.backdrop_masks_dropped) + " of " +
+                std::to_string(run.mask_photos.size()) +
+                " photos only (a minority): not the capture's, every photo used whole"
+          : MaskSummary(run.mask_photos);
+  const std::string silhouette_line = TilesAndSilhouettesLines(run);
+  size_t judged_voxels = 0;
+  for (const ColouredVoxel& voxel : run.result->surface) {
+    judged_voxels += voxel.num_views >= request.options.min_views;
+  }
+  const std::string level_line = LevelsText(request, s);
   std::string floater_text;
   if (s.unsupported_components > 0) {
     floater_text = ", " + std::to_string(s.unsupported_component_carved) + " in " +

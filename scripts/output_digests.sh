@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # What carve, holdout and benchmark produce, reduced to digests and figures that a change which
-# should not alter behaviour (a refactoring) must leave the same: SHA-256 of every PLY, and every
+# should not alter behaviour (a refactoring) must leave the same: SHA-256 of every PLY, of the
+# textured mesh (OBJ, GLB, texture), and every
 # figure of the JSON reports except timings, memory, paths and the build's identity.
 #
 # Usage: scripts/output_digests.sh OUT_DIR [RAYCARVE]  > digests.txt
@@ -38,7 +39,7 @@ digest() { for f in "$@"; do echo "$(basename "$(dirname "$f")")/$(basename "$f"
 quiet "$raycarve" synth --output_path "$out/demo" --camera_model OPENCV --views 8 --width 640 --height 480
 quiet "$raycarve" carve --workspace_path "$out/demo" --output_path "$out/demo_carve" --num_threads 1
 echo "== demo: carve at the defaults, one thread"
-digest "$out"/demo_carve/{cloud,mesh}.ply
+digest "$out"/demo_carve/{cloud,mesh}.ply "$out"/demo_carve/mesh{.obj,.glb,_texture.png}
 figures "$out/demo_carve/report.json"
 quiet "$raycarve" holdout --workspace_path "$out/demo" --output_path "$out/demo_carve" --num_threads 1
 echo "== demo: holdout at the defaults, one thread"
@@ -57,7 +58,7 @@ for set in templeSparseRing dinoSparseRing dinoRing; do
   quiet "$raycarve" carve --input_path "$data/middlebury/$set/colmap/given" \
     --image_path "$data/middlebury/$set" --output_path "$out/$set" --num_threads 1
   echo "== $set (given model): carve at the defaults, one thread"
-  digest "$out/$set"/{cloud,mesh}.ply
+  digest "$out/$set"/{cloud,mesh}.ply "$out/$set"/mesh{.obj,.glb,_texture.png}
   figures "$out/$set/report.json"
 done
 if [ -d "$data/middlebury/templeSparseRing" ]; then

@@ -156,6 +156,37 @@ struct VertexMove {
   float pinned = 0.0f;  // how firmly the photos place it (PinnedShare)
 };
 
+// Whether two of the photos in `seen` see the vertex's offsets along its normal differently. An
+// offset t moves the point a photo samples on the surface by t tan(angle) along the photo's
+// direction across the surface (its unit vector u): t (d - cos(angle) n) / cos(angle), d the
+// unit direction to the photo. Photos that all look from one side at a grazing angle (a
+// forward-facing capture's floor) move it alike: the offsets then differ by where the samples
+// fall, not by how well the photos agree, and the refinement follows the texture's edges (that
+// floor came out bumpier than the carve left it). Two photos tell the offsets apart where, over
+// the search range, their sampled points part by at least either's pixel footprint on the
+// surface (depth / focal length, stretched by 1 / cos(angle) along the tilt).
+bool OffsetsToldApart(const std::vector<CalibratedView>& views,
+                      const std::vector<VertexSighting>& seen,
+                      const Eigen::Vector3d& centre,
+                      const Eigen::Vector3d& normal,
+                      double search_range) {
+  std::vector<Eigen::Vector3d> slide(seen.size());
+  std::vector<double> footprint(seen.size());
+  for (size_t k = 0; k < seen.size(); ++k) {
+    const CalibratedView& view = views[seen[k].view];
+    const Eigen::Vector3d d = (view.centre - centre).normalized();
+    const double cosine = std::max(1e-6, d.dot(normal));
+    slide[k] = (d - cosine * normal) / cosine;
+    footprint[k] = view.Depth(centre) / view.K(0, 0) / cosine;
+  }
+  for (size_t k = 0; k < seen.size(); ++k) {
+    for (size_t l = k + 1; l < seen.size(); ++l) {
+      if (search_range * (slide[k] - slide[l]).norm() >= std::max(footprint[k], footprint[l])) return true;
+    }
+  }
+  return false;
+}
+
 // Tries the vertex at `centre` (unit `normal`) at every offset of the search range in the photos
 // of `seen` (the best-facing options.max_views of them) and keeps the offset whose patch the
 // photos agree on best, when it beats staying by options.min_gain. `patch` and `projected` are
@@ -182,6 +213,7 @@ VertexMove JudgeVertex(const std::vector<CalibratedView>& views,
                       });
     seen.resize(options.max_views);
   }
+  if (!OffsetsToldApart(views, seen, centre, normal, options.search_range)) return result;
   result.judged = true;
   Eigen::Vector3d u, w;
   TangentBasis(normal, &u, &w);

@@ -12,19 +12,21 @@ namespace exporter {
 
 // Moves a mesh's vertices along their normals to where the photos agree best.
 //
-// Voxel colouring keeps every voxel whose photos agree to within the threshold, so its surface
-// lies up to a voxel or so outside the true one (in front of it as the photos see it), and the
+// Voxel colouring keeps every voxel whose photos agree to within the threshold, so its surface lies
+// up to a voxel or so outside the true one (in front of it as the photos see it), and the
 // iso-surface adds half a voxel more. Each pass: every vertex that two or more photos see (as
-// FindVertexSightings says) tries offsets along its normal within +-search_range, and at each it
-// compares small patches (the point and 4 points around it on the tangent plane) across those
-// photos: the cost is the mean over photos and patch samples of the squared RGB distance to the
-// photos' mean. The vertex's offset is the cheapest one where that is clearly better than staying
-// (below `min_gain` x the cost of staying), else 0; offsets are then averaged over each vertex's
-// neighbours (smoothing passes) before the vertices move, and normals are recomputed.
-// Passes go on until one moves the mesh's vertices by less than `converged_offset` on average
-// (each pass moves a vertex by at most `search_range`, and the surface the carve leaves can lie
-// several voxels out where the photos agree above it, the more voxels the finer the grid), or
-// until `passes` have run.
+// FindVertexSightings says), two of which tell its offsets apart (over the search range the points
+// they sample on the surface part by at least a pixel's footprint there: not so for photos that all
+// look from one side at a grazing angle), tries offsets along its normal within +-search_range, and
+// at each it compares small patches (the point and 4 points around it on the tangent plane) across
+// those photos: the cost is the mean over photos and patch samples of the squared RGB distance to
+// the photos' mean. The vertex's offset is the cheapest one where that is clearly better than
+// staying (below `min_gain` x the cost of staying), else 0; offsets are then averaged over each
+// vertex's neighbours (smoothing passes) before the vertices move, and normals are recomputed.
+// Passes go on until one moves the mesh's vertices by less than `converged_offset` on average (each
+// pass moves a vertex by at most `search_range`, and the surface the carve leaves can lie several
+// voxels out where the photos agree above it, the more voxels the finer the grid), or until
+// `passes` have run.
 struct MeshRefinementOptions {
   int passes = 4;                   // search and move passes at most
   double converged_offset = 0.0;    // world units; a pass moving the vertices less on average is the last (0: run every pass)
@@ -44,7 +46,7 @@ struct MeshRefinementOptions {
 
 struct MeshRefinementSummary {
   int64_t vertices = 0;
-  int64_t judged = 0;     // seen by min_views photos, in the last pass
+  int64_t judged = 0;     // seen by min_views photos that tell its offsets apart, in the last pass
   int64_t moved = 0;      // given a non-zero offset before smoothing, in the last pass
   int passes = 0;         // passes run
   double last_mean_abs_offset = 0.0;  // over all vertices, in the last pass

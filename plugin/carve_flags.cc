@@ -117,6 +117,10 @@ void AddCarvingFlags(OptionParser* parser, CarveRequest* request, CarveFlagText*
   parser->AddDefault("min_component_voxels", &request->options.min_component_voxels,
                      "after carving, carve every connected piece of fewer solid voxels than this "
                      "(specks in empty space) and carry on carving behind them; 0: keep all");
+}
+
+// The carve's machinery (the seed paper's variants and the memory limit), in the "Carve" group.
+void AddCarveMethodFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* text) {
   parser->AddDefault("method", &text->method,
                      "visibility: ray casting (the seed paper), or its baselines GVC (item "
                      "buffers, passes) and GVC-LDI (layered depth images)",
@@ -290,6 +294,7 @@ void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* t
   AddPhotoFlags(parser, request, text);
   AddBoundsFlags(parser, &request->bounds);
   AddCarvingFlags(parser, request, text);
+  AddCarveMethodFlags(parser, request, text);
   AddLevelFlags(parser, request);
   AddMeshFlags(parser, request);
   AddThreadFlags(parser, request);

@@ -145,6 +145,41 @@ std::string PlanFolder(const std::string& plan_path) {
   return fs::absolute(plan_path).parent_path().string();
 }
 
+// The plan's folder (and its logs/), made: never inside the photos' or the model's folder.
+fs::path MakePlanFolder(const std::string& tile_path, const std::vector<std::string>& inputs) {
+  const fs::path folder = fs::absolute(tile_path);
+  for (const std::string& input : inputs) {
+    const fs::path inside = fs::weakly_canonical(input);
+    const fs::path plan_folder = fs::weakly_canonical(folder);
+    if (std::mismatch(inside.begin(), inside.end(), plan_folder.begin(), plan_folder.end()).first ==
+        inside.end()) {
+      throw InputError("raycarve tile plan: --tile_path " + tile_path + " lies in the input " +
+                       input + ": give another --tile_path");
+    }
+  }
+  std::error_code error;
+  fs::create_directories(folder / "logs", error);
+  if (error) throw InputError(tile_path + ": cannot make the plan's folder: " + error.message());
+  return folder;
+}
+
+// What the plan holds and how to run it.
+void PrintPlan(const TilePlan& plan, const CoarseCarve& coarse, const Eigen::Vector3i& tiles,
+               int overlap, const std::string& folder, const std::string& plan_path) {
+  std::printf("tile plan %s: a %dx%dx%d grid (resolution %d) in %dx%dx%d tiles, overlap %d; "
+              "%d with work (%d empty in the coarse volume)\n",
+              plan.plan_id.c_str(), plan.dimensions.x(), plan.dimensions.y(), plan.dimensions.z(),
+              plan.resolution, tiles.x(), tiles.y(), tiles.z(), overlap, plan.jobs,
+              static_cast<int>(plan.tiles.size()) - plan.jobs);
+  std::printf("coarse levels: %.1f s; final threshold %.2f\n",
+              coarse.statistics.carve_seconds + coarse.statistics.setup_seconds,
+              plan.final_threshold);
+  std::printf("plan: %s\n", plan_path.c_str());
+  std::printf("run:  %s/submit_slurm.sh (Slurm), kubectl apply -f %s/tiles.k8s.yaml (Kubernetes),\n"
+              "      or %s/run_local.sh (this machine); one job: raycarve tile run --plan %s --index I\n",
+              folder.c_str(), folder.c_str(), folder.c_str(), plan_path.c_str());
+}
+
 int RunTilePlan(int argc, char** argv) {
   CarveRequest request;
   CarveFlagText text;
@@ -186,19 +221,7 @@ int RunTilePlan(int argc, char** argv) {
     throw InputError("raycarve tile plan: " + reason);
   }
   if (tile_path.empty()) tile_path = pipeline.run().output_path + "_tiles";
-  const fs::path folder = fs::absolute(tile_path);
-  for (const std::string& input : {pipeline.run().image_path, pipeline.run().model_path}) {
-    const fs::path inside = fs::weakly_canonical(input);
-    const fs::path plan_folder = fs::weakly_canonical(folder);
-    if (std::mismatch(inside.begin(), inside.end(), plan_folder.begin(), plan_folder.end()).first ==
-        inside.end()) {
-      throw InputError("raycarve tile plan: --tile_path " + tile_path + " lies in the input " +
-                       input + ": give another --tile_path");
-    }
-  }
-  std::error_code error;
-  fs::create_directories(folder / "logs", error);
-  if (error) throw InputError(tile_path + ": cannot make the plan's folder: " + error.message());
+  const fs::path folder = MakePlanFolder(tile_path, {pipeline.run().image_path, pipeline.run().model_path});
 
   const CoarseCarve coarse = pipeline.CarveCoarse();
   const TilePlan plan = MakeTilePlan(pipeline.carved_views(), box, options, coarse, tiles, overlap,
@@ -217,18 +240,7 @@ int RunTilePlan(int argc, char** argv) {
   WriteTileJobScripts(folder.string(), plan, raycarve, plan_path);
   WriteTextFileAtomically(plan_path, TilePlanJson(plan));
 
-  std::printf("tile plan %s: a %dx%dx%d grid (resolution %d) in %dx%dx%d tiles, overlap %d; "
-              "%d with work (%d empty in the coarse volume)\n",
-              plan.plan_id.c_str(), plan.dimensions.x(), plan.dimensions.y(), plan.dimensions.z(),
-              plan.resolution, tiles.x(), tiles.y(), tiles.z(), overlap, plan.jobs,
-              static_cast<int>(plan.tiles.size()) - plan.jobs);
-  std::printf("coarse levels: %.1f s; final threshold %.2f\n",
-              coarse.statistics.carve_seconds + coarse.statistics.setup_seconds,
-              plan.final_threshold);
-  std::printf("plan: %s\n", plan_path.c_str());
-  std::printf("run:  %s/submit_slurm.sh (Slurm), kubectl apply -f %s/tiles.k8s.yaml (Kubernetes),\n"
-              "      or %s/run_local.sh (this machine); one job: raycarve tile run --plan %s --index I\n",
-              folder.c_str(), folder.c_str(), folder.c_str(), plan_path.c_str());
+  PrintPlan(plan, coarse, tiles, overlap, folder.string(), plan_path);
   return 0;
 }
 

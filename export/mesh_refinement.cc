@@ -71,14 +71,15 @@ bool MeshRefinementOptions::IsValid(std::string* reason) const {
 }
 
 std::string MeshRefinementSummary::Summary() const {
-  char text[256];
+  char text[384];
   std::snprintf(text, sizeof(text),
                 "mesh refinement: %d passes; in the last %lld of %lld vertices judged, %lld "
                 "moved (mean |offset| %.3g); mean offset per pass %.3g (|%.3g|) along the "
-                "normals; pinned by the photos %.0f%% (mean); in %.2f s",
+                "normals; pinned by the photos %.0f%% (mean); %lld whose photos cannot tell "
+                "their offsets apart moved half a voxel in; in %.2f s",
                 passes, static_cast<long long>(judged), static_cast<long long>(vertices),
                 static_cast<long long>(moved), last_mean_abs_offset, mean_offset,
-                mean_abs_offset, 100.0 * mean_pinned, seconds);
+                mean_abs_offset, 100.0 * mean_pinned, static_cast<long long>(unresolved), seconds);
   return text;
 }
 
@@ -151,6 +152,7 @@ bool OffsetCost(const std::vector<CalibratedView>& views,
 // What one refinement pass decides for a vertex.
 struct VertexMove {
   bool judged = false;  // seen by enough photos to be judged
+  bool unresolved = false;  // seen by enough, but none two of them tell its offsets apart
   bool moved = false;
   float offset = 0.0f;  // along the normal, world units
   float pinned = 0.0f;  // how firmly the photos place it (PinnedShare)
@@ -213,7 +215,10 @@ VertexMove JudgeVertex(const std::vector<CalibratedView>& views,
                       });
     seen.resize(options.max_views);
   }
-  if (!OffsetsToldApart(views, seen, centre, normal, options.search_range)) return result;
+  if (!OffsetsToldApart(views, seen, centre, normal, options.search_range)) {
+    result.unresolved = true;
+    return result;
+  }
   result.judged = true;
   Eigen::Vector3d u, w;
   TangentBasis(normal, &u, &w);
@@ -286,7 +291,7 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
         views, *mesh, options.depth_tolerance, &on_rim, options.voxel_size, 1.0,
         options.num_threads, &mask_distances);
     std::vector<float> offsets(n, 0.0f);
-    std::vector<uint8_t> judged(n, 0), moved(n, 0);
+    std::vector<uint8_t> judged(n, 0), moved(n, 0), unresolved(n, 0);
     summary.pinned.assign(n, 0.0f);
     const int threads = options.num_threads > 0 ? options.num_threads : ResolveNumThreads(-1);
     ParallelRanges(n, threads, /*min_per_thread=*/1024, [&](size_t begin, size_t end) {
@@ -297,6 +302,7 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
                                           mesh->vertices[i].cast<double>(),
                                           mesh->normals[i].cast<double>(), &patch, &projected);
       judged[i] = move.judged;
+      unresolved[i] = move.unresolved;
       moved[i] = move.moved;
       offsets[i] = move.offset;
       if (move.judged) summary.pinned[i] = move.pinned;
@@ -304,6 +310,15 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
     });
     summary.judged = std::count(judged.begin(), judged.end(), 1);
     summary.moved = std::count(moved.begin(), moved.end(), 1);
+    if (pass == 0) {
+      // Where no two photos tell a vertex's offsets apart, nothing places it but the carve: its
+      // surface voxels hold the surface somewhere inside them, and the iso-surface runs along
+      // their outer faces, half a voxel out on average. Such vertices move half a voxel in, once.
+      for (size_t i = 0; i < n; ++i) {
+        if (unresolved[i]) offsets[i] = static_cast<float>(-0.5 * options.voxel_size);
+      }
+      summary.unresolved = std::count(unresolved.begin(), unresolved.end(), 1);
+    }
     AverageOverNeighbours(neighbours, options.smoothing_passes, &offsets, options.num_threads);
     double pass_abs_sum = 0.0;
     for (size_t i = 0; i < n; ++i) {

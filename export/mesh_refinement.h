@@ -17,7 +17,8 @@ namespace exporter {
 // iso-surface adds half a voxel more. Each pass: every vertex that two or more photos see (as
 // FindVertexSightings says), two of which tell its offsets apart (over the search range the points
 // they sample on the surface part by at least a pixel's footprint there: not so for photos that all
-// look from one side at a grazing angle), tries offsets along its normal within +-search_range, and
+// look from one side at a grazing angle; where none do, it moves half a voxel in once, the
+// iso-surface's offset on average), tries offsets along its normal within +-search_range, and
 // at each it compares small patches (the point and 4 points around it on the tangent plane) across
 // those photos: the cost is the mean over photos and patch samples of the squared RGB distance to
 // the photos' mean. The vertex's offset is the cheapest one where that is clearly better than
@@ -47,6 +48,7 @@ struct MeshRefinementOptions {
 struct MeshRefinementSummary {
   int64_t vertices = 0;
   int64_t judged = 0;     // seen by min_views photos that tell its offsets apart, in the last pass
+  int64_t unresolved = 0;  // seen by min_views photos, no two of which tell them apart (first pass)
   int64_t moved = 0;      // given a non-zero offset before smoothing, in the last pass
   int passes = 0;         // passes run
   double last_mean_abs_offset = 0.0;  // over all vertices, in the last pass

@@ -97,16 +97,21 @@ TEST(RefineMeshFromPhotos, PhotosFromAboveMoveALiftedFloorOntoIt) {
 
 // 6 away, 18-26 degrees above the floor: a pixel covers about 0.015 of it, 0.034-0.049 stretched
 // by the tilt. From one azimuth, over the search range (0.02 either side) the photos' sampled
-// points part by at most 0.02 x (tan 72 - tan 64) = 0.021: not told apart, no vertex is judged
-// and the sheet stays. From three azimuths at 22 degrees they part by 0.02 x tan 68 x sqrt(3) =
-// 0.086: judged.
+// points part by at most 0.02 x (tan 72 - tan 64) = 0.021: not told apart, no vertex is judged,
+// and the sheet moves half a voxel in, once (the iso-surface's mean offset), whatever the photos
+// show. From three azimuths at 22 degrees they part by 0.02 x tan 68 x sqrt(3) = 0.086: judged.
 TEST(RefineMeshFromPhotos, PhotosFromOneSideAtAGrazingAngleDoNotJudgeThoseFromAroundDo) {
   TriangleMesh one_side = FloorSheet(0.5 * kVoxel);
   const MeshRefinementSummary from_one_side =
       RefineMeshFromPhotos(FloorViews({{10, 18}, {10, 22}, {10, 26}}, 6.0), FloorOptions(), &one_side);
   EXPECT_EQ(from_one_side.judged, 0);
   EXPECT_EQ(from_one_side.moved, 0);
-  for (const Eigen::Vector3f& v : one_side.vertices) EXPECT_FLOAT_EQ(v.z(), static_cast<float>(0.5 * kVoxel));
+  EXPECT_GT(from_one_side.unresolved, static_cast<int64_t>(one_side.vertices.size() / 2));
+  for (const Eigen::Vector3f& v : one_side.vertices) {
+    EXPECT_GE(v.z(), -1e-6f);
+    EXPECT_LE(v.z(), static_cast<float>(0.5 * kVoxel) + 1e-6f);
+  }
+  EXPECT_LT(MedianHeight(one_side), 0.05 * kVoxel);
 
   TriangleMesh around = FloorSheet(0.5 * kVoxel);
   const MeshRefinementSummary from_around =

@@ -185,6 +185,26 @@ void ChooseCaptureBox(const BoundsRequest& request, int resolution, LoadedProjec
             << "; --capture " << request.capture << ")";
 }
 
+namespace {
+int DistinctImages(const Point3D& point) {
+  std::set<image_t> images;
+  for (const TrackElement& e : point.track) images.insert(e.image_id);
+  return static_cast<int>(images.size());
+}
+}  // namespace
+
+std::vector<Eigen::Vector3d> CheckedPoints(const Reconstruction& reconstruction,
+                                          const Eigen::AlignedBox3d& box) {
+  std::vector<Eigen::Vector3d> checked, all;
+  for (const auto& [id, point] : reconstruction.points3D) {
+    if (!box.contains(point.xyz)) continue;
+    const int images = DistinctImages(point);
+    if (images >= 2) all.push_back(point.xyz);
+    if (images >= 3) checked.push_back(point.xyz);
+  }
+  return static_cast<int>(checked.size()) >= kMinCheckedPoints ? checked : all;
+}
+
 LoadedProject LoadProject(const ProjectRequest& request) {
   LoadedProject project;
   const WorkspacePaths paths = ResolveProjectPaths(request, &project.output_path);
@@ -244,10 +264,12 @@ LoadedProject LoadProject(const ProjectRequest& request) {
   }
   ChooseCaptureBox(request.bounds, request.resolution, &project);
   {
-    std::vector<Eigen::Vector3d> points, cameras;
-    for (const auto& [id, point] : project.reconstruction.points3D) {
-      if (point.track.size() >= 2 && project.bounds.box.contains(point.xyz)) points.push_back(point.xyz);
-    }
+    // A wrong match between two photos triangulates anywhere, under the floor too (a chequered
+    // floor or a repeated pattern, measured: docs/studies/2026-12-05-colmap-points.md), and points
+    // below a plane rule it out; a third photo checks the match.
+    std::vector<Eigen::Vector3d> cameras;
+    const std::vector<Eigen::Vector3d> points =
+        CheckedPoints(project.reconstruction, project.bounds.box);
     for (const auto& [id, image] : project.reconstruction.images) {
       cameras.push_back(image.ProjectionCenter());
     }

@@ -29,8 +29,9 @@ struct LoadedProject {
   Reconstruction reconstruction;
   Bounds bounds;
   CaptureLayout layout;  // how the cameras stand (DescribeCapture), after any hold-out
-  // The plane the subject stands on, from the sparse points in the volume (FitSupportingPlane,
-  // tolerance kPlaneTolerance of the volume's largest extent): reported, not used to carve.
+  // The plane the subject stands on, from the sparse points in the volume that three or more
+  // photos saw (CheckedPoints; FitSupportingPlane, tolerance kPlaneTolerance of the volume's
+  // largest extent). Without masks the carve holds the ground under it (DecideGround).
   exporter::SupportingPlane plane;
   std::vector<CalibratedView> views;
   ViewReaderSummary view_summary;
@@ -52,6 +53,13 @@ constexpr int kMinSurfaceTrack = 2;
 constexpr double kMaxSurfaceError = 1.0;
 std::vector<SurfacePoint> SurfacePointsOf(const Reconstruction& reconstruction,
                                           const std::vector<CalibratedView>& views,
+                                          const Eigen::AlignedBox3d& box);
+
+// Sparse points inside `box` that three or more photos saw (a third photo checks the match), or,
+// where fewer than kMinCheckedPoints are, those that two or more saw. The supporting plane is fit
+// to these.
+constexpr int kMinCheckedPoints = 20;
+std::vector<Eigen::Vector3d> CheckedPoints(const Reconstruction& reconstruction,
                                           const Eigen::AlignedBox3d& box);
 
 // Holds out every `every`-th image in name order (the first, then every k-th after it): their

@@ -12,13 +12,32 @@
 #     masks, kept apart from the project), and the share of their sparse points (triangulated from
 #     the other photos) the mesh draws at their depth and hides behind something nearer.
 # Prints a Markdown table and writes out/unmasked_table/table.json.
-# Usage: scripts/run_unmasked_table.sh
+#
+# With --sift_points the sparse points are COLMAP's instead of exact samples of the truth
+# (scripts/triangulate_sift_points.sh: SIFT features matched and triangulated at the true poses),
+# as in a user's model: fewer, noisier, short tracks, some wrong matches. --views N and --size WxH
+# change the photos (SIFT needs more and larger photos than the exact points do: 36 of 640x480
+# give a ring's neighbours 10 degrees apart). Written to out/unmasked_table_sift.
+# --scene "room ring" runs that scene alone (backdrop and layout, then "clutter" where it has some).
+# Usage: scripts/run_unmasked_table.sh [--sift_points] [--views 12] [--size 320x240] [--scene S]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v python3 > /dev/null || { echo "run_unmasked_table.sh needs python3" >&2; exit 1; }
+sift=0 views=12 size=320x240 only=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --sift_points) sift=1; shift ;;
+    --views) views=$2; shift 2 ;;
+    --size) size=$2; shift 2 ;;
+    --scene) only=$2; shift 2 ;;
+    *) echo "usage: $0 [--sift_points] [--views N] [--size WxH] [--scene S]" >&2; exit 1 ;;
+  esac
+done
+width=${size%x*} height=${size#*x}
 scripts/setup.sh raycarve >&2
 rc=build/plugin/raycarve
 out=out/unmasked_table
+[ "$sift" = 1 ] && out=out/unmasked_table_sift
 rm -rf "$out"
 mkdir -p "$out"
 rows="$out/rows.jsonl"
@@ -26,12 +45,16 @@ rows="$out/rows.jsonl"
 for scene in "room ring" "room arc" "room forward" "patchwork ring" "patchwork arc" \
              "patchwork forward" "room arc clutter" "patchwork ring clutter" \
              "patchwork eye_level" "cloudy eye_level"; do
+  [ -n "$only" ] && [ "$scene" != "$only" ] && continue
   set -- $scene
   backdrop=$1 layout=$2 kind=${3:-simple} name="$1_$2${3:+_$3}"
   dir="$out/$name"
   $rc synth --output_path "$dir/scene" --scene "$kind" --backdrop "$backdrop" --layout "$layout" \
-    --views 12 --width 320 --height 240 > "$dir.synth.log" 2>&1
+    --views "$views" --width "$width" --height "$height" > "$dir.synth.log" 2>&1
   mv "$dir/scene/masks" "$dir/truth_masks"
+  if [ "$sift" = 1 ]; then
+    echo "$name: $(scripts/triangulate_sift_points.sh "$dir/scene")" >&2
+  fi
   for run in defaults colour_off; do
     flags=""
     [ "$run" = colour_off ] && flags="--threshold 1000000"

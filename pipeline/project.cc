@@ -186,6 +186,7 @@ void ChooseCaptureBox(const BoundsRequest& request, int resolution, LoadedProjec
 }
 
 namespace {
+// The photos a point's track holds, each once.
 int DistinctImages(const Point3D& point) {
   std::set<image_t> images;
   for (const TrackElement& e : point.track) images.insert(e.image_id);
@@ -378,9 +379,7 @@ std::vector<std::string> HoldOutImages(
     track.erase(std::remove_if(track.begin(), track.end(),
                                [&](const TrackElement& e) { return held.count(e.image_id) > 0; }),
                 track.end());
-    std::set<image_t> distinct;
-    for (const TrackElement& e : track) distinct.insert(e.image_id);
-    if (distinct.size() < 2) {
+    if (DistinctImages(it->second) < 2) {
       for (const TrackElement& e : track) {
         Image& image = reconstruction->images.at(e.image_id);
         if (e.point2D_idx < image.points2D.size()) {

@@ -22,6 +22,10 @@ struct SupportingPlane {
   double on_plane_share = 0.0;  // of them, within `tolerance` of the plane
   double below_share = 0.0;     // beyond `tolerance` on the side away from the cameras
   double cameras_above_share = 0.0;
+  // Where the plane holding the most points was no support and a less dense one is: that densest
+  // plane's shares (negative otherwise).
+  double densest_on_share = -1.0;
+  double densest_below_share = -1.0;
   std::string Summary() const;
 };
 
@@ -30,20 +34,31 @@ struct SupportingPlane {
 constexpr double kMinSupportShare = 0.2;
 constexpr double kMaxBelowShare = 0.1;
 constexpr double kMinCamerasAbove = 0.8;
+// A plane that is not the densest one, with nothing below it, is a support with this share on
+// it: a ball's points hold a few percent on any plane (a cap as thick as the tolerance), a floor
+// seen past an object much more.
+constexpr double kMinSupportShareWithNothingBelow = 0.1;
 
 // The plane holding the most of `points` within `tolerance` (RANSAC with PCL's plane model, a
 // fixed seed, refined by least squares on its inliers), oriented towards the majority of
 // `cameras` (their centres), and whether it is a support: kMinSupportShare of the points on it,
-// at most kMaxBelowShare of them below it, and kMinCamerasAbove of the cameras above. Fewer than
-// 20 points: not found.
+// at most kMaxBelowShare of them below it, and kMinCamerasAbove of the cameras above. Where that
+// densest plane is no support, the plane holding the most points among those with at most
+// kMaxBelowShare below and kMinCamerasAbove of the cameras above (planes through random triples,
+// a fixed seed), if it holds kMinSupportShareWithNothingBelow: wrong matches along a repeated pattern, or the
+// sides of a large object, can outnumber the ground's points on some tilted plane. Otherwise the
+// densest plane, not found. Fewer than 20 points: not found.
 SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
                                    const std::vector<Eigen::Vector3d>& cameras, double tolerance);
 
 // The ground a found support makes (empty when `plane` is not a support): the points of
 // `points` on the plane (within its tolerance) as the footprint, their convex hull as the outline,
-// the feet of the points below it as holes, all reaching twice the median spacing between
-// neighbours on the plane; `depth` the plane's tolerance.
-Ground GroundUnder(const SupportingPlane& plane, const std::vector<Eigen::Vector3d>& points);
+// the feet of the points of `hole_points` below it as holes, all reaching twice the median
+// spacing between neighbours on the plane; `depth` the plane's tolerance. (A hole says the photos
+// saw through the plane: only points a third photo checked say so, where there are enough; a
+// wrong match between two photos lies anywhere.)
+Ground GroundUnder(const SupportingPlane& plane, const std::vector<Eigen::Vector3d>& points,
+                   const std::vector<Eigen::Vector3d>& hole_points);
 
 }  // namespace exporter
 }  // namespace raycarve

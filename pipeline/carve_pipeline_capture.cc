@@ -27,11 +27,16 @@ void CarvePipeline::DecideGround() {
     // none of its own), those of the carved photos.
     const Eigen::AlignedBox3d& box = project_.bounds.box;
     const Eigen::AlignedBox3d around(box.min() - 0.5 * box.sizes(), box.max() + 0.5 * box.sizes());
-    std::vector<Eigen::Vector3d> points;
+    // A point under the plane opens a hole in the ground; a wrong match between two photos lies
+    // anywhere, so holes come from the points three or more photos saw, as the plane does
+    // (CheckedPoints), where there are enough.
+    std::vector<Eigen::Vector3d> points, checked;
     for (const SurfacePoint& point : SurfacePointsOf(project_.reconstruction, carved_, around)) {
       points.push_back(point.xyz);
+      if (point.views.size() >= 3) checked.push_back(point.xyz);
     }
-    run_.ground = exporter::GroundUnder(run_.plane, points);
+    const bool enough = static_cast<int>(checked.size()) >= kMinCheckedPoints;
+    run_.ground = exporter::GroundUnder(run_.plane, points, enough ? checked : points);
     std::ostringstream text;
     text.precision(3);
     if (run_.ground.empty()) {

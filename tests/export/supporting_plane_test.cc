@@ -78,7 +78,7 @@ TEST(GroundUnder, TheTablesPointsMakeTheGroundAndAStepDownMakesHoles) {
   }
   const SupportingPlane plane = FitSupportingPlane(scene.points, scene.cameras, 0.01);
   ASSERT_TRUE(plane.found) << plane.Summary();
-  const Ground ground = GroundUnder(plane, scene.points);
+  const Ground ground = GroundUnder(plane, scene.points, scene.points);
   ASSERT_FALSE(ground.empty());
   EXPECT_GE(ground.footprint.size(), 500u);
   EXPECT_LT(ground.footprint.size(), 540u);  // and the few of the ball that touch the table
@@ -95,11 +95,60 @@ TEST(GroundUnder, TheTablesPointsMakeTheGroundAndAStepDownMakesHoles) {
   EXPECT_EQ(map.At(origin + 3.1 * u - 0.3 * n), GroundMap::Foot::kNearHole);
   EXPECT_EQ(map.At(origin - 3.0 * u - 0.3 * n), GroundMap::Foot::kNeither);
   // No support, no ground.
-  EXPECT_TRUE(GroundUnder(SupportingPlane(), scene.points).empty());
+  EXPECT_TRUE(GroundUnder(SupportingPlane(), scene.points, scene.points).empty());
   // Every point twice (a point seen twice at the same place): the same reach.
   std::vector<Eigen::Vector3d> twice = scene.points;
   twice.insert(twice.end(), scene.points.begin(), scene.points.end());
-  EXPECT_NEAR(GroundUnder(plane, twice).radius, ground.radius, 1e-6);
+  EXPECT_NEAR(GroundUnder(plane, twice, twice).radius, ground.radius, 1e-6);
+  // Holes come from the points given for them only (the caller's checked points): the same
+  // footprint, no hole.
+  const Ground no_holes = GroundUnder(plane, scene.points, {});
+  EXPECT_EQ(no_holes.footprint.size(), ground.footprint.size());
+  EXPECT_TRUE(no_holes.holes.empty());
+  EXPECT_EQ(no_holes.radius, ground.radius);
+}
+
+// A slanted roof above a floor holds more points than the floor (wrong matches along a repeated
+// pattern do the same on a tilted plane): the densest plane has the floor and a ball below it, so
+// it is no support, and the floor, the densest plane with nothing below it, is.
+TEST(FitSupportingPlane, FindsTheFloorUnderADenserPlaneThatIsNoSupport) {
+  std::mt19937_64 random(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Eigen::Vector3d> points, cameras;
+  for (int i = 0; i < 120; ++i) {  // the floor z = 0, a disc of radius 2
+    const double r = 2.0 * std::sqrt(unit(random)), a = 2.0 * M_PI * unit(random);
+    points.emplace_back(r * std::cos(a), r * std::sin(a), 0.0);
+  }
+  for (int i = 0; i < 130; ++i) {  // a ball of radius 0.4 resting on it
+    const double z = 2.0 * unit(random) - 1.0, a = 2.0 * M_PI * unit(random);
+    const double s = std::sqrt(1.0 - z * z);
+    points.emplace_back(0.4 * s * std::cos(a), 0.4 * s * std::sin(a), 0.4 + 0.4 * z);
+  }
+  for (int i = 0; i < 250; ++i) {  // the roof z = 1 + 0.5 x over [-1, 1]^2
+    const double x = 2.0 * unit(random) - 1.0, y = 2.0 * unit(random) - 1.0;
+    points.emplace_back(x, y, 1.0 + 0.5 * x);
+  }
+  for (int i = 0; i < 12; ++i) {
+    const double a = 2.0 * M_PI * i / 12.0;
+    cameras.emplace_back(4.0 * std::cos(a), 4.0 * std::sin(a), 5.0);
+  }
+  const SupportingPlane plane = FitSupportingPlane(points, cameras, 0.01);
+  ASSERT_TRUE(plane.found) << plane.Summary();
+  EXPECT_GT(plane.normal.z(), 0.9999);
+  EXPECT_NEAR(plane.offset, 0.0, 1e-3);
+  EXPECT_NEAR(plane.on_plane_share, 120.0 / 500.0, 0.02);  // and the ball's lowest few
+  EXPECT_EQ(plane.below_share, 0.0);
+  // The roof was the densest plane, with the floor and the ball under it.
+  EXPECT_NEAR(plane.densest_on_share, 0.5, 0.02);
+  EXPECT_GT(plane.densest_below_share, 0.4);
+  EXPECT_NE(plane.Summary().find("the densest plane"), std::string::npos);
+
+  // Without the floor, nothing with the ball and the roof is a support: the roof has the ball
+  // below it, and no other plane holds a tenth of the points.
+  std::vector<Eigen::Vector3d> no_floor(points.begin() + 120, points.end());
+  const SupportingPlane none = FitSupportingPlane(no_floor, cameras, 0.01);
+  EXPECT_FALSE(none.found) << none.Summary();
+  EXPECT_LT(none.densest_on_share, 0.0);
 }
 
 }  // namespace

@@ -180,7 +180,12 @@ void WriteCapture(const CarveRun& run, JsonWriter& json) {
       .Key("on_plane_share").Value(plane.on_plane_share)
       .Key("below_share").Value(plane.below_share)
       .Key("cameras_above_share").Value(plane.cameras_above_share)
-      .Key("ground_held").Value(!run.ground.empty())
+      .Key("densest_plane_passed_over").Value(plane.densest_on_share >= 0.0);
+  if (plane.densest_on_share >= 0.0) {
+    json.Key("densest_plane_on_share").Value(plane.densest_on_share)
+        .Key("densest_plane_below_share").Value(plane.densest_below_share);
+  }
+  json.Key("ground_held").Value(!run.ground.empty())
       .Key("ground").Value(run.ground_reason)
       .Key("ground_footprint_points").Value(static_cast<int64_t>(run.ground.footprint.size()))
       .Key("ground_reach").Value(run.ground.radius)

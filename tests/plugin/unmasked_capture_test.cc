@@ -184,6 +184,9 @@ TEST(UnmaskedCapture, ForwardFacingPhotosAreASceneBoxedToTheDepthTheyPlace) {
       << output;
   EXPECT_NE(report.find("\"ground_held\": true"), std::string::npos);
   EXPECT_GT(JsonNumber(report, "ground_voxels"), 0);
+  // The generated points are exact: the densest plane is the ground itself.
+  EXPECT_NE(report.find("\"densest_plane_passed_over\": false"), std::string::npos);
+  EXPECT_EQ(report.find("densest_plane_on_share"), std::string::npos);
   // The same with --capture scene: every point, no narrowing.
   ASSERT_EQ(RunRaycarve("carve --workspace_path " + root + " --resolution 32 --capture scene "
                         "--output_path " + root + "/all_points",

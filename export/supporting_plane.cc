@@ -51,6 +51,12 @@ std::string SupportingPlane::Summary() const {
 
 namespace {
 
+// Nothing much under the plane, the cameras above it: whether it could be a support, however many
+// points it holds.
+bool CouldSupport(const SupportingPlane& plane) {
+  return plane.below_share <= kMaxBelowShare && plane.cameras_above_share >= kMinCamerasAbove;
+}
+
 // `coefficients` (a plane of the centred cloud) as a SupportingPlane in the world frame, oriented
 // towards the majority of `cameras`, with its shares of `points` (false for a degenerate plane).
 bool MeasurePlane(const Eigen::VectorXf& coefficients, const Eigen::Vector3d& centre,
@@ -80,9 +86,7 @@ bool MeasurePlane(const Eigen::VectorXf& coefficients, const Eigen::Vector3d& ce
   plane->below_share = static_cast<double>(below) / points.size();
   plane->cameras_above_share =
       cameras.empty() ? 0.0 : static_cast<double>(above) / cameras.size();
-  plane->found = plane->on_plane_share >= kMinSupportShare &&
-                 plane->below_share <= kMaxBelowShare &&
-                 plane->cameras_above_share >= kMinCamerasAbove;
+  plane->found = plane->on_plane_share >= kMinSupportShare && CouldSupport(*plane);
   return true;
 }
 
@@ -128,11 +132,7 @@ bool BestSupportCandidate(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
     }
     SupportingPlane candidate = *best;
     if (!MeasurePlane(coefficients, centre, scored, cameras, &candidate)) continue;
-    if (candidate.below_share > kMaxBelowShare ||
-        candidate.cameras_above_share < kMinCamerasAbove) {
-      continue;
-    }
-    if (candidate.on_plane_share > best_on) {
+    if (CouldSupport(candidate) && candidate.on_plane_share > best_on) {
       best_on = candidate.on_plane_share;
       best_coefficients = coefficients;
     }
@@ -142,9 +142,7 @@ bool BestSupportCandidate(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
                     best)) {
     return false;
   }
-  best->found = best->on_plane_share >= kMinSupportShareWithNothingBelow &&
-                best->below_share <= kMaxBelowShare &&
-                best->cameras_above_share >= kMinCamerasAbove;
+  best->found = best->on_plane_share >= kMinSupportShareWithNothingBelow && CouldSupport(*best);
   return best->found;
 }
 

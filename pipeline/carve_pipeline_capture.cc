@@ -33,7 +33,7 @@ void CarvePipeline::DecideGround() {
     std::vector<Eigen::Vector3d> points, checked;
     for (const SurfacePoint& point : SurfacePointsOf(project_.reconstruction, carved_, around)) {
       points.push_back(point.xyz);
-      if (point.views.size() >= 3) checked.push_back(point.xyz);
+      if (static_cast<int>(point.views.size()) >= kCheckedTrack) checked.push_back(point.xyz);
     }
     const bool enough = static_cast<int>(checked.size()) >= kMinCheckedPoints;
     run_.ground = exporter::GroundUnder(run_.plane, points, enough ? checked : points);

@@ -201,7 +201,7 @@ std::vector<Eigen::Vector3d> CheckedPoints(const Reconstruction& reconstruction,
     if (!box.contains(point.xyz)) continue;
     const int images = DistinctImages(point);
     if (images >= 2) all.push_back(point.xyz);
-    if (images >= 3) checked.push_back(point.xyz);
+    if (images >= kCheckedTrack) checked.push_back(point.xyz);
   }
   return static_cast<int>(checked.size()) >= kMinCheckedPoints ? checked : all;
 }

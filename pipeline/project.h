@@ -58,6 +58,7 @@ std::vector<SurfacePoint> SurfacePointsOf(const Reconstruction& reconstruction,
 // Sparse points inside `box` that three or more photos saw (a third photo checks the match), or,
 // where fewer than kMinCheckedPoints are, those that two or more saw. The supporting plane is fit
 // to these.
+constexpr int kCheckedTrack = 3;  // photos that make a point checked
 constexpr int kMinCheckedPoints = 20;
 std::vector<Eigen::Vector3d> CheckedPoints(const Reconstruction& reconstruction,
                                           const Eigen::AlignedBox3d& box);

@@ -39,8 +39,10 @@ open(work + "/known/points3D.txt", "w").close()
 PY
 colmap point_triangulator --database_path "$work/db.db" --image_path "$project/images" \
   --input_path "$work/known" --output_path "$work/triangulated" >> "$work/log" 2>&1
-rm -rf "$project/sparse/0"
-mkdir -p "$project/sparse/0"
-cp "$work/triangulated/"* "$project/sparse/0/"
+# The new model beside the old, then swapped in: an interrupted run leaves one whole model.
+rm -rf "$project/sparse/0.sift"
+cp -r "$work/triangulated" "$project/sparse/0.sift"
+mv "$project/sparse/0" "$work/exact"
+mv "$project/sparse/0.sift" "$project/sparse/0"
 colmap model_analyzer --path "$project/sparse/0" 2>&1 | grep -E "Points:|Mean track|reprojection" | sed 's/^.*\] //' | tr '\n' ' '
 echo

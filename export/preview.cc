@@ -5,6 +5,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "calib/photos_up.h"
 #include "export/mesh_renderer.h"
 
 namespace raycarve {
@@ -37,12 +38,9 @@ CalibratedView ViewFrom(const Eigen::Vector3d& target, double distance,
 }  // namespace
 
 Eigen::Vector3d PhotosUp(const std::vector<CalibratedView>& views) {
-  Eigen::Vector3d up = Eigen::Vector3d::Zero();
-  for (const CalibratedView& view : views) {
-    const Eigen::Matrix3d rotation = view.K.inverse() * view.P.leftCols<3>();
-    up -= rotation.row(1).transpose();  // the camera's -y: up in the photo
-  }
-  return up.norm() < 1e-9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d(up.normalized());
+  std::vector<Rigid3d> poses;
+  for (const CalibratedView& view : views) poses.push_back(view.cam_from_world);
+  return EstimatePhotosUp(poses).up;
 }
 
 std::vector<CalibratedView> ViewsFromOutside(const TriangleMesh& mesh,

@@ -20,8 +20,9 @@ namespace exporter {
 cv::Mat PreviewImage(const TriangleMesh& mesh, const std::vector<CalibratedView>& views,
                      int count = 3, int max_width = 1600);
 
-// The photos' mean up direction in the world: the mean of their cameras' -y axes (up in a
-// photo), unit; +z where they cancel out (or there are none).
+// The photos' up direction in the world (EstimatePhotosUp: the mean of their cameras' -y axes,
+// up in a photo, with photos turned a quarter turned back), unit; +z where they cancel out (or
+// there are none).
 Eigen::Vector3d PhotosUp(const std::vector<CalibratedView>& views);
 
 // `count` pinhole cameras of `width` x `height` (40 degrees across) framing the whole mesh from

@@ -42,11 +42,22 @@ std::string SupportingPlane::Summary() const {
        << "% of " << points << " sparse points on it (within " << tolerance << "), "
        << 100.0 * below_share << "% below it, " << 100.0 * cameras_above_share
        << "% of the cameras above it";
+  if (angle_to_photos_up >= 0.0) {
+    text << ", " << angle_to_photos_up << " degrees from the photos' up";
+  }
   if (densest_on_share >= 0.0) {
-    text << " (the densest plane, " << 100.0 * densest_on_share << "% on it and "
-         << 100.0 * densest_below_share << "% below it, is none)";
+    text << " (passed over: the densest plane, " << 100.0 * densest_on_share << "% on it and "
+         << 100.0 * densest_below_share << "% below it";
+    if (densest_angle_to_photos_up >= 0.0) {
+      text << ", " << densest_angle_to_photos_up << " degrees from the photos' up";
+    }
+    text << ")";
   }
   return text.str();
+}
+
+bool SupportingPlane::Level() const {
+  return angle_to_photos_up < 0.0 || angle_to_photos_up <= kMaxLevelAngle;
 }
 
 namespace {
@@ -61,7 +72,8 @@ bool CouldSupport(const SupportingPlane& plane) {
 // towards the majority of `cameras`, with its shares of `points` (false for a degenerate plane).
 bool MeasurePlane(const Eigen::VectorXf& coefficients, const Eigen::Vector3d& centre,
                   const std::vector<Eigen::Vector3d>& points,
-                  const std::vector<Eigen::Vector3d>& cameras, SupportingPlane* plane) {
+                  const std::vector<Eigen::Vector3d>& cameras, const PhotosUp& up,
+                  SupportingPlane* plane) {
   Eigen::Vector3d normal(coefficients[0], coefficients[1], coefficients[2]);
   if (!(normal.norm() > 0.0)) return false;
   double offset = coefficients[3] / normal.norm();
@@ -86,6 +98,8 @@ bool MeasurePlane(const Eigen::VectorXf& coefficients, const Eigen::Vector3d& ce
   plane->below_share = static_cast<double>(below) / points.size();
   plane->cameras_above_share =
       cameras.empty() ? 0.0 : static_cast<double>(above) / cameras.size();
+  plane->angle_to_photos_up =
+      up.Known() ? std::acos(std::clamp(normal.dot(up.up), -1.0, 1.0)) * 180.0 / M_PI : -1.0;
   plane->found = plane->on_plane_share >= kMinSupportShare && CouldSupport(*plane);
   return true;
 }
@@ -101,15 +115,16 @@ Eigen::VectorXf Refined(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
 }
 
 // The plane that holds the most points among those that could be a support (at most
-// kMaxBelowShare of the points below it, kMinCamerasAbove of the cameras above it): planes
+// kMaxBelowShare of the points below it, kMinCamerasAbove of the cameras above it; level with the
+// photos' up where `level_only`): planes
 // through random triples of points (a fixed seed), scored on up to 1,000 of the points, the best
 // refined on all. Where wrong matches or an object's sides hold more points on another plane than
 // the ground holds, the ground is still the densest plane with (nearly) nothing under it.
 bool BestSupportCandidate(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
                           const Eigen::Vector3d& centre,
                           const std::vector<Eigen::Vector3d>& points,
-                          const std::vector<Eigen::Vector3d>& cameras,
-                          SupportingPlane* best) {
+                          const std::vector<Eigen::Vector3d>& cameras, const PhotosUp& up,
+                          bool level_only, SupportingPlane* best) {
   // A plane holding kMinSupportShareWithNothingBelow (0.1) of the points: a triple of them comes
   // up once in 1,000 draws, so 10,000 draws miss it with a chance of about 5e-5.
   constexpr int kDraws = 10000;
@@ -131,28 +146,32 @@ bool BestSupportCandidate(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
       continue;
     }
     SupportingPlane candidate = *best;
-    if (!MeasurePlane(coefficients, centre, scored, cameras, &candidate)) continue;
-    if (CouldSupport(candidate) && candidate.on_plane_share > best_on) {
+    if (!MeasurePlane(coefficients, centre, scored, cameras, up, &candidate)) continue;
+    if (CouldSupport(candidate) && (!level_only || candidate.Level()) &&
+        candidate.on_plane_share > best_on) {
       best_on = candidate.on_plane_share;
       best_coefficients = coefficients;
     }
   }
   if (best_on < 0.0 ||
       !MeasurePlane(Refined(model, best_coefficients, best->tolerance), centre, points, cameras,
-                    best)) {
+                    up, best)) {
     return false;
   }
-  best->found = best->on_plane_share >= kMinSupportShareWithNothingBelow && CouldSupport(*best);
+  best->found = best->on_plane_share >= kMinSupportShareWithNothingBelow && CouldSupport(*best) &&
+                (!level_only || best->Level());
   return best->found;
 }
 
 }  // namespace
 
 SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
-                                   const std::vector<Eigen::Vector3d>& cameras, double tolerance) {
+                                   const std::vector<Eigen::Vector3d>& cameras,
+                                   const PhotosUp& up, double tolerance) {
   SupportingPlane plane;
   plane.points = static_cast<int>(points.size());
   plane.tolerance = tolerance;
+  plane.photos_up = up;
   if (points.size() < 20 || !(tolerance > 0.0)) return plane;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& p : points) centre += p;
@@ -169,14 +188,26 @@ SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
   ransac.getModelCoefficients(coefficients);
   Eigen::VectorXf refined = coefficients;
   if (inliers.size() >= 3) model->optimizeModelCoefficients(inliers, coefficients, refined);
-  if (!MeasurePlane(refined, centre, points, cameras, &plane) || plane.found) return plane;
-  // The densest plane is no support (points under it, or cameras on both sides): the densest
-  // plane that could be one.
-  SupportingPlane support = plane;
-  if (BestSupportCandidate(*model, centre, points, cameras, &support)) {
+  if (!MeasurePlane(refined, centre, points, cameras, up, &plane)) return plane;
+  if (plane.found && plane.Level()) return plane;
+  // The densest plane is no support (points under it, or cameras on both sides) or not level: the
+  // densest level plane that could be one, then (where there is none) the densest support of any
+  // direction.
+  const auto passed_over = [&plane](SupportingPlane support) {
     support.densest_on_share = plane.on_plane_share;
     support.densest_below_share = plane.below_share;
+    support.densest_angle_to_photos_up = plane.angle_to_photos_up;
     return support;
+  };
+  SupportingPlane support = plane;
+  if (up.Known() &&
+      BestSupportCandidate(*model, centre, points, cameras, up, /*level_only=*/true, &support)) {
+    return passed_over(support);
+  }
+  if (plane.found) return plane;
+  support = plane;
+  if (BestSupportCandidate(*model, centre, points, cameras, up, /*level_only=*/false, &support)) {
+    return passed_over(support);
   }
   return plane;
 }

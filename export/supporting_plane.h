@@ -7,10 +7,16 @@
 
 #include <Eigen/Core>
 
+#include "calib/photos_up.h"
 #include "carve/ground.h"
 
 namespace raycarve {
 namespace exporter {
+
+// A plane within this many degrees of the photos' up is level (ground, a table). A narrow arc of
+// cameras looking down tilts their mean up towards the object (by the cameras' pitch at most);
+// a floor and a wall are 90 degrees apart.
+constexpr double kMaxLevelAngle = 45.0;
 
 struct SupportingPlane {
   bool found = false;
@@ -26,6 +32,12 @@ struct SupportingPlane {
   // plane's shares (negative otherwise).
   double densest_on_share = -1.0;
   double densest_below_share = -1.0;
+  // Degrees between the normal and the photos' up (EstimatePhotosUp); negative where the photos
+  // say nothing of up. Where the densest plane was passed over for not being level, its angle.
+  double angle_to_photos_up = -1.0;
+  double densest_angle_to_photos_up = -1.0;
+  PhotosUp photos_up;  // what the fit was given
+  bool Level() const;
   std::string Summary() const;
 };
 
@@ -45,11 +57,17 @@ constexpr double kMinSupportShareWithNothingBelow = 0.1;
 // at most kMaxBelowShare of them below it, and kMinCamerasAbove of the cameras above. Where that
 // densest plane is no support, the plane holding the most points among those with at most
 // kMaxBelowShare below and kMinCamerasAbove of the cameras above (planes through random triples,
-// a fixed seed), if it holds kMinSupportShareWithNothingBelow: wrong matches along a repeated pattern, or the
-// sides of a large object, can outnumber the ground's points on some tilted plane. Otherwise the
-// densest plane, not found. Fewer than 20 points: not found.
+// a fixed seed), if it holds kMinSupportShareWithNothingBelow: wrong matches along a repeated
+// pattern, or the sides of a large object, can outnumber the ground's points on some tilted
+// plane. Otherwise the densest plane, not found. Fewer than 20 points: not found.
+// Where the photos know up (`up.Known()`), the ground is level with it: a support within
+// kMaxLevelAngle of up is taken before one that is not (a backdrop wall behind the object, with
+// the cameras in front of it, passes every other test and can hold more points than the floor);
+// one that is not level is taken only where no level plane holds
+// kMinSupportShareWithNothingBelow.
 SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
-                                   const std::vector<Eigen::Vector3d>& cameras, double tolerance);
+                                   const std::vector<Eigen::Vector3d>& cameras,
+                                   const PhotosUp& up, double tolerance);
 
 // The ground a found support makes (empty when `plane` is not a support): the points of
 // `points` on the plane (within its tolerance) as the footprint, their convex hull as the outline,

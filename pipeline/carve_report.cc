@@ -183,8 +183,14 @@ void WriteCapture(const CarveRun& run, JsonWriter& json) {
       .Key("densest_plane_passed_over").Value(plane.densest_on_share >= 0.0);
   if (plane.densest_on_share >= 0.0) {
     json.Key("densest_plane_on_share").Value(plane.densest_on_share)
-        .Key("densest_plane_below_share").Value(plane.densest_below_share);
+        .Key("densest_plane_below_share").Value(plane.densest_below_share)
+        .Key("densest_plane_angle_to_photos_up").Value(plane.densest_angle_to_photos_up);
   }
+  json.Key("angle_to_photos_up").Value(plane.angle_to_photos_up)
+      .Key("photos_up").Value(JsonArray(plane.photos_up.up))
+      .Key("photos_up_agreement").Value(plane.photos_up.agreement)
+      .Key("photos_turned").Value(plane.photos_up.turned)
+      .Key("photos_up_known").Value(plane.photos_up.Known());
   json.Key("ground_held").Value(!run.ground.empty())
       .Key("ground").Value(run.ground_reason)
       .Key("ground_footprint_points").Value(static_cast<int64_t>(run.ground.footprint.size()))

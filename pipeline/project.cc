@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "calib/input_error.h"
+#include "calib/photos_up.h"
 #include "calib/model_reader.h"
 #include "carve/carver.h"
 #include "pipeline/output_files.h"
@@ -269,13 +270,16 @@ LoadedProject LoadProject(const ProjectRequest& request) {
     // floor or a repeated pattern, measured: docs/studies/2026-12-05-colmap-points.md), and points
     // below a plane rule it out; a third photo checks the match.
     std::vector<Eigen::Vector3d> cameras;
+    std::vector<Rigid3d> poses;
     const std::vector<Eigen::Vector3d> points =
         CheckedPoints(project.reconstruction, project.bounds.box);
     for (const auto& [id, image] : project.reconstruction.images) {
       cameras.push_back(image.ProjectionCenter());
+      poses.push_back(image.cam_from_world);
     }
     project.plane = exporter::FitSupportingPlane(
-        points, cameras, kPlaneTolerance * project.bounds.box.sizes().maxCoeff());
+        points, cameras, EstimatePhotosUp(poses),
+        kPlaneTolerance * project.bounds.box.sizes().maxCoeff());
     LOG(INFO) << "support: " << project.plane.Summary();
   }
   project.surface_points =

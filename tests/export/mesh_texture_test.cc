@@ -315,6 +315,30 @@ TEST(ViewsFromOutside, FarFromThePhotosAndFramingTheWholeMesh) {
   EXPECT_TRUE(ViewsFromOutside(TriangleMesh(), views, 3, 120, 90).empty());
 }
 
+// Middlebury's dino ring was photographed with the camera on its side: the top of every photo
+// points along the ring. The views from outside and the page's 3D view take the photos' up
+// turned back, the world's.
+TEST(PhotosUp, PhotosAllTurnedAQuarterGiveTheWorldsUp) {
+  std::vector<CalibratedView> views;
+  for (int i = 0; i < 16; ++i) {  // half a ring: the photos' tops do not cancel out
+    const double a = M_PI * i / 15.0;
+    const Eigen::Vector3d centre(3.0 * std::cos(a), 3.0 * std::sin(a), 1.5);
+    const Eigen::Vector3d forward(-std::cos(a), -std::sin(a), 0.0);  // level
+    const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+    Eigen::Matrix3d level;
+    level << right.transpose(), forward.cross(right).transpose(), forward.transpose();
+    // Turned a quarter about the optical axis: the photo's x axis is the world's up or down.
+    const Eigen::Matrix3d turned =
+        Eigen::AngleAxisd(M_PI / 2.0, Eigen::Vector3d::UnitZ()).toRotationMatrix() * level;
+    CalibratedView view;
+    view.cam_from_world.rotation = Eigen::Quaterniond(turned);
+    view.cam_from_world.translation = -turned * centre;
+    view.centre = centre;
+    views.push_back(view);
+  }
+  EXPECT_GT(PhotosUp(views).z(), 1.0 - 1e-9);
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

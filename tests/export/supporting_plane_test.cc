@@ -1,5 +1,6 @@
 // The supporting plane against scenes whose answer is known: an object on a tilted table seen
-// from above, a ball with no table, and a table seen from below.
+// from above, a ball with no table, a table seen from below, a floor under a denser slanted roof
+// and a floor in front of a denser backdrop wall.
 #include "export/supporting_plane.h"
 
 #include <cmath>
@@ -42,7 +43,7 @@ TEST(FitSupportingPlane, FindsTheTableUnderAnObjectOrientedTowardsTheCameras) {
   const Eigen::Vector3d n = Eigen::Vector3d(0.2, -0.1, 1.0).normalized();
   const Eigen::Vector3d origin(1.0, 2.0, -0.5);
   const Scene scene = TableScene(origin, n, true);
-  const SupportingPlane plane = FitSupportingPlane(scene.points, scene.cameras, 0.01);
+  const SupportingPlane plane = FitSupportingPlane(scene.points, scene.cameras, PhotosUp(), 0.01);
   ASSERT_TRUE(plane.found) << plane.Summary();
   EXPECT_GT(plane.normal.dot(n), 0.9999);
   EXPECT_NEAR(plane.normal.dot(origin) + plane.offset, 0.0, 1e-3);
@@ -56,15 +57,15 @@ TEST(FitSupportingPlane, FindsTheTableUnderAnObjectOrientedTowardsTheCameras) {
 TEST(FitSupportingPlane, ABallAloneOrATableSeenFromBelowIsNoSupport) {
   const Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
   const Scene ball = TableScene(Eigen::Vector3d::Zero(), n, false);
-  EXPECT_FALSE(FitSupportingPlane(ball.points, ball.cameras, 0.01).found);
+  EXPECT_FALSE(FitSupportingPlane(ball.points, ball.cameras, PhotosUp(), 0.01).found);
   // Cameras under the table: the plane's normal turns to them, and the ball lies below it.
   Scene under = TableScene(Eigen::Vector3d::Zero(), n, true);
   for (Eigen::Vector3d& camera : under.cameras) camera.z() = -camera.z();
-  const SupportingPlane plane = FitSupportingPlane(under.points, under.cameras, 0.01);
+  const SupportingPlane plane = FitSupportingPlane(under.points, under.cameras, PhotosUp(), 0.01);
   EXPECT_LT(plane.normal.z(), -0.999);
   EXPECT_GT(plane.below_share, 0.3);
   EXPECT_FALSE(plane.found);
-  EXPECT_FALSE(FitSupportingPlane({}, under.cameras, 0.01).found);
+  EXPECT_FALSE(FitSupportingPlane({}, under.cameras, PhotosUp(), 0.01).found);
 }
 
 TEST(GroundUnder, TheTablesPointsMakeTheGroundAndAStepDownMakesHoles) {
@@ -76,7 +77,7 @@ TEST(GroundUnder, TheTablesPointsMakeTheGroundAndAStepDownMakesHoles) {
   for (int i = 0; i < 40; ++i) {
     scene.points.push_back(origin - 0.4 * n + (3.0 + 0.01 * i) * u + 0.02 * i * n.cross(u));
   }
-  const SupportingPlane plane = FitSupportingPlane(scene.points, scene.cameras, 0.01);
+  const SupportingPlane plane = FitSupportingPlane(scene.points, scene.cameras, PhotosUp(), 0.01);
   ASSERT_TRUE(plane.found) << plane.Summary();
   const Ground ground = GroundUnder(plane, scene.points, scene.points);
   ASSERT_FALSE(ground.empty());
@@ -132,7 +133,7 @@ TEST(FitSupportingPlane, FindsTheFloorUnderADenserPlaneThatIsNoSupport) {
     const double a = 2.0 * M_PI * i / 12.0;
     cameras.emplace_back(4.0 * std::cos(a), 4.0 * std::sin(a), 5.0);
   }
-  const SupportingPlane plane = FitSupportingPlane(points, cameras, 0.01);
+  const SupportingPlane plane = FitSupportingPlane(points, cameras, PhotosUp(), 0.01);
   ASSERT_TRUE(plane.found) << plane.Summary();
   EXPECT_GT(plane.normal.z(), 0.9999);
   EXPECT_NEAR(plane.offset, 0.0, 1e-3);
@@ -146,9 +147,78 @@ TEST(FitSupportingPlane, FindsTheFloorUnderADenserPlaneThatIsNoSupport) {
   // Without the floor, nothing with the ball and the roof is a support: the roof has the ball
   // below it, and no other plane holds a tenth of the points.
   std::vector<Eigen::Vector3d> no_floor(points.begin() + 120, points.end());
-  const SupportingPlane none = FitSupportingPlane(no_floor, cameras, 0.01);
+  const SupportingPlane none = FitSupportingPlane(no_floor, cameras, PhotosUp(), 0.01);
   EXPECT_FALSE(none.found) << none.Summary();
   EXPECT_LT(none.densest_on_share, 0.0);
+}
+
+// The pose of a level camera at `centre` looking at `target` (z up), turned `quarters` quarter
+// turns about its axis (a portrait photo).
+Rigid3d LevelCamera(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, int quarters) {
+  const Eigen::Vector3d forward = (target - centre).normalized();
+  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+  Eigen::Matrix3d rotation;
+  rotation << right.transpose(), forward.cross(right).transpose(), forward.transpose();
+  rotation = Eigen::AngleAxisd(quarters * M_PI / 2.0, Eigen::Vector3d::UnitZ()) * rotation;
+  Rigid3d pose;
+  pose.rotation = Eigen::Quaterniond(rotation);
+  pose.translation = -rotation * centre;
+  return pose;
+}
+
+// Cameras at eye level on an arc in front of a backdrop wall (y = 2), an object on the floor
+// (z = 0) between them: the wall holds more points than the floor, nothing lies behind it and
+// every camera is in front of it, so without the photos' up it passes for the support. Held
+// level, the photos say the floor is level and the wall is not.
+TEST(FitSupportingPlane, TheFloorLevelWithThePhotosUpBeforeADenserBackdrop) {
+  std::mt19937_64 random(9);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Eigen::Vector3d> points, cameras;
+  for (int i = 0; i < 100; ++i) {  // the floor, in front of the wall
+    points.emplace_back(4.0 * unit(random) - 2.0, 4.0 * unit(random) - 2.0, 0.0);
+  }
+  for (int i = 0; i < 220; ++i) {  // the backdrop wall
+    points.emplace_back(4.0 * unit(random) - 2.0, 2.0, 3.0 * unit(random));
+  }
+  for (int i = 0; i < 180; ++i) {  // a box of 1 x 1 x 1 on the floor
+    const double a = unit(random), b = unit(random);
+    const int face = i % 5;
+    points.emplace_back(face == 0 ? -0.5 : face == 1 ? 0.5 : a - 0.5,
+                        face == 2 ? -0.5 : face == 3 ? 0.5 : b - 0.5,
+                        face < 2 ? b : face < 4 ? a : 1.0);
+  }
+  std::vector<Rigid3d> poses;
+  for (int i = 0; i < 9; ++i) {  // an arc of 120 degrees, 1.2 above the floor
+    const double a = -M_PI / 2.0 + (i - 4) * M_PI / 12.0;
+    cameras.emplace_back(5.0 * std::cos(a), 5.0 * std::sin(a), 1.2);
+    poses.push_back(LevelCamera(cameras.back(), {0.0, 0.0, 0.5}, i == 3 ? 1 : 0));
+  }
+  const SupportingPlane wall = FitSupportingPlane(points, cameras, PhotosUp(), 0.01);
+  ASSERT_TRUE(wall.found) << wall.Summary();
+  EXPECT_LT(wall.normal.y(), -0.9999);
+  EXPECT_LT(wall.angle_to_photos_up, 0.0);  // not known, not said
+
+  const PhotosUp up = EstimatePhotosUp(poses);
+  ASSERT_TRUE(up.Known());
+  EXPECT_EQ(up.turned, 1);  // the portrait photo
+  const SupportingPlane floor = FitSupportingPlane(points, cameras, up, 0.01);
+  ASSERT_TRUE(floor.found) << floor.Summary();
+  EXPECT_GT(floor.normal.z(), 0.9999);
+  EXPECT_NEAR(floor.offset, 0.0, 1e-3);
+  // The cameras look 8 degrees down at the box, and from an arc, not a ring: their mean up leans
+  // towards the wall by about that much.
+  EXPECT_LT(floor.angle_to_photos_up, 8.0);
+  EXPECT_NEAR(floor.densest_on_share, wall.on_plane_share, 1e-9);
+  EXPECT_NEAR(floor.densest_angle_to_photos_up, 90.0 + floor.angle_to_photos_up, 0.5);
+  EXPECT_NE(floor.Summary().find("degrees from the photos' up"), std::string::npos);
+
+  // Without the floor the wall is the support still: no level plane holds a tenth of the points.
+  std::vector<Eigen::Vector3d> no_floor(points.begin() + 100, points.end());
+  const SupportingPlane only_wall = FitSupportingPlane(no_floor, cameras, up, 0.01);
+  ASSERT_TRUE(only_wall.found) << only_wall.Summary();
+  EXPECT_LT(only_wall.normal.y(), -0.9999);
+  EXPECT_NEAR(only_wall.angle_to_photos_up, 90.0 + floor.angle_to_photos_up, 0.5);
+  EXPECT_LT(only_wall.densest_on_share, 0.0);
 }
 
 }  // namespace

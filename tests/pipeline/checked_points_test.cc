@@ -55,14 +55,15 @@ TEST(CheckedPoints, APlaneUnderWhichOnlyTwoViewPointsLieIsFound) {
   const std::vector<Eigen::Vector3d> checked = CheckedPoints(model.model(), kBox);
   EXPECT_EQ(checked.size(), 200u);
   const exporter::SupportingPlane from_checked =
-      exporter::FitSupportingPlane(checked, model.Cameras(), 0.02);
+      exporter::FitSupportingPlane(checked, model.Cameras(), PhotosUp(), 0.02);
   EXPECT_TRUE(from_checked.found) << from_checked.Summary();
   EXPECT_NEAR(std::abs(from_checked.normal.z()), 1.0, 1e-6);
 
   // The same plane fit to every point two photos saw: half of them lie below it.
   std::vector<Eigen::Vector3d> all;
   for (const auto& [id, point] : model.model().points3D) all.push_back(point.xyz);
-  const exporter::SupportingPlane from_all = exporter::FitSupportingPlane(all, model.Cameras(), 0.02);
+  const exporter::SupportingPlane from_all =
+      exporter::FitSupportingPlane(all, model.Cameras(), PhotosUp(), 0.02);
   EXPECT_FALSE(from_all.found) << from_all.Summary();
 }
 

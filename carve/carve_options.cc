@@ -69,6 +69,10 @@ bool CarveOptions::IsValid(std::string* reason) const {
     *reason = "adaptive_threshold must be a finite number >= 0";
     return false;
   }
+  if (!std::isfinite(spread_floor) || spread_floor < 0.0) {
+    *reason = "spread_floor must be a finite number >= 0";
+    return false;
+  }
   if (min_views < 1) {
     *reason = "min_views must be >= 1";
     return false;

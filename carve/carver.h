@@ -85,6 +85,12 @@ struct CarveOptions {
   // Adaptive allowance: the threshold grows by this times the voxel's within-view colour spread
   // (see ConsistencyTest); 0 holds every voxel to `threshold`.
   double adaptive_threshold = 0.0;
+  // Spread floor: the threshold is at least this times the voxel's within-view colour spread. A
+  // voxel across a texture edge takes a different share of each side in each photo, so its
+  // photos disagree by up to its spread at the true surface; a threshold taken from narrow
+  // tracks of sparse points (neighbouring photos, which agree on everything) is below that.
+  // 0: no floor.
+  double spread_floor = 0.0;
   // Views a voxel must be seen by to be judged; voxels seen by fewer stay.
   int min_views = 2;
   // A voxel is judged only when at least min_views views each see this share of its projected

@@ -1,5 +1,6 @@
 #include "carve/consistency.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace raycarve {
@@ -66,11 +67,13 @@ ConsistencyTest::ConsistencyTest(ConsistencyMethod method,
                                  double threshold,
                                  int min_views,
                                  double adaptive,
-                                 bool correct_view_count)
+                                 bool correct_view_count,
+                                 double spread_floor)
     : function_(MakeConsistencyFunction(method, correct_view_count)),
       threshold_(threshold),
       min_views_(min_views),
-      adaptive_(adaptive) {}
+      adaptive_(adaptive),
+      spread_floor_(spread_floor) {}
 
 double ConsistencyTest::WithinViewSpread(const std::vector<ViewColourStats>& views) {
   double weighted = 0.0;
@@ -101,7 +104,11 @@ Consistency ConsistencyTest::Evaluate(const std::vector<ViewColourStats>& views)
   result.judged = true;
   result.error = function_->Error(views, result.colour, result.num_pixels);
   result.threshold = threshold_;
-  if (adaptive_ != 0.0) result.threshold += adaptive_ * WithinViewSpread(views);
+  if (adaptive_ != 0.0 || spread_floor_ != 0.0) {
+    const double spread = WithinViewSpread(views);
+    result.threshold += adaptive_ * spread;
+    result.threshold = std::max(result.threshold, spread_floor_ * spread);
+  }
   result.consistent = result.error <= result.threshold;
   return result;
 }

@@ -89,19 +89,20 @@ std::unique_ptr<ConsistencyFunction> MakeConsistencyFunction(ConsistencyMethod m
                                                              bool correct_view_count = false);
 
 // Decides whether a voxel's visible pixels agree on one colour: inconsistent when the function's
-// error exceeds `threshold` + `adaptive` x the voxel's within-view spread; a voxel seen by fewer
-// than `min_views` views is not judged and stays.
+// error exceeds `threshold` + `adaptive` x the voxel's within-view spread, or `spread_floor` x
+// that spread where that is more; a voxel seen by fewer than `min_views` views is not judged and
+// stays.
 //
 // The within-view spread is the pixel-weighted mean over views of each view's RGB standard
 // deviation (the Euclidean norm of the per-channel deviations). A voxel on a texture edge shows
 // both colours within each view, so its per-view means differ with the viewpoint even on the true
 // surface; the allowance grows with that spread (Slabaugh et al.'s adaptive threshold), while a
 // voxel whose views each see one uniform but different colour (empty space in front of a
-// background) gets none.
+// background) gets none. The floor allows the same without raising a threshold already above it.
 class ConsistencyTest {
  public:
   ConsistencyTest(ConsistencyMethod method, double threshold, int min_views, double adaptive = 0.0,
-                  bool correct_view_count = false);
+                  bool correct_view_count = false, double spread_floor = 0.0);
   Consistency Evaluate(const std::vector<ViewColourStats>& views) const;
 
   // The within-view spread of `views` (RGB units; 0 without pixels).
@@ -112,6 +113,7 @@ class ConsistencyTest {
   double threshold_;
   int min_views_;
   double adaptive_;
+  double spread_floor_;
 };
 
 }  // namespace raycarve

@@ -202,6 +202,7 @@ void CarvePipeline::AgreeMasks() {
 void CarvePipeline::CheckVolume() {
   CHECK(loaded_);
   DecideGround();
+  DecideSpreadFloor();
   FindDistant();
   FindGroundPixels();
   std::string reason;
@@ -359,6 +360,7 @@ CarveResult CarvePipeline::CarveWith(CarveOptions options,
 }
 
 CarveOptions CarvePipeline::FilledOptions(CarveOptions options) const {
+  if (request_.auto_spread_floor) options.spread_floor = run_.spread_floor;
   options.surface_points = surface_points_;
   options.ground = run_.ground;
   options.distant_rays = distant_rays_;

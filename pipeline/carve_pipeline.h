@@ -78,6 +78,9 @@ struct CarveRun {
   int masks_from_backdrop = 0;
   // Automatic backdrop masks found in a minority of the photos: not used (see AgreeMasks).
   int backdrop_masks_dropped = 0;
+  // The spread floor used (CarveOptions::spread_floor) and why.
+  double spread_floor = 0.0;
+  std::string spread_floor_reason;
   std::vector<PhotoMaskInfo> mask_photos;  // per view: where its mask came from, what was found
   std::vector<std::string> view_names;     // the views carved, in carve order
   ColourCalibration colour;
@@ -197,6 +200,7 @@ class CarvePipeline {
   void RecordCarve();  // the log lines and stage times of run_.result's carve
   void DecideMasks();
   void DecideGround();  // run_.ground, once the masks are decided
+  void DecideSpreadFloor();  // run_.spread_floor, once the masks are decided
   void FindDistant();   // distant_rays_ and run_.distant, once the masks are decided
   void FindGroundPixels();  // appends to distant_rays_, run_.ground_pixels, once the ground is
   void RecordSeconds(const std::string& stage, double seconds);

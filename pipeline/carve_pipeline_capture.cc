@@ -14,6 +14,30 @@
 
 namespace raycarve {
 
+void CarvePipeline::DecideSpreadFloor() {
+  run_.spread_floor = request_.options.spread_floor;
+  if (!request_.auto_spread_floor) {
+    run_.spread_floor_reason = "as given";
+  } else if (!request_.options.auto_threshold) {
+    run_.spread_floor_reason = "none: --threshold given";
+  } else if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
+    run_.spread_floor_reason = "none: masks (their threshold keeps the surface)";
+  } else if (request_.bounds.capture == "scene" ||
+             (request_.bounds.capture == "auto" && !run_.layout.object_centred)) {
+    run_.spread_floor_reason = "none: a scene (seen from one side)";
+  } else {
+    // The threshold comes from the sparse points' tracks, neighbouring photos that agree on
+    // everything; the photos around the object that judge a voxel across a texture edge disagree
+    // by up to its spread at the true surface.
+    run_.spread_floor = kAutoSpreadFloor;
+    run_.spread_floor_reason = "an object without masks (cameras around it)";
+  }
+  if (request_.auto_spread_floor) {
+    LOG(INFO) << "spread floor: the threshold at least " << run_.spread_floor
+              << " x each voxel's within-view colour spread (" << run_.spread_floor_reason << ")";
+  }
+}
+
 void CarvePipeline::DecideGround() {
   run_.ground = Ground();
   if (!run_.plane.found) {

@@ -28,6 +28,8 @@ void WriteOptions(const CarveRequest& request, const CarveRun& run, JsonWriter& 
       .Key("floater_expected_points").Value(request.options.unsupported_component_points)
       .Key("repair_silhouettes").Value(request.options.repair_silhouettes)
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
+      .Key("spread_floor").Value(run.spread_floor)
+      .Key("spread_floor_reason").Value(run.spread_floor_reason)
       .Key("min_views").Value(request.options.min_views)
       .Key("min_coverage").Value(request.options.min_coverage)
       .Key("order").Value(CarveOrderToString(request.options.order))

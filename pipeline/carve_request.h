@@ -23,6 +23,10 @@ constexpr double kFallbackPatternThreshold = 0.5;
 constexpr int kDefaultMaxImageSize = 2400;
 // --free_space_margin (voxels short of the point where a sight line stops).
 constexpr double kDefaultFreeSpaceMarginVoxels = 2.0;
+// --spread_floor auto on an object capture without masks: the threshold is at least one
+// within-view spread (CarveOptions::spread_floor). Measured:
+// docs/studies/2026-12-06-spread-floor.md.
+constexpr double kAutoSpreadFloor = 1.0;
 // --floater_expected_points: a piece with no sparse point goes where three were expected (a
 // Poisson count of mean 3 is 0 one time in 20).
 constexpr double kDefaultFloaterExpectedPoints = 3.0;
@@ -83,6 +87,10 @@ struct CarveRequest {
   // empty space, and their rays are carved before colouring down to kGroundClearanceVoxels
   // above the plane's tolerance.
   bool ground_free_space = true;
+  // options.spread_floor chosen for the capture (--spread_floor auto): with --threshold auto, an
+  // object capture without masks (cameras around it) holds each voxel to at least
+  // kAutoSpreadFloor times its within-view colour spread (CarvePipeline::DecideSpreadFloor).
+  bool auto_spread_floor = true;
   // A grid whose voxels span fewer pixels of the photos than this (median at the volume's
   // centre) is refused before the work: there the photos cannot tell a voxel from its
   // neighbours, rays pass between voxels that are never judged, and the carve degrades (the

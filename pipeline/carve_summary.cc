@@ -235,7 +235,13 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
   for (const ColouredVoxel& voxel : run.result->surface) {
     judged_voxels += voxel.num_views >= request.options.min_views;
   }
-  const std::string level_line = LevelsText(request, s);
+  std::string level_line = LevelsText(request, s);
+  if (run.spread_floor > 0.0) {
+    char floor[64];
+    std::snprintf(floor, sizeof(floor), "; at least %.3g x a voxel's within-view spread",
+                  run.spread_floor);
+    level_line += floor;
+  }
   std::string floater_text;
   if (s.unsupported_components > 0) {
     floater_text = ", " + std::to_string(s.unsupported_component_carved) + " in " +

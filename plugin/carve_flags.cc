@@ -109,6 +109,12 @@ void AddCarvingFlags(OptionParser* parser, CarveRequest* request, CarveFlagText*
   parser->AddDefault("adaptive_threshold", &request->options.adaptive_threshold,
                      "raise the threshold by this times the voxel's within-view colour spread "
                      "(texture edges); 0: a fixed threshold");
+  parser->AddDefault("spread_floor", &text->spread_floor,
+                     "hold the threshold to at least this times the voxel's within-view colour "
+                     "spread (a voxel across a texture edge: its photos disagree by up to that at "
+                     "the true surface); 0: no floor; auto: " + Number(kAutoSpreadFloor) +
+                         " with --threshold auto on an object capture without masks (cameras "
+                         "around it), else 0");
   parser->AddDefault("min_views", &request->options.min_views,
                      "views a voxel must be seen by to be judged");
   parser->AddDefault("min_coverage", &request->options.min_coverage,
@@ -330,6 +336,20 @@ void ApplyCarveFlags(const OptionParser& parser, const CarveFlagText& text, Carv
     }
     request->options.auto_threshold = false;
     request->options.threshold = value;
+  }
+  if (text.spread_floor == "auto") {
+    request->auto_spread_floor = true;
+    request->options.spread_floor = 0.0;
+  } else {
+    char* end = nullptr;
+    const double value = std::strtod(text.spread_floor.c_str(), &end);
+    if (text.spread_floor.empty() || end == nullptr || *end != '\0' || !std::isfinite(value) ||
+        value < 0.0) {
+      throw InputError("--spread_floor: must be a finite number >= 0 or auto, got '" +
+                       text.spread_floor + "'");
+    }
+    request->auto_spread_floor = false;
+    request->options.spread_floor = value;
   }
   ConsistencyMethodFromString(text.consistency, &request->options.consistency);
   VisLookupFromString(text.vis_lookup, &request->options.vis_lookup);

@@ -36,6 +36,7 @@ struct CarveFlagText {
   std::string order;
   std::string decision;
   std::string background = "auto";
+  std::string spread_floor = "auto";
 };
 void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* text);
 // `parser` (after Parse) says which flags were given: a --resolution not given may be lowered to

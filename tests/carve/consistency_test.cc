@@ -108,5 +108,40 @@ TEST(ConsistencyTest, VoxelsSeenByFewerThanMinViewsAreKeptUnjudged) {
   EXPECT_FALSE(ConsistencyMethodFromString("median", &method));
 }
 
+// A voxel across a black-and-white edge: each view sees both colours, in different shares, so
+// their means disagree although it is the true surface. The spread floor holds the threshold to at
+// least the views' own spread; a threshold already above it is left as it is, and a voxel whose
+// views each see one plain colour gets no floor.
+TEST(ConsistencyTest, TheSpreadFloorRaisesALowThresholdToTheVoxelsWithinViewSpread) {
+  const Eigen::Vector3d black(0, 0, 0), white(255, 255, 255);
+  const std::vector<ViewColourStats> edge = {View(0, {black, white, white, white}),
+                                             View(1, {black, black, black, white})};
+  const double spread = ConsistencyTest::WithinViewSpread(edge);
+  // Each view: 255 sqrt(3/16) a channel, over three channels.
+  EXPECT_NEAR(spread, 3.0 * 255.0 / 4.0, 1e-9);
+  const Consistency low = ConsistencyTest(ConsistencyMethod::kMeanColour, 5.0, 2).Evaluate(edge);
+  EXPECT_FALSE(low.consistent);
+  EXPECT_LT(low.error, spread);
+  const Consistency floored =
+      ConsistencyTest(ConsistencyMethod::kMeanColour, 5.0, 2, 0.0, false, 1.0).Evaluate(edge);
+  EXPECT_TRUE(floored.consistent);
+  EXPECT_DOUBLE_EQ(floored.threshold, spread);
+  EXPECT_DOUBLE_EQ(floored.error, low.error);
+  // Above the spread: the threshold as it is (where the adaptive allowance would add to it).
+  EXPECT_DOUBLE_EQ(ConsistencyTest(ConsistencyMethod::kMeanColour, 400.0, 2, 0.0, false, 1.0)
+                       .Evaluate(edge)
+                       .threshold,
+                   400.0);
+  EXPECT_DOUBLE_EQ(
+      ConsistencyTest(ConsistencyMethod::kMeanColour, 400.0, 2, 1.0).Evaluate(edge).threshold,
+      400.0 + spread);
+  // Plain views of different colours (empty space in front of a background): no spread, no floor.
+  const std::vector<ViewColourStats> plain = {View(0, {black, black}), View(1, {white, white})};
+  const Consistency apart =
+      ConsistencyTest(ConsistencyMethod::kMeanColour, 5.0, 2, 0.0, false, 1.0).Evaluate(plain);
+  EXPECT_DOUBLE_EQ(apart.threshold, 5.0);
+  EXPECT_FALSE(apart.consistent);
+}
+
 }  // namespace
 }  // namespace raycarve

@@ -256,6 +256,8 @@ TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
   ExpectUserError(base + " --mesh_max_faces 2", {"--mesh_", "face budget"});
   ExpectUserError(base + " --cloud_min_views 0", {"--cloud_min_views", "must be >= 1", "got 0"});
   ExpectUserError(base + " --pattern_threshold 3", {"--pattern_threshold", "[0, 2]", "'3'"});
+  ExpectUserError(base + " --spread_floor -1", {"--spread_floor", "number >= 0 or auto", "'-1'"});
+  ExpectUserError(base + " --spread_floor inf", {"--spread_floor", "'inf'"});
   ExpectUserError(base + " --consistency median", {"not one of: mean_colour, standard_deviation"});
   ExpectUserError(base + " --method zbuffer", {"not one of: ray, gvc, gvc_ldi"});
 

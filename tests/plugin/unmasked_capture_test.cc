@@ -85,12 +85,18 @@ TEST(UnmaskedCapture, TheSubjectIsCarvedInItsOwnBoxWithoutTheBoxsWalls) {
       << report.substr(report.find("\"supporting_plane\""), 200);
   EXPECT_GT(JsonNumber(report, "on_plane_share"), 0.2);
   EXPECT_NE(output.find("a supporting plane: normal"), std::string::npos) << output;
+  // Cameras around the subject, no masks: the threshold is at least a voxel's spread.
+  EXPECT_EQ(JsonNumber(report, "spread_floor"), 1.0);
+  EXPECT_NE(report.find("\"spread_floor_reason\": \"an object without masks"),
+            std::string::npos);
+  EXPECT_NE(output.find("at least 1 x a voxel's within-view spread"), std::string::npos)
+      << output;
   // The cloud against the truth (the objects, the ground square and the room's floor) inside the
   // volume, at two voxels (measured: F-score 99.0%).
   EXPECT_GT(FScoreInVolume(root, report), 0.88);
   // Held out, scored inside the truth's silhouettes and against the photos' sparse points: the
-  // colour test against no colour test (measured: 24.01 against 16.64 dB; 93.7% of the sparse
-  // points at their depth and 3.6% hidden, against 59.7% and 39.5%: the ground pixels' free
+  // colour test against no colour test (measured: 23.96 against 16.64 dB; 94.0% of the sparse
+  // points at their depth and 3.4% hidden, against 59.7% and 39.5%: the ground pixels' free
   // space, which colour off keeps, opens the floor's surroundings to it too).
   const std::string defaults = HeldOut(root, "defaults", "");
   const std::string colour_off = HeldOut(root, "colour_off", " --threshold 1000000");
@@ -175,6 +181,10 @@ TEST(UnmaskedCapture, ForwardFacingPhotosAreASceneBoxedToTheDepthTheyPlace) {
   const std::string report = testing::ReadFileBytes(root + "/raycarve/report.json");
   EXPECT_NE(report.find("\"kind\": \"scene\""), std::string::npos);
   EXPECT_NE(report.find("\"around_focus\": false"), std::string::npos);
+  // Seen from one side: no spread floor.
+  EXPECT_EQ(JsonNumber(report, "spread_floor"), 0.0);
+  EXPECT_NE(report.find("\"spread_floor_reason\": \"none: a scene"), std::string::npos);
+  EXPECT_EQ(output.find("x a voxel's within-view spread"), std::string::npos) << output;
   const double tried = JsonNumber(report, "depth_tried_points");
   const double resolved = JsonNumber(report, "depth_resolved_points");
   EXPECT_GT(tried, 400);

@@ -30,7 +30,7 @@ void CarvePipeline::DecideSpreadFloor() {
     // everything; the photos around the object that judge a voxel across a texture edge disagree
     // by up to its spread at the true surface.
     run_.spread_floor = kAutoSpreadFloor;
-    run_.spread_floor_reason = "an object without masks (cameras around it)";
+    run_.spread_floor_reason = "an object without masks, cameras around it";
   }
   if (request_.auto_spread_floor) {
     LOG(INFO) << "spread floor: the threshold at least " << run_.spread_floor

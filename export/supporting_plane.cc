@@ -114,17 +114,20 @@ Eigen::VectorXf Refined(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
   return refined;
 }
 
-// The plane that holds the most points among those that could be a support (at most
-// kMaxBelowShare of the points below it, kMinCamerasAbove of the cameras above it; level with the
-// photos' up where `level_only`): planes
-// through random triples of points (a fixed seed), scored on up to 1,000 of the points, the best
-// refined on all. Where wrong matches or an object's sides hold more points on another plane than
-// the ground holds, the ground is still the densest plane with (nearly) nothing under it.
-bool BestSupportCandidate(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
-                          const Eigen::Vector3d& centre,
-                          const std::vector<Eigen::Vector3d>& points,
-                          const std::vector<Eigen::Vector3d>& cameras, const PhotosUp& up,
-                          bool level_only, SupportingPlane* best) {
+// The planes that could be a support (at most kMaxBelowShare of the points below it,
+// kMinCamerasAbove of the cameras above it) holding the most points: of any direction, and level
+// with the photos' up (Level: any where the photos do not know up). Planes through random triples
+// of points (a fixed seed), scored on up to 1,000 of the points; empty coefficients where none
+// could. Where wrong matches or an object's sides hold more points on another plane than the
+// ground holds, the ground is still the densest plane with (nearly) nothing under it.
+struct SupportCandidates {
+  Eigen::VectorXf any, level;
+};
+SupportCandidates DrawSupportCandidates(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
+                                        const Eigen::Vector3d& centre,
+                                        const std::vector<Eigen::Vector3d>& points,
+                                        const std::vector<Eigen::Vector3d>& cameras,
+                                        const PhotosUp& up, const SupportingPlane& measure) {
   // A plane holding kMinSupportShareWithNothingBelow (0.1) of the points: a triple of them comes
   // up once in 1,000 draws, so 10,000 draws miss it with a chance of about 5e-5.
   constexpr int kDraws = 10000;
@@ -136,8 +139,8 @@ bool BestSupportCandidate(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
     scored.resize(kScoredPoints);
   }
   std::uniform_int_distribution<int> pick(0, static_cast<int>(points.size()) - 1);
-  double best_on = -1.0;
-  Eigen::VectorXf best_coefficients;
+  double best_any = -1.0, best_level = -1.0;
+  SupportCandidates best;
   for (int draw = 0; draw < kDraws; ++draw) {
     const pcl::Indices sample = {pick(random), pick(random), pick(random)};
     Eigen::VectorXf coefficients;
@@ -145,22 +148,38 @@ bool BestSupportCandidate(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
         !model.computeModelCoefficients(sample, coefficients)) {
       continue;
     }
-    SupportingPlane candidate = *best;
-    if (!MeasurePlane(coefficients, centre, scored, cameras, up, &candidate)) continue;
-    if (CouldSupport(candidate) && (!level_only || candidate.Level()) &&
-        candidate.on_plane_share > best_on) {
-      best_on = candidate.on_plane_share;
-      best_coefficients = coefficients;
+    SupportingPlane candidate = measure;
+    if (!MeasurePlane(coefficients, centre, scored, cameras, up, &candidate) ||
+        !CouldSupport(candidate)) {
+      continue;
+    }
+    if (candidate.on_plane_share > best_any) {
+      best_any = candidate.on_plane_share;
+      best.any = coefficients;
+    }
+    if (candidate.Level() && candidate.on_plane_share > best_level) {
+      best_level = candidate.on_plane_share;
+      best.level = coefficients;
     }
   }
-  if (best_on < 0.0 ||
-      !MeasurePlane(Refined(model, best_coefficients, best->tolerance), centre, points, cameras,
-                    up, best)) {
+  return best;
+}
+
+// A candidate's plane refined on all the points and measured into *plane: whether it is a support
+// with nothing below it (kMinSupportShareWithNothingBelow on it; level where `level_only`).
+bool AcceptCandidate(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
+                     const Eigen::VectorXf& coefficients, const Eigen::Vector3d& centre,
+                     const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector3d>& cameras, const PhotosUp& up,
+                     bool level_only, SupportingPlane* plane) {
+  if (coefficients.size() == 0 ||
+      !MeasurePlane(Refined(model, coefficients, plane->tolerance), centre, points, cameras, up,
+                    plane)) {
     return false;
   }
-  best->found = best->on_plane_share >= kMinSupportShareWithNothingBelow && CouldSupport(*best) &&
-                (!level_only || best->Level());
-  return best->found;
+  plane->found = plane->on_plane_share >= kMinSupportShareWithNothingBelow &&
+                 CouldSupport(*plane) && (!level_only || plane->Level());
+  return plane->found;
 }
 
 }  // namespace
@@ -199,14 +218,17 @@ SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
     support.densest_angle_to_photos_up = plane.angle_to_photos_up;
     return support;
   };
+  const SupportCandidates candidates =
+      DrawSupportCandidates(*model, centre, points, cameras, up, plane);
   SupportingPlane support = plane;
-  if (up.Known() &&
-      BestSupportCandidate(*model, centre, points, cameras, up, /*level_only=*/true, &support)) {
+  if (up.Known() && AcceptCandidate(*model, candidates.level, centre, points, cameras, up,
+                                    /*level_only=*/true, &support)) {
     return passed_over(support);
   }
   if (plane.found) return plane;
   support = plane;
-  if (BestSupportCandidate(*model, centre, points, cameras, up, /*level_only=*/false, &support)) {
+  if (AcceptCandidate(*model, candidates.any, centre, points, cameras, up, /*level_only=*/false,
+                      &support)) {
     return passed_over(support);
   }
   return plane;

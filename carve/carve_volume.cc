@@ -83,7 +83,8 @@ void ChooseLevelThresholds(const std::vector<CalibratedView>& level_views,
                            int enlarge,
                            const CarveOptions& options,
                            CarveOptions* level_options,
-                           LevelStatistics* level_statistics) {
+                           LevelStatistics* level_statistics,
+                           const Volume* seen_through = nullptr) {
   const bool auto_pattern = options.consistency == ConsistencyMethod::kPatchCorrelation &&
                             (options.auto_threshold || options.auto_pattern_threshold);
   if (!options.auto_threshold && !auto_pattern) return;
@@ -96,6 +97,7 @@ void ChooseLevelThresholds(const std::vector<CalibratedView>& level_views,
   rule.quantile = options.auto_threshold_quantile;
   rule.fallback = level_options->threshold;
   rule.pattern_fallback = options.pattern_threshold;
+  rule.seen_through = seen_through;
   const int resolution = std::max(1, level_resolution / enlarge);
   if (enlarge > 1) level_statistics->threshold_resolution = resolution;
   level_statistics->estimate = EstimateThreshold(enlarge > 1 ? photos : level_views,
@@ -105,6 +107,29 @@ void ChooseLevelThresholds(const std::vector<CalibratedView>& level_views,
       level_statistics->estimate.points_judged >= kMinThresholdPoints;
   if (options.auto_threshold) level_options->threshold = level_statistics->estimate.threshold;
   if (auto_pattern) level_options->pattern_threshold = level_statistics->estimate.pattern_threshold;
+}
+
+// Whether the thresholds are measured through a first pass (CarveOptions::threshold_seen_views).
+bool MeasuresThroughFirstPass(const std::vector<CalibratedView>& views, const CarveOptions& options) {
+  return options.threshold_seen_views && options.auto_threshold &&
+         std::none_of(views.begin(), views.end(),
+                      [](const CalibratedView& view) { return !view.mask.empty(); });
+}
+
+// The first level carved at the thresholds its sparse points' tracks give (`level_options`),
+// the volume the levels' thresholds are then measured through; its threshold and time into
+// *level_statistics.
+std::unique_ptr<Volume> FirstPass(const std::vector<CalibratedView>& level_views,
+                                  const Eigen::AlignedBox3d& box,
+                                  const CarveOptions& level_options,
+                                  LevelStatistics* level_statistics) {
+  const Clock::time_point start = Clock::now();
+  IncrementalCarver pass(level_views, box, level_options);
+  while (pass.Step()) {
+  }
+  level_statistics->first_pass_threshold = level_options.threshold;
+  level_statistics->first_pass_seconds = SecondsSince(start);
+  return std::make_unique<Volume>(pass.volume());
 }
 
 // The final level: specks left in empty space go, then pieces without the sparse points their
@@ -365,6 +390,8 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
   std::unique_ptr<IncrementalCarver> carver;
   std::vector<CalibratedView> scaled_views;  // a level's photos, when reduced or enlarged
   const int supersample = FinalSupersample(views, box, options);
+  // The first level's first pass (CarveOptions::threshold_seen_views).
+  std::unique_ptr<Volume> seen_through;
   // Only where the threshold comes from the same corrected errors: a --threshold given as a
   // number is on the seed paper's scale.
   const bool correct_view_count =
@@ -398,7 +425,14 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
       level_statistics.threshold_given = true;
     } else {
       ChooseLevelThresholds(level_views, photos, box, resolutions[level], image_scale.enlarge,
-                            options, &level_options, &level_statistics);
+                            options, &level_options, &level_statistics, seen_through.get());
+      if (level == 0 && MeasuresThroughFirstPass(views, options)) {
+        seen_through = FirstPass(level_views, box, level_options, &level_statistics);
+        level_options.threshold = LevelOptions(options, resolutions[level], level, num_levels,
+                                               correct_view_count).threshold;
+        ChooseLevelThresholds(level_views, photos, box, resolutions[level], image_scale.enlarge,
+                              options, &level_options, &level_statistics, seen_through.get());
+      }
     }
     if (final_level && !stages.final_visual_hull) level_options.visual_hull = false;
     if (level == 0) {
@@ -427,6 +461,7 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
     statistics.levels.push_back(level_statistics);
     if (level < last_level || !stages.finish) AddWorkerTimes(*carver, &statistics);
   }
+  if (stages.seen_through_out != nullptr) *stages.seen_through_out = std::move(seen_through);
   if (stages.finish) RepairSilhouettesAndRecolour(views, options, &carver, &statistics);
   return FinishLevels(stages, last_level, num_levels, progress, clock, carver.get(),
                       std::move(statistics));
@@ -443,6 +478,7 @@ CarveResult CarveVolume(const std::vector<CalibratedView>& views,
 void FinalLevelThresholds(const std::vector<CalibratedView>& views,
                           const Eigen::AlignedBox3d& box,
                           const CarveOptions& options,
+                          const Volume* seen_through,
                           double* threshold,
                           double* pattern_threshold) {
   CarveOptions level_options = options;
@@ -452,7 +488,8 @@ void FinalLevelThresholds(const std::vector<CalibratedView>& views,
                    [](const CalibratedView& view) { return !view.mask.empty(); });
   LevelStatistics ignored;
   ChooseLevelThresholds(views, views, box, options.resolution,
-                        FinalSupersample(views, box, options), options, &level_options, &ignored);
+                        FinalSupersample(views, box, options), options, &level_options, &ignored,
+                        MeasuresThroughFirstPass(views, options) ? seen_through : nullptr);
   *threshold = level_options.threshold;
   *pattern_threshold = level_options.pattern_threshold;
 }

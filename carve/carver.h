@@ -91,6 +91,14 @@ struct CarveOptions {
   // tracks of sparse points (neighbouring photos, which agree on everything) is below that.
   // 0: no floor.
   double spread_floor = 0.0;
+  // With auto_threshold and no masks: each sparse point's voxel (and the voxel in front of it) is
+  // judged, to measure the threshold, from every photo that sees it through a first carve of the
+  // coarsest level at the tracks' threshold, not only from the photos of its track
+  // (ThresholdRule::seen_through). A SIFT track is a few neighbouring photos that agree on the
+  // surface and on the space just in front of it alike; the carve judges a voxel from every photo
+  // that sees it. The first carve (too much carved at the tracks' low threshold) lets a photo
+  // see a point more often than the final volume would: the threshold errs high, and keeps.
+  bool threshold_seen_views = false;
   // Views a voxel must be seen by to be judged; voxels seen by fewer stay.
   int min_views = 2;
   // A voxel is judged only when at least min_views views each see this share of its projected

@@ -45,6 +45,10 @@ struct CarveStages {
   double final_threshold = 0.0;
   double final_pattern_threshold = 0.0;
   bool final_visual_hull = true;  // off: the final level carves no visual hull
+  // Where set, receives the volume the levels' thresholds were measured through (the first
+  // level's first pass: CarveOptions::threshold_seen_views; null without one), for
+  // FinalLevelThresholds.
+  std::unique_ptr<Volume>* seen_through_out = nullptr;
   // After the last level: the final level's removal of components, silhouette repair and
   // colouring (off: the result's surface is left empty).
   bool finish = true;
@@ -58,10 +62,12 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
                         double progress_interval_seconds);
 
 // The thresholds the final level of a carve of `views` with `options` judges with (estimated from
-// the sparse points where options ask for it; otherwise options' own).
+// the sparse points where options ask for it, through `seen_through` where
+// CarveOptions::threshold_seen_views asks; otherwise options' own).
 void FinalLevelThresholds(const std::vector<CalibratedView>& views,
                           const Eigen::AlignedBox3d& box,
                           const CarveOptions& options,
+                          const Volume* seen_through,
                           double* threshold,
                           double* pattern_threshold);
 

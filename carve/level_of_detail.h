@@ -31,6 +31,10 @@ struct LevelStatistics {
   // The threshold was estimated before, over the whole volume, and given (a carve in tiles:
   // carve/tiling.h); `estimate` is then empty.
   bool threshold_given = false;
+  // CarveOptions::threshold_seen_views, the first level: the threshold its first pass carved
+  // with (from the tracks) and the pass's time; 0 where no first pass ran.
+  double first_pass_threshold = 0.0;
+  double first_pass_seconds = 0.0;
   int64_t protected_kept = 0;  // evaluations that kept a protected voxel found inconsistent
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   int64_t start_solid = 0;  // solid voxels when the level began (after refinement and hull)

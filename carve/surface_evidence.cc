@@ -56,7 +56,14 @@ std::string ThresholdEstimate::Summary() const {
   text << std::fixed << std::setprecision(1) << "threshold " << threshold << " ("
        << (masked ? "their 99% quantile: masks" : "weighted equal error: no masks") << ") from "
        << points_judged << " of " << points_in_grid
-       << " surface points: surface voxels' error median " << Quantile(surface_errors, 0.5)
+       << " surface points";
+  if (views_judged > track_views && points_in_grid > 0) {
+    text << " (judged from the " << std::setprecision(1)
+         << static_cast<double>(views_judged) / points_in_grid
+         << " photos a point that see it, tracks "
+         << static_cast<double>(track_views) / points_in_grid << ")";
+  }
+  text << ": surface voxels' error median " << Quantile(surface_errors, 0.5)
        << ", 90% " << Quantile(surface_errors, 0.9) << ", 95% " << Quantile(surface_errors, 0.95)
        << ", 99% " << Quantile(surface_errors, 0.99) << "; voxels " << kFrontOffsetVoxels
        << " in front: median " << Quantile(front_errors, 0.5) << ", "
@@ -92,6 +99,40 @@ void GatherVoxelPixels(const CalibratedView& view,
   }
 }
 
+std::vector<int> SeenThrough(const std::vector<CalibratedView>& views,
+                             const Volume& volume,
+                             const Eigen::Vector3d& point,
+                             double margin,
+                             const std::vector<int>& track) {
+  const VoxelGrid& grid = volume.grid();
+  const Eigen::AlignedBox3d box = grid.Box();
+  const double step = 0.5 * grid.voxel_size();
+  std::vector<int> seen(track);
+  for (int v = 0; v < static_cast<int>(views.size()); ++v) {
+    if (std::find(track.begin(), track.end(), v) != track.end()) continue;
+    const CalibratedView& view = views[v];
+    if (view.Depth(point) <= 0.0) continue;
+    const Eigen::Vector2d pixel = view.Project(point);
+    if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < view.width &&
+          pixel.y() < view.height)) {
+      continue;
+    }
+    const Eigen::Vector3d offset = point - view.centre;
+    const double distance = offset.norm();
+    const Eigen::Vector3d direction = offset / distance;
+    double t_near = 0.0, t_far = 0.0;
+    bool blocked = false;
+    if (ClipRayToBox(view.centre, direction, box, &t_near, &t_far)) {
+      const double t_end = std::min(t_far, distance - margin);
+      for (double t = t_near + 0.5 * step; t < t_end && !blocked; t += step) {
+        blocked = volume.IsSolid(grid.VoxelOf(view.centre + t * direction));
+      }
+    }
+    if (!blocked) seen.push_back(v);
+  }
+  return seen;
+}
+
 namespace {
 
 // Each point's voxel's error, and that of the voxel kFrontOffsetVoxels in front of it (towards
@@ -102,6 +143,7 @@ void MeasurePointErrors(const std::vector<CalibratedView>& views,
                         ConsistencyMethod test_method,
                         int min_views,
                         bool correct_view_count,
+                        const Volume* seen_through,
                         ThresholdEstimate* estimate_out) {
   ThresholdEstimate& estimate = *estimate_out;
   const ConsistencyTest test(test_method, 0.0, min_views, 0.0, correct_view_count);
@@ -109,9 +151,16 @@ void MeasurePointErrors(const std::vector<CalibratedView>& views,
   // The error of `voxel` judged from `point`'s views, or a negative value when not judged.
   const bool patterns = test_method == ConsistencyMethod::kPatchCorrelation;
   double pattern_error = -1.0;  // of the last voxel error_of judged
-  auto error_of = [&](const Eigen::Vector3i& voxel, const SurfacePoint& point) {
+  // Solid voxels this near the point may be the thickness a coarser volume keeps in front of it.
+  const double margin =
+      seen_through == nullptr
+          ? 0.0
+          : (ThresholdEstimate::kFrontOffsetVoxels + 1.0) * grid.voxel_size() +
+                seen_through->grid().voxel_size();
+  std::vector<int> point_views;
+  auto error_of = [&](const Eigen::Vector3i& voxel) {
     stats.clear();
-    for (int v : point.views) {
+    for (int v : point_views) {
       ViewColourStats view_stats;
       view_stats.view = v;
       GatherVoxelPixels(views[v], grid, voxel, &view_stats);
@@ -130,7 +179,12 @@ void MeasurePointErrors(const std::vector<CalibratedView>& views,
     const Eigen::Vector3i voxel = grid.VoxelOf(point.xyz);
     if (!grid.Contains(voxel) || static_cast<int>(point.views.size()) < min_views) continue;
     ++estimate.points_in_grid;
-    const double surface = error_of(voxel, point);
+    point_views = seen_through == nullptr
+                      ? point.views
+                      : SeenThrough(views, *seen_through, point.xyz, margin, point.views);
+    estimate.views_judged += point_views.size();
+    estimate.track_views += point.views.size();
+    const double surface = error_of(voxel);
     if (surface < 0.0) continue;
     ++estimate.points_judged;
     estimate.surface_errors.push_back(surface);
@@ -141,7 +195,7 @@ void MeasurePointErrors(const std::vector<CalibratedView>& views,
     const Eigen::Vector3i front = grid.VoxelOf(
         point.xyz + towards.normalized() * ThresholdEstimate::kFrontOffsetVoxels * grid.voxel_size());
     if (!grid.Contains(front) || front == voxel) continue;
-    const double front_error = error_of(front, point);
+    const double front_error = error_of(front);
     if (front_error < 0.0) continue;
     if (surface <= ThresholdEstimate::kNoEvidence && front_error <= ThresholdEstimate::kNoEvidence) {
       ++estimate.uninformative;
@@ -170,7 +224,7 @@ ThresholdEstimate EstimateThreshold(const std::vector<CalibratedView>& views,
   estimate.quantile = quantile;
   const bool patterns = test_method == ConsistencyMethod::kPatchCorrelation;
   MeasurePointErrors(views, grid, points, test_method, rule.min_views, rule.correct_view_count,
-                     &estimate);
+                     masked ? nullptr : rule.seen_through, &estimate);
   estimate.masked = masked;
   auto choose = [&](const std::vector<double>& surface, const std::vector<double>& front) {
     return masked || front.empty() ? ThresholdEstimate::Quantile(surface, quantile)

@@ -9,6 +9,7 @@
 
 #include "calib/calibrated_view.h"
 #include "carve/consistency.h"
+#include "carve/volume.h"
 #include "carve/voxel_grid.h"
 
 namespace raycarve {
@@ -44,6 +45,10 @@ struct ThresholdEstimate {
   int points_in_grid = 0;  // surface points inside the grid with at least min_views views
   int points_judged = 0;   // of them, those whose voxel had pixels in at least min_views views
   int uninformative = 0;   // of them, those whose surface and front errors are both <= kNoEvidence
+  // Summed over the points in the grid: the views each was judged from, and its track's views
+  // (more judged than in the tracks where ThresholdRule::seen_through widened them).
+  int64_t views_judged = 0;
+  int64_t track_views = 0;
   std::vector<double> surface_errors;  // sorted ascending
   std::vector<double> front_errors;    // sorted ascending (voxels inside the grid only)
   double quantile = 0.0;   // the share of surface voxels the threshold keeps
@@ -84,7 +89,22 @@ struct ThresholdRule {
   double fallback = 0.0;          // the threshold when too few points can be judged
   double pattern_fallback = 0.0;  // likewise the pattern threshold
   int min_points = kMinThresholdPoints;
+  // Without masks, when set: each point is judged from every view that sees it through this
+  // volume (a carve of the same space: a coarser level's, or a first pass of the same level),
+  // not only from its track. A SIFT track is the few neighbouring photos that matched the
+  // point; the carve judges a voxel from every photo that sees it, so a threshold measured on the
+  // tracks alone is measured on easier evidence than the carve meets (see SeenThrough).
+  const Volume* seen_through = nullptr;
 };
+
+// The views (indices into `views`) from whose centre the segment to `point` passes no solid
+// voxel of `volume` farther than `margin` (world units) from the point, with the point in front
+// of the view and inside its frame, together with `track` (views known to see it).
+std::vector<int> SeenThrough(const std::vector<CalibratedView>& views,
+                             const Volume& volume,
+                             const Eigen::Vector3d& point,
+                             double margin,
+                             const std::vector<int>& track);
 
 // Measures the errors of rule.test_method at `grid` over `points` (see ThresholdEstimate) and
 // chooses the threshold (likewise the pattern threshold, from the textured voxels):

@@ -134,12 +134,14 @@ CoarseCarve CarveCoarseLevels(const std::vector<CalibratedView>& views,
   CarveStages stages;
   stages.last_level = num_levels - 2;
   stages.finish = false;
+  std::unique_ptr<Volume> seen_through;
+  stages.seen_through_out = &seen_through;
   CarveResult levels = CarveLevels(views, box, options, std::move(stages), progress,
                                    progress_interval_seconds);
   CoarseCarve result(levels.volume.grid());
   result.volume = std::move(levels.volume);
   result.statistics = std::move(levels.statistics);
-  FinalLevelThresholds(views, box, options, &result.final_threshold,
+  FinalLevelThresholds(views, box, options, seen_through.get(), &result.final_threshold,
                        &result.final_pattern_threshold);
   return result;
 }

@@ -58,6 +58,15 @@ void LogSurfacePointUses(const CarveOptions& options, size_t count) {
             << "+ photos, error <= " << kMaxSurfaceError << " px) in the volume" << joined;
 }
 
+// "; measured through ..." where the level's thresholds were (CarveOptions::threshold_seen_views).
+std::string FirstPassText(const LevelStatistics& level) {
+  if (level.first_pass_seconds <= 0.0) return "";
+  std::ostringstream text;
+  text << "; measured through a first pass carved at the tracks' threshold "
+       << level.first_pass_threshold << " (" << level.first_pass_seconds << " s)";
+  return text.str();
+}
+
 // Logs what the carve did beyond colouring: free space, floaters, repair, thresholds.
 void LogCarve(const CarveOptions& options, const CarveStatistics& s) {
   if (s.free_space_sight_lines > 0) LOG(INFO) << s.FreeSpaceSummary();
@@ -78,7 +87,8 @@ void LogCarve(const CarveOptions& options, const CarveStatistics& s) {
                         ? " (measured at " + std::to_string(level.threshold_resolution) +
                               " voxels on the photos as they are: this level enlarges them " +
                               std::to_string(level.image_enlargement) + "x)"
-                        : std::string());
+                        : std::string())
+                << FirstPassText(level);
     } else {
       LOG(WARNING) << "level " << level.resolution << ": only " << level.estimate.points_judged
                    << " sparse points could be judged (" << kMinThresholdPoints
@@ -361,6 +371,7 @@ CarveResult CarvePipeline::CarveWith(CarveOptions options,
 
 CarveOptions CarvePipeline::FilledOptions(CarveOptions options) const {
   if (request_.auto_spread_floor) options.spread_floor = run_.spread_floor;
+  if (request_.auto_threshold_views) options.threshold_seen_views = run_.threshold_seen_views;
   options.surface_points = surface_points_;
   options.ground = run_.ground;
   options.distant_rays = distant_rays_;

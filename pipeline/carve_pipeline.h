@@ -81,6 +81,10 @@ struct CarveRun {
   // The spread floor used (CarveOptions::spread_floor) and why.
   double spread_floor = 0.0;
   std::string spread_floor_reason;
+  // The views that judge the sparse points for the threshold
+  // (CarveOptions::threshold_seen_views) and why.
+  bool threshold_seen_views = false;
+  std::string threshold_views_reason;
   std::vector<PhotoMaskInfo> mask_photos;  // per view: where its mask came from, what was found
   std::vector<std::string> view_names;     // the views carved, in carve order
   ColourCalibration colour;
@@ -200,7 +204,11 @@ class CarvePipeline {
   void RecordCarve();  // the log lines and stage times of run_.result's carve
   void DecideMasks();
   void DecideGround();  // run_.ground, once the masks are decided
-  void DecideSpreadFloor();  // run_.spread_floor, once the masks are decided
+  // Why the automatic rules for an object without masks (the spread floor, the threshold's seen
+  // views) do not apply; "" where they do.
+  std::string ObjectRulesWithheld() const;
+  // run_.spread_floor and run_.threshold_seen_views, once the masks are decided
+  void DecideSpreadFloor();
   void FindDistant();   // distant_rays_ and run_.distant, once the masks are decided
   void FindGroundPixels();  // appends to distant_rays_, run_.ground_pixels, once the ground is
   void RecordSeconds(const std::string& stage, double seconds);

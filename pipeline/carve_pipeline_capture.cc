@@ -14,27 +14,52 @@
 
 namespace raycarve {
 
+std::string CarvePipeline::ObjectRulesWithheld() const {
+  if (!request_.options.auto_threshold) return "--threshold given";
+  if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
+    return "masks (their threshold keeps the surface)";
+  }
+  if (request_.bounds.capture == "scene" ||
+      (request_.bounds.capture == "auto" && !run_.layout.object_centred)) {
+    return "a scene (seen from one side)";
+  }
+  return "";
+}
+
 void CarvePipeline::DecideSpreadFloor() {
+  // The threshold comes from the sparse points, whose tracks are neighbouring photos that agree
+  // on everything; the photos around the object that judge a voxel across a texture edge disagree
+  // by up to its spread at the true surface.
+  const std::string withheld = ObjectRulesWithheld();
   run_.spread_floor = request_.options.spread_floor;
   if (!request_.auto_spread_floor) {
     run_.spread_floor_reason = "as given";
-  } else if (!request_.options.auto_threshold) {
-    run_.spread_floor_reason = "none: --threshold given";
-  } else if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
-    run_.spread_floor_reason = "none: masks (their threshold keeps the surface)";
-  } else if (request_.bounds.capture == "scene" ||
-             (request_.bounds.capture == "auto" && !run_.layout.object_centred)) {
-    run_.spread_floor_reason = "none: a scene (seen from one side)";
+  } else if (!withheld.empty()) {
+    run_.spread_floor_reason = "none: " + withheld;
   } else {
-    // The threshold comes from the sparse points' tracks, neighbouring photos that agree on
-    // everything; the photos around the object that judge a voxel across a texture edge disagree
-    // by up to its spread at the true surface.
     run_.spread_floor = kAutoSpreadFloor;
     run_.spread_floor_reason = "an object without masks, cameras around it";
   }
   if (request_.auto_spread_floor) {
     LOG(INFO) << "spread floor: the threshold at least " << run_.spread_floor
               << " x each voxel's within-view colour spread (" << run_.spread_floor_reason << ")";
+  }
+  // Likewise the photos that judge each sparse point when the threshold is measured: every photo
+  // that sees it, not its track alone (measured: docs/studies/2026-12-06-seen-views.md).
+  run_.threshold_seen_views = request_.options.threshold_seen_views;
+  if (!request_.auto_threshold_views) {
+    run_.threshold_views_reason = "as given";
+  } else if (!withheld.empty()) {
+    run_.threshold_seen_views = false;
+    run_.threshold_views_reason = "tracks: " + withheld;
+  } else {
+    run_.threshold_seen_views = true;
+    run_.threshold_views_reason = "an object without masks, cameras around it";
+  }
+  if (request_.auto_threshold_views && run_.threshold_seen_views) {
+    LOG(INFO) << "threshold: each sparse point judged from every photo that sees it through a "
+                 "first pass of the coarsest level, not its track alone ("
+              << run_.threshold_views_reason << ")";
   }
 }
 

@@ -30,6 +30,8 @@ void WriteOptions(const CarveRequest& request, const CarveRun& run, JsonWriter& 
       .Key("adaptive_threshold").Value(request.options.adaptive_threshold)
       .Key("spread_floor").Value(run.spread_floor)
       .Key("spread_floor_reason").Value(run.spread_floor_reason)
+      .Key("threshold_views").Value(run.threshold_seen_views ? "seen" : "tracks")
+      .Key("threshold_views_reason").Value(run.threshold_views_reason)
       .Key("min_views").Value(request.options.min_views)
       .Key("min_coverage").Value(request.options.min_coverage)
       .Key("order").Value(CarveOrderToString(request.options.order))
@@ -315,11 +317,24 @@ void WriteLevels(const CarveRequest& request, const CarveRun& run, JsonWriter& j
           .Key("quantile").Value(e.quantile)
           .Key("points_in_grid").Value(e.points_in_grid)
           .Key("points_judged").Value(e.points_judged)
+          .Key("views_per_point").Value(e.points_in_grid > 0 ? static_cast<double>(e.views_judged) /
+                                                                  e.points_in_grid
+                                                            : 0.0)
+          .Key("track_views_per_point").Value(e.points_in_grid > 0
+                                                  ? static_cast<double>(e.track_views) /
+                                                        e.points_in_grid
+                                                  : 0.0)
           .Key("surface_error_quantiles_0_to_1_by_0_05").Value(surface)
           .Key("front_offset_voxels").Value(ThresholdEstimate::kFrontOffsetVoxels)
           .Key("front_voxels").Value(static_cast<uint64_t>(e.front_errors.size()))
           .Key("front_error_quantiles_0_to_1_by_0_05").Value(front)
           .Key("front_share_above_threshold").Value(e.FrontCarved())
+          .EndObject();
+    }
+    if (level.first_pass_seconds > 0.0) {
+      json.Key("first_pass").BeginObject()
+          .Key("threshold").Value(level.first_pass_threshold)
+          .Key("seconds").Value(level.first_pass_seconds)
           .EndObject();
     }
     json.Key("protected_kept").Value(level.protected_kept)

@@ -91,6 +91,9 @@ struct CarveRequest {
   // object capture without masks (cameras around it) holds each voxel to at least
   // kAutoSpreadFloor times its within-view colour spread (CarvePipeline::DecideSpreadFloor).
   bool auto_spread_floor = true;
+  // options.threshold_seen_views chosen for the capture (--threshold_views auto): on where the
+  // spread floor applies (an object without masks, --threshold auto).
+  bool auto_threshold_views = true;
   // A grid whose voxels span fewer pixels of the photos than this (median at the volume's
   // centre) is refused before the work: there the photos cannot tell a voxel from its
   // neighbours, rays pass between voxels that are never judged, and the carve degrades (the

@@ -115,6 +115,11 @@ void AddCarvingFlags(OptionParser* parser, CarveRequest* request, CarveFlagText*
                      "the true surface); 0: no floor; auto: " + Number(kAutoSpreadFloor) +
                          " with --threshold auto on an object capture without masks (cameras "
                          "around it), else 0");
+  parser->AddDefault("threshold_views", &text->threshold_views,
+                     "with --threshold auto, the photos that judge each sparse point when the "
+                     "threshold is measured: tracks (the photos that matched it), seen (every "
+                     "photo that sees it through a first pass of the coarsest level) or auto "
+                     "(seen on an object capture without masks, cameras around it; else tracks)");
   parser->AddDefault("min_views", &request->options.min_views,
                      "views a voxel must be seen by to be judged");
   parser->AddDefault("min_coverage", &request->options.min_coverage,
@@ -350,6 +355,14 @@ void ApplyCarveFlags(const OptionParser& parser, const CarveFlagText& text, Carv
     }
     request->auto_spread_floor = false;
     request->options.spread_floor = value;
+  }
+  if (text.threshold_views == "auto" || text.threshold_views == "seen" ||
+      text.threshold_views == "tracks") {
+    request->auto_threshold_views = text.threshold_views == "auto";
+    request->options.threshold_seen_views = text.threshold_views == "seen";
+  } else {
+    throw InputError("--threshold_views: must be auto, seen or tracks, got '" +
+                     text.threshold_views + "'");
   }
   ConsistencyMethodFromString(text.consistency, &request->options.consistency);
   VisLookupFromString(text.vis_lookup, &request->options.vis_lookup);

@@ -37,6 +37,7 @@ struct CarveFlagText {
   std::string decision;
   std::string background = "auto";
   std::string spread_floor = "auto";
+  std::string threshold_views = "auto";
 };
 void AddCarveFlags(OptionParser* parser, CarveRequest* request, CarveFlagText* text);
 // `parser` (after Parse) says which flags were given: a --resolution not given may be lowered to

@@ -118,6 +118,100 @@ TEST(EstimateThreshold, SeparatesTheSurfaceFromTheSpaceInFrontAndChoosesByTheDoc
   EXPECT_EQ(fallback.threshold, -7.0);
 }
 
+// A view sees a point unless a solid voxel lies on its sight line farther than the margin from
+// the point; a view behind the camera or out of frame never does; the track always does.
+TEST(SeenThrough, KeepsTheTrackAndTheViewsWhoseSightLineNoSolidVoxelBlocks) {
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(8, 160, 120));
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  const VoxelGrid grid(scene.object_box, 32);
+  const Eigen::Vector3d point = scene.object_box.center();
+  std::vector<uint64_t> none((grid.num_voxels() + 63) / 64, 0);
+  const Volume empty(grid, none);
+  std::vector<int> in_frame;
+  for (int v = 0; v < static_cast<int>(views.size()); ++v) {
+    const Eigen::Vector2d pixel = views[v].Project(point);
+    if (views[v].Depth(point) > 0.0 && pixel.x() >= 0 && pixel.y() >= 0 &&
+        pixel.x() < views[v].width && pixel.y() < views[v].height) {
+      in_frame.push_back(v);
+    }
+  }
+  ASSERT_GE(in_frame.size(), 4u);
+  std::vector<int> seen = SeenThrough(views, empty, point, 0.0, {});
+  EXPECT_EQ(seen, in_frame);
+
+  // A solid voxel halfway from the point to the first view's centre (inside the grid) blocks
+  // that view alone; within the margin it does not.
+  const int blocked = in_frame[0];
+  std::vector<uint64_t> one = none;
+  const Eigen::Vector3d towards = (views[blocked].centre - point).normalized();
+  const Eigen::Vector3d blocker = point + towards * 8.0 * grid.voxel_size();
+  ASSERT_TRUE(grid.Contains(grid.VoxelOf(blocker)));
+  const int64_t index = grid.Index(grid.VoxelOf(blocker));
+  one[index >> 6] |= uint64_t{1} << (index & 63);
+  const Volume walled(grid, one);
+  seen = SeenThrough(views, walled, point, 2.0 * grid.voxel_size(), {});
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), blocked), 0);
+  EXPECT_EQ(seen.size(), in_frame.size() - 1);
+  seen = SeenThrough(views, walled, point, 10.0 * grid.voxel_size(), {});
+  EXPECT_EQ(seen, in_frame);
+  // The track is kept as it is, first, though the wall blocks it.
+  seen = SeenThrough(views, walled, point, 2.0 * grid.voxel_size(), {blocked});
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.front(), blocked);
+  EXPECT_EQ(seen.size(), in_frame.size());
+  // A solid grid: nothing but the track.
+  std::vector<uint64_t> all((grid.num_voxels() + 63) / 64, ~uint64_t{0});
+  EXPECT_EQ(SeenThrough(views, Volume(grid, all), point, 2.0 * grid.voxel_size(), {3}),
+            std::vector<int>{3});
+}
+
+// Tracks cut to two neighbouring views (as SIFT's are: the photos that matched a point) judge the
+// space in front of the surface from nearly one direction, and the threshold falls; judged from
+// every view that sees each point through the object's own volume, the estimate comes back
+// towards the one of the full tracks (every view that sees the point).
+TEST(EstimateThreshold, PointsJudgedFromTheViewsThatSeeThemNotTheirNarrowTracks) {
+  const SyntheticScene scene = TexturedScene();
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  const std::vector<SurfacePoint> full = testing::SceneSurfacePoints(scene);
+  ASSERT_GT(full.size(), 100u);
+  std::vector<SurfacePoint> narrow = full;
+  for (SurfacePoint& point : narrow) point.views.resize(2);
+  const VoxelGrid grid(scene.object_box, 64);
+  // The object's volume: the visual hull of its masks at the grid.
+  CarveOptions hull = testing::Options(64, 1e9);
+  hull.lod_levels = 1;
+  const CarveResult carved =
+      CarveVolume(testing::SceneViews(scene, /*with_masks=*/true), scene.object_box, hull);
+
+  const ThresholdRule rule = Rule(ConsistencyMethod::kMeanColour, false, -7.0, 0.5);
+  const ThresholdEstimate from_full = EstimateThreshold(views, grid, full, rule);
+  const ThresholdEstimate from_narrow = EstimateThreshold(views, grid, narrow, rule);
+  ThresholdRule seen_rule = rule;
+  seen_rule.seen_through = &carved.volume;
+  const ThresholdEstimate from_seen = EstimateThreshold(views, grid, narrow, seen_rule);
+  std::cout << "full tracks: " << from_full.Summary() << "\nnarrow: " << from_narrow.Summary()
+            << "\nseen: " << from_seen.Summary() << "\n";
+  EXPECT_EQ(from_narrow.views_judged, from_narrow.track_views);
+  EXPECT_EQ(from_narrow.track_views, 2 * from_narrow.points_in_grid);
+  // The hull of eight views is fat: fewer views see through it than see the object (2.9 a point
+  // against the full tracks' 4.0), but more than the two of the track.
+  EXPECT_GT(from_seen.views_judged, from_seen.track_views * 13 / 10);
+  EXPECT_LT(from_seen.views_judged, from_full.views_judged);
+  const double front_narrow = ThresholdEstimate::Quantile(from_narrow.front_errors, 0.5);
+  const double front_seen = ThresholdEstimate::Quantile(from_seen.front_errors, 0.5);
+  EXPECT_GT(front_seen, 1.15 * front_narrow);
+  EXPECT_LT(from_narrow.threshold, from_full.threshold);
+  EXPECT_GT(from_seen.threshold, from_narrow.threshold);
+  EXPECT_LT(std::abs(from_seen.threshold - from_full.threshold),
+            std::abs(from_narrow.threshold - from_full.threshold));
+  // With masks the rule stays on the tracks.
+  ThresholdRule masked_rule = seen_rule;
+  masked_rule.masked = true;
+  const ThresholdEstimate masked =
+      EstimateThreshold(testing::SceneViews(scene, true), grid, narrow, masked_rule);
+  EXPECT_EQ(masked.views_judged, masked.track_views);
+}
+
 // Every photo's exposure and white balance changed (a gain and an offset per view and channel):
 // the mean-colour test's errors on the true surface nearly double, while the patch test's
 // barely move, and it still tells the surface from the space in front of it.

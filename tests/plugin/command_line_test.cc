@@ -258,6 +258,7 @@ TEST_F(CommandLine, CarveRefusesNonsenseOptionsAndVolumesTooLargeForMemory) {
   ExpectUserError(base + " --pattern_threshold 3", {"--pattern_threshold", "[0, 2]", "'3'"});
   ExpectUserError(base + " --spread_floor -1", {"--spread_floor", "number >= 0 or auto", "'-1'"});
   ExpectUserError(base + " --spread_floor inf", {"--spread_floor", "'inf'"});
+  ExpectUserError(base + " --threshold_views all", {"--threshold_views", "auto, seen or tracks", "'all'"});
   ExpectUserError(base + " --consistency median", {"not one of: mean_colour, standard_deviation"});
   ExpectUserError(base + " --method zbuffer", {"not one of: ray, gvc, gvc_ldi"});
 

@@ -91,6 +91,13 @@ TEST(UnmaskedCapture, TheSubjectIsCarvedInItsOwnBoxWithoutTheBoxsWalls) {
             std::string::npos);
   EXPECT_NE(output.find("at least 1 x a voxel's within-view spread"), std::string::npos)
       << output;
+  // Likewise the threshold is measured on every photo that sees each sparse point through a first
+  // pass of the coarsest level, not on its track alone (synth's tracks already hold every photo
+  // that sees the point, so here the views a point barely grow).
+  EXPECT_NE(report.find("\"threshold_views\": \"seen\""), std::string::npos);
+  EXPECT_NE(report.find("\"first_pass\": {"), std::string::npos);
+  EXPECT_GE(JsonNumber(report, "views_per_point"), JsonNumber(report, "track_views_per_point"));
+  EXPECT_NE(output.find("judged from every photo that sees it"), std::string::npos) << output;
   // The cloud against the truth (the objects, the ground square and the room's floor) inside the
   // volume, at two voxels (measured: F-score 99.0%).
   EXPECT_GT(FScoreInVolume(root, report), 0.88);
@@ -185,6 +192,8 @@ TEST(UnmaskedCapture, ForwardFacingPhotosAreASceneBoxedToTheDepthTheyPlace) {
   EXPECT_EQ(JsonNumber(report, "spread_floor"), 0.0);
   EXPECT_NE(report.find("\"spread_floor_reason\": \"none: a scene"), std::string::npos);
   EXPECT_EQ(output.find("x a voxel's within-view spread"), std::string::npos) << output;
+  EXPECT_NE(report.find("\"threshold_views\": \"tracks\""), std::string::npos);
+  EXPECT_EQ(report.find("\"first_pass\""), std::string::npos);
   const double tried = JsonNumber(report, "depth_tried_points");
   const double resolved = JsonNumber(report, "depth_resolved_points");
   EXPECT_GT(tried, 400);

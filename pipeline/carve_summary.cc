@@ -242,6 +242,20 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
                   run.spread_floor);
     level_line += floor;
   }
+  if (!s.levels.empty() && s.levels.front().first_pass_seconds > 0.0) {
+    char seen[160];
+    std::snprintf(seen, sizeof(seen),
+                  "; measured on the %.3g photos a sparse point that see it, not its track's %.2g",
+                  s.levels.back().estimate.points_in_grid > 0
+                      ? static_cast<double>(s.levels.back().estimate.views_judged) /
+                            s.levels.back().estimate.points_in_grid
+                      : 0.0,
+                  s.levels.back().estimate.points_in_grid > 0
+                      ? static_cast<double>(s.levels.back().estimate.track_views) /
+                            s.levels.back().estimate.points_in_grid
+                      : 0.0);
+    level_line += seen;
+  }
   std::string floater_text;
   if (s.unsupported_components > 0) {
     floater_text = ", " + std::to_string(s.unsupported_component_carved) + " in " +

@@ -98,6 +98,8 @@ TEST(UnmaskedCapture, TheSubjectIsCarvedInItsOwnBoxWithoutTheBoxsWalls) {
   EXPECT_NE(report.find("\"first_pass\": {"), std::string::npos);
   EXPECT_GE(JsonNumber(report, "views_per_point"), JsonNumber(report, "track_views_per_point"));
   EXPECT_NE(output.find("judged from every photo that sees it"), std::string::npos) << output;
+  EXPECT_NE(output.find("photos a sparse point that see it, not its track's"), std::string::npos)
+      << output;
   // The cloud against the truth (the objects, the ground square and the room's floor) inside the
   // volume, at two voxels (measured: F-score 99.0%).
   EXPECT_GT(FScoreInVolume(root, report), 0.88);

@@ -175,9 +175,22 @@ void MeasurePointErrors(const std::vector<CalibratedView>& views,
     }
     return consistency.judged ? consistency.error : -1.0;
   };
+  // The points in the grid with enough views; judged from the photos that see them, at most
+  // kMaxSeenThroughPoints of them, evenly spread over the list (every k-th).
+  std::vector<const SurfacePoint*> eligible;
   for (const SurfacePoint& point : points) {
+    if (grid.Contains(grid.VoxelOf(point.xyz)) && static_cast<int>(point.views.size()) >= min_views) {
+      eligible.push_back(&point);
+    }
+  }
+  const size_t stride =
+      seen_through == nullptr
+          ? 1
+          : (eligible.size() + ThresholdEstimate::kMaxSeenThroughPoints - 1) /
+                ThresholdEstimate::kMaxSeenThroughPoints;
+  for (size_t i = 0; i < eligible.size(); i += std::max<size_t>(1, stride)) {
+    const SurfacePoint& point = *eligible[i];
     const Eigen::Vector3i voxel = grid.VoxelOf(point.xyz);
-    if (!grid.Contains(voxel) || static_cast<int>(point.views.size()) < min_views) continue;
     ++estimate.points_in_grid;
     point_views = seen_through == nullptr
                       ? point.views

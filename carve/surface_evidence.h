@@ -41,8 +41,15 @@ struct ThresholdEstimate {
   // surface and front voxels both agree so well (a plain or saturated region) says nothing about
   // where to put the threshold, and the no-mask rule leaves it out.
   static constexpr double kNoEvidence = 1.0;
+  // Judged from every photo that sees it (ThresholdRule::seen_through), a point costs a sight
+  // line and a footprint per photo: at most this many points are judged then (every k-th), a
+  // sample that fixes an equal-error point to well within a quantisation step while a project of
+  // 100,000 points and 500 photos stays at seconds.
+  static constexpr size_t kMaxSeenThroughPoints = 5000;
 
-  int points_in_grid = 0;  // surface points inside the grid with at least min_views views
+  // surface points inside the grid with at least min_views views (judged from the photos that
+  // see them: those sampled, at most kMaxSeenThroughPoints)
+  int points_in_grid = 0;
   int points_judged = 0;   // of them, those whose voxel had pixels in at least min_views views
   int uninformative = 0;   // of them, those whose surface and front errors are both <= kNoEvidence
   // Summed over the points in the grid: the views each was judged from, and its track's views

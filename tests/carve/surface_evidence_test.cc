@@ -204,6 +204,15 @@ TEST(EstimateThreshold, PointsJudgedFromTheViewsThatSeeThemNotTheirNarrowTracks)
   EXPECT_GT(from_seen.threshold, from_narrow.threshold);
   EXPECT_LT(std::abs(from_seen.threshold - from_full.threshold),
             std::abs(from_narrow.threshold - from_full.threshold));
+  // A long list is sampled (every k-th point, at most kMaxSeenThroughPoints): the same points
+  // five times over give the same threshold from a sample of them.
+  std::vector<SurfacePoint> many;
+  for (int copy = 0; copy < 5; ++copy) many.insert(many.end(), narrow.begin(), narrow.end());
+  ASSERT_GT(many.size(), ThresholdEstimate::kMaxSeenThroughPoints);
+  const ThresholdEstimate sampled = EstimateThreshold(views, grid, many, seen_rule);
+  EXPECT_LE(static_cast<size_t>(sampled.points_in_grid), ThresholdEstimate::kMaxSeenThroughPoints);
+  EXPECT_GT(static_cast<size_t>(sampled.points_in_grid), ThresholdEstimate::kMaxSeenThroughPoints / 2);
+  EXPECT_NEAR(sampled.threshold, from_seen.threshold, 0.1 * from_seen.threshold);
   // With masks the rule stays on the tracks.
   ThresholdRule masked_rule = seen_rule;
   masked_rule.masked = true;

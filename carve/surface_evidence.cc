@@ -135,6 +135,26 @@ std::vector<int> SeenThrough(const std::vector<CalibratedView>& views,
 
 namespace {
 
+// The points in the grid with at least `min_views` views; with `sample`, at most
+// ThresholdEstimate::kMaxSeenThroughPoints of them, evenly spread over the list (every k-th).
+std::vector<const SurfacePoint*> JudgedPoints(const VoxelGrid& grid,
+                                              const std::vector<SurfacePoint>& points,
+                                              int min_views,
+                                              bool sample) {
+  std::vector<const SurfacePoint*> eligible;
+  for (const SurfacePoint& point : points) {
+    if (grid.Contains(grid.VoxelOf(point.xyz)) && static_cast<int>(point.views.size()) >= min_views) {
+      eligible.push_back(&point);
+    }
+  }
+  const size_t limit = ThresholdEstimate::kMaxSeenThroughPoints;
+  if (!sample || eligible.size() <= limit) return eligible;
+  const size_t stride = (eligible.size() + limit - 1) / limit;
+  std::vector<const SurfacePoint*> judged;
+  for (size_t i = 0; i < eligible.size(); i += stride) judged.push_back(eligible[i]);
+  return judged;
+}
+
 // Each point's voxel's error, and that of the voxel kFrontOffsetVoxels in front of it (towards
 // the views that saw it), judged from the point's views, into `estimate`'s lists (sorted).
 void MeasurePointErrors(const std::vector<CalibratedView>& views,
@@ -175,21 +195,8 @@ void MeasurePointErrors(const std::vector<CalibratedView>& views,
     }
     return consistency.judged ? consistency.error : -1.0;
   };
-  // The points in the grid with enough views; judged from the photos that see them, at most
-  // kMaxSeenThroughPoints of them, evenly spread over the list (every k-th).
-  std::vector<const SurfacePoint*> eligible;
-  for (const SurfacePoint& point : points) {
-    if (grid.Contains(grid.VoxelOf(point.xyz)) && static_cast<int>(point.views.size()) >= min_views) {
-      eligible.push_back(&point);
-    }
-  }
-  const size_t stride =
-      seen_through == nullptr
-          ? 1
-          : (eligible.size() + ThresholdEstimate::kMaxSeenThroughPoints - 1) /
-                ThresholdEstimate::kMaxSeenThroughPoints;
-  for (size_t i = 0; i < eligible.size(); i += std::max<size_t>(1, stride)) {
-    const SurfacePoint& point = *eligible[i];
+  for (const SurfacePoint* judged : JudgedPoints(grid, points, min_views, seen_through != nullptr)) {
+    const SurfacePoint& point = *judged;
     const Eigen::Vector3i voxel = grid.VoxelOf(point.xyz);
     ++estimate.points_in_grid;
     point_views = seen_through == nullptr

@@ -489,7 +489,7 @@ void FinalLevelThresholds(const std::vector<CalibratedView>& views,
   LevelStatistics ignored;
   ChooseLevelThresholds(views, views, box, options.resolution,
                         FinalSupersample(views, box, options), options, &level_options, &ignored,
-                        MeasuresThroughFirstPass(views, options) ? seen_through : nullptr);
+                        seen_through);
   *threshold = level_options.threshold;
   *pattern_threshold = level_options.pattern_threshold;
 }

@@ -62,8 +62,8 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
                         double progress_interval_seconds);
 
 // The thresholds the final level of a carve of `views` with `options` judges with (estimated from
-// the sparse points where options ask for it, through `seen_through` where
-// CarveOptions::threshold_seen_views asks; otherwise options' own).
+// the sparse points where options ask for it, through `seen_through` where the carve's first
+// pass gave one (CarveStages::seen_through_out); otherwise options' own).
 void FinalLevelThresholds(const std::vector<CalibratedView>& views,
                           const Eigen::AlignedBox3d& box,
                           const CarveOptions& options,

@@ -57,11 +57,9 @@ std::string ThresholdEstimate::Summary() const {
        << (masked ? "their 99% quantile: masks" : "weighted equal error: no masks") << ") from "
        << points_judged << " of " << points_in_grid
        << " surface points";
-  if (views_judged > track_views && points_in_grid > 0) {
-    text << " (judged from the " << std::setprecision(1)
-         << static_cast<double>(views_judged) / points_in_grid
-         << " photos a point that see it, tracks "
-         << static_cast<double>(track_views) / points_in_grid << ")";
+  if (views_judged > track_views) {
+    text << " (judged from the " << std::setprecision(1) << ViewsPerPoint()
+         << " photos a point that see it, tracks " << TrackViewsPerPoint() << ")";
   }
   text << ": surface voxels' error median " << Quantile(surface_errors, 0.5)
        << ", 90% " << Quantile(surface_errors, 0.9) << ", 95% " << Quantile(surface_errors, 0.95)

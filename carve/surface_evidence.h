@@ -56,6 +56,13 @@ struct ThresholdEstimate {
   // (more judged than in the tracks where ThresholdRule::seen_through widened them).
   int64_t views_judged = 0;
   int64_t track_views = 0;
+  // Their means over the points in the grid (0 without points).
+  double ViewsPerPoint() const {
+    return points_in_grid > 0 ? double(views_judged) / points_in_grid : 0.0;
+  }
+  double TrackViewsPerPoint() const {
+    return points_in_grid > 0 ? double(track_views) / points_in_grid : 0.0;
+  }
   std::vector<double> surface_errors;  // sorted ascending
   std::vector<double> front_errors;    // sorted ascending (voxels inside the grid only)
   double quantile = 0.0;   // the share of surface voxels the threshold keeps
@@ -97,7 +104,7 @@ struct ThresholdRule {
   double pattern_fallback = 0.0;  // likewise the pattern threshold
   int min_points = kMinThresholdPoints;
   // Without masks, when set: each point is judged from every view that sees it through this
-  // volume (a carve of the same space: a coarser level's, or a first pass of the same level),
+  // volume (the first pass of the carve's coarsest level: CarveOptions::threshold_seen_views),
   // not only from its track. A SIFT track is the few neighbouring photos that matched the
   // point; the carve judges a voxel from every photo that sees it, so a threshold measured on the
   // tracks alone is measured on easier evidence than the carve meets (see SeenThrough).

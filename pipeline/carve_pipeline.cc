@@ -212,7 +212,7 @@ void CarvePipeline::AgreeMasks() {
 void CarvePipeline::CheckVolume() {
   CHECK(loaded_);
   DecideGround();
-  DecideSpreadFloor();
+  DecideObjectRules();
   FindDistant();
   FindGroundPixels();
   std::string reason;

@@ -208,7 +208,7 @@ class CarvePipeline {
   // views) do not apply; "" where they do.
   std::string ObjectRulesWithheld() const;
   // run_.spread_floor and run_.threshold_seen_views, once the masks are decided
-  void DecideSpreadFloor();
+  void DecideObjectRules();
   void FindDistant();   // distant_rays_ and run_.distant, once the masks are decided
   void FindGroundPixels();  // appends to distant_rays_, run_.ground_pixels, once the ground is
   void RecordSeconds(const std::string& stage, double seconds);

@@ -26,7 +26,7 @@ std::string CarvePipeline::ObjectRulesWithheld() const {
   return "";
 }
 
-void CarvePipeline::DecideSpreadFloor() {
+void CarvePipeline::DecideObjectRules() {
   // The threshold comes from the sparse points, whose tracks are neighbouring photos that agree
   // on everything; the photos around the object that judge a voxel across a texture edge disagree
   // by up to its spread at the true surface.

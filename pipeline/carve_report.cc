@@ -317,13 +317,8 @@ void WriteLevels(const CarveRequest& request, const CarveRun& run, JsonWriter& j
           .Key("quantile").Value(e.quantile)
           .Key("points_in_grid").Value(e.points_in_grid)
           .Key("points_judged").Value(e.points_judged)
-          .Key("views_per_point").Value(e.points_in_grid > 0 ? static_cast<double>(e.views_judged) /
-                                                                  e.points_in_grid
-                                                            : 0.0)
-          .Key("track_views_per_point").Value(e.points_in_grid > 0
-                                                  ? static_cast<double>(e.track_views) /
-                                                        e.points_in_grid
-                                                  : 0.0)
+          .Key("views_per_point").Value(e.ViewsPerPoint())
+          .Key("track_views_per_point").Value(e.TrackViewsPerPoint())
           .Key("surface_error_quantiles_0_to_1_by_0_05").Value(surface)
           .Key("front_offset_voxels").Value(ThresholdEstimate::kFrontOffsetVoxels)
           .Key("front_voxels").Value(static_cast<uint64_t>(e.front_errors.size()))

@@ -89,7 +89,7 @@ struct CarveRequest {
   bool ground_free_space = true;
   // options.spread_floor chosen for the capture (--spread_floor auto): with --threshold auto, an
   // object capture without masks (cameras around it) holds each voxel to at least
-  // kAutoSpreadFloor times its within-view colour spread (CarvePipeline::DecideSpreadFloor).
+  // kAutoSpreadFloor times its within-view colour spread (CarvePipeline::DecideObjectRules).
   bool auto_spread_floor = true;
   // options.threshold_seen_views chosen for the capture (--threshold_views auto): on where the
   // spread floor applies (an object without masks, --threshold auto).

@@ -244,16 +244,10 @@ void AppendSummary(const CarveRequest& request, const CarveRun& run, std::string
   }
   if (!s.levels.empty() && s.levels.front().first_pass_seconds > 0.0) {
     char seen[160];
+    const ThresholdEstimate& final_estimate = s.levels.back().estimate;
     std::snprintf(seen, sizeof(seen),
                   "; measured on the %.3g photos a sparse point that see it, not its track's %.2g",
-                  s.levels.back().estimate.points_in_grid > 0
-                      ? static_cast<double>(s.levels.back().estimate.views_judged) /
-                            s.levels.back().estimate.points_in_grid
-                      : 0.0,
-                  s.levels.back().estimate.points_in_grid > 0
-                      ? static_cast<double>(s.levels.back().estimate.track_views) /
-                            s.levels.back().estimate.points_in_grid
-                      : 0.0);
+                  final_estimate.ViewsPerPoint(), final_estimate.TrackViewsPerPoint());
     level_line += seen;
   }
   std::string floater_text;

@@ -102,9 +102,14 @@ DistantPixels FindDistantPixels(const std::vector<CalibratedView>& views,
 // can tell from it (*clear_to <= *at); false where it says nothing of that ray. A pixel matches
 // the surface when its patch, each pixel's ray ending on the surface, matches the other photos
 // there clearly better than anywhere on its ray inside `box` up to *clear_to, that part's far end
-// lying at least `min_parallax` pixels from the surface's point. Rays are those of the pixels
-// found (judged and grown), with `length` *clear_to where the surface is at a finite distance.
-// FindDistantPixels is this with the sky at infinity (clear_to: the box's far side).
+// lying at least `min_parallax` pixels from the surface's point. For a surface at a finite
+// distance, a photo that does not tell the ray's point at *clear_to from the surface's searches
+// the part it does tell apart (up to where the point comes within `min_parallax` pixels) and
+// speaks for that part alone. Rays are those of the pixels found (judged and grown), with `length`
+// up to where `min_agreeing_views` of the photos that agree tell the ray from the surface, at most
+// *clear_to, where the surface is at a finite distance (a pixel of a found pixel's stride cell: the
+// same share of the way to the surface). FindDistantPixels is this with the sky at infinity
+// (clear_to: the box's far side, which every photo asked must tell apart).
 using SupposedSurface = std::function<bool(const Eigen::Vector3d& centre, const Eigen::Vector3d& direction,
                                            double* at, double* clear_to)>;
 DistantPixels FindPixelsOnSurface(const std::vector<CalibratedView>& views,

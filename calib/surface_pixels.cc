@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <thread>
 
@@ -142,6 +143,9 @@ double Correlation(const CentredPatch& a, const ReducedView& j, const Eigen::Vec
 // volume land in photo j.
 struct PairGeometry {
   int partner = -1;
+  // Along the ray, up to where photo j tells it from the surface (min_parallax away from
+  // on_surface): the segment searched ends there, and so does what j says is empty.
+  double resolved_to = 0.0;
   Eigen::Vector2d on_surface;
   std::vector<Eigen::Vector2d> offsets;  // the patch's pixels on the surface, around on_surface
   std::vector<Eigen::Vector2d> segment;  // samples of the ray inside the volume, projected
@@ -172,6 +176,26 @@ Eigen::Vector4d SurfacePoint(const Eigen::Vector3d& centre, const Eigen::Vector3
   return (centre + at * direction).homogeneous();
 }
 
+// The farthest point of the ray's segment [t0, t1] that photo j sees at least `min_parallax`
+// pixels from q (the surface's point), into *t1 (bisection in inverse distance, along which the
+// point moves monotonically on j's epipolar line); false where no point of it is.
+bool ResolvedEnd(const ReducedView& i, const ReducedView& j, const PixelRay& ray, const Eigen::Vector2d& q,
+                 double min_parallax, double* t1) {
+  const auto resolved = [&](double t) {
+    Eigen::Vector2d pixel;
+    return ProjectPointInFront(j, i.centre + t * ray.direction, &pixel) && (pixel - q).norm() >= min_parallax;
+  };
+  const double t_near = std::max(ray.t0, 1e-6);
+  if (!(t_near < ray.t1) || !resolved(t_near)) return false;
+  double near = 1.0 / t_near, far = 1.0 / ray.t1;  // inverse distances: resolved at near, not at far
+  for (int k = 0; k < 40; ++k) {
+    const double mid = 0.5 * (near + far);
+    (resolved(1.0 / mid) ? near : far) = mid;
+  }
+  *t1 = 1.0 / near;
+  return true;
+}
+
 bool PairFor(const ReducedView& i, const ReducedView& j, int partner, const PixelRay& ray,
              size_t centre_index, const DistantOptions& options, PairGeometry* pair) {
   Eigen::Vector2d q;
@@ -181,10 +205,17 @@ bool PairFor(const ReducedView& i, const ReducedView& j, int partner, const Pixe
       q.y() > j.rgb.rows - margin) {
     return false;
   }
-  // The segment's far end must be told apart from the surface.
+  // The segment's far end must be told apart from the surface. For a surface at a finite
+  // distance the segment is cut where photo j stops telling it apart (the ray is cleared that far
+  // only); for the sky the whole segment must be (its ray is cleared through the volume).
   Eigen::Vector2d far;
   if (!ProjectPointInFront(j, i.centre + ray.t1 * ray.direction, &far)) return false;
-  if ((far - q).norm() < options.min_parallax) return false;
+  double t1 = ray.t1;
+  if ((far - q).norm() < options.min_parallax) {
+    if (std::isinf(ray.at) || !ResolvedEnd(i, j, ray, q, options.min_parallax, &t1)) return false;
+    if (!ProjectPointInFront(j, i.centre + t1 * ray.direction, &far)) return false;
+  }
+  pair->resolved_to = t1;
   pair->partner = partner;
   pair->on_surface = q;
   pair->offsets.clear();
@@ -198,14 +229,14 @@ bool PairFor(const ReducedView& i, const ReducedView& j, int partner, const Pixe
   pair->segment.clear();
   Eigen::Vector2d near_pixel = Eigen::Vector2d::Zero();
   double t_near = std::max(ray.t0, 1e-6);
-  while (t_near < ray.t1 && !ProjectPointInFront(j, i.centre + t_near * ray.direction, &near_pixel)) {
+  while (t_near < t1 && !ProjectPointInFront(j, i.centre + t_near * ray.direction, &near_pixel)) {
     t_near = t_near * 2.0 + 1e-6;
   }
-  if (!(t_near < ray.t1)) return true;
+  if (!(t_near < t1)) return true;
   const double length = (near_pixel - far).norm();
   const int count = std::clamp(static_cast<int>(std::ceil(length / kSegmentStep)) + 1, 2, 128);
   for (int k = 0; k < count; ++k) {
-    const double s = 1.0 / ray.t1 + (1.0 / t_near - 1.0 / ray.t1) * k / (count - 1);
+    const double s = 1.0 / t1 + (1.0 / t_near - 1.0 / t1) * k / (count - 1);
     Eigen::Vector2d pixel;
     if (ProjectPointInFront(j, i.centre + ray.direction / s, &pixel)) pair->segment.push_back(pixel);
   }
@@ -256,8 +287,10 @@ class PhotoJudge {
   }
 
   // The verdict on pixel p, whose centred patch is `a`: 1 on the surface, -1 nearer, 0 neither.
-  // `ray` is p's ray (RayOf).
-  int Verdict(const PixelRay& ray, const CentredPatch& a) {
+  // `ray` is p's ray (RayOf). On the surface, *cleared_to is how far along the ray
+  // min_agreeing_views of the photos that agree tell it from the surface (the ray's segment end,
+  // or nearer where a photo resolves less of it).
+  int Verdict(const PixelRay& ray, const CentredPatch& a, double* cleared_to) {
     // First the cheap test on the surface, on up to max_partners photos.
     pairs_.clear();
     on_surface_.clear();
@@ -281,7 +314,7 @@ class PhotoJudge {
     }
     coarse_.Centre();
     coarse_.mean += a.mean;  // a's values were centred already
-    int agreeing = 0;
+    resolved_.clear();
     for (size_t k = 0; k < pairs_.size(); ++k) {
       const double inside = BestInside(a, pairs_[k]);
       if (inside >= options_.min_correlation && inside - on_surface_[k] >= options_.min_advantage) {
@@ -289,10 +322,15 @@ class PhotoJudge {
       }
       if (on_surface_[k] >= options_.min_correlation &&
           on_surface_[k] - inside >= options_.min_advantage) {
-        ++agreeing;
+        resolved_.push_back(pairs_[k].resolved_to);
       }
     }
-    return agreeing >= options_.min_agreeing_views ? 1 : 0;
+    const int agreeing = static_cast<int>(resolved_.size());
+    if (agreeing < options_.min_agreeing_views) return 0;
+    std::nth_element(resolved_.begin(), resolved_.begin() + (options_.min_agreeing_views - 1), resolved_.end(),
+                     std::greater<double>());
+    *cleared_to = resolved_[options_.min_agreeing_views - 1];
+    return 1;
   }
 
  private:
@@ -334,6 +372,7 @@ class PhotoJudge {
   // Scratch, kept between pixels.
   std::vector<PairGeometry> pairs_;
   std::vector<double> on_surface_;
+  std::vector<double> resolved_;  // the agreeing pairs' resolved_to
   CentredPatch coarse_, buffer_;
   std::vector<Eigen::Vector2d> coarse_offsets_;
 };
@@ -469,8 +508,11 @@ PhotoVerdicts JudgePhoto(const std::vector<ReducedView>& reduced, int v, const E
   CentredPatch a;
   a.values.resize(3 * patch.size());
   PixelRay ray;
-  const auto add_ray = [&](const PixelRay& found) {
-    const double length = std::isinf(found.at) ? std::numeric_limits<double>::infinity() : found.t1;
+  // A ray found, cleared to `cleared_to` (its own or, for a pixel of a found pixel's stride cell,
+  // that pixel's share of the way to the surface).
+  const auto add_ray = [&](const PixelRay& found, double cleared_to) {
+    const double length = std::isinf(found.at) ? std::numeric_limits<double>::infinity()
+                                               : std::min(found.t1, cleared_to);
     out.rays.push_back(DistantRay{v, found.direction, length});
   };
   for (int row = r + 1; row < i.rgb.rows - r - 1; row += options.stride) {
@@ -486,18 +528,20 @@ PhotoVerdicts JudgePhoto(const std::vector<ReducedView>& reduced, int v, const E
         continue;
       }
       a.Centre();
-      const int verdict = judge.Verdict(ray, a);
+      double cleared_to = ray.t1;
+      const int verdict = judge.Verdict(ray, a, &cleared_to);
       out.mask.at<uint8_t>(row, col) = verdict > 0 ? kDistantJudged : verdict < 0 ? kNearer : kUndecided;
       if (verdict < 0) ++out.nearer;
       if (verdict <= 0) continue;
       ++out.found;
-      add_ray(ray);
+      add_ray(ray, cleared_to);
       if (!options.cell_rays) continue;
+      const double share = std::isinf(ray.at) ? 1.0 : cleared_to / ray.at;
       PixelRay neighbour;  // the pixels of the stride cell that p stands for
       for (int dy = 0; dy < options.stride; ++dy) {
         for (int dx = 0; dx < options.stride; ++dx) {
           if ((dx != 0 || dy != 0) && RayOf(i, PixelCentre(row + dy, col + dx), box, {}, surface, &neighbour)) {
-            add_ray(neighbour);
+            add_ray(neighbour, share * neighbour.at);
           }
         }
       }
@@ -505,7 +549,7 @@ PhotoVerdicts JudgePhoto(const std::vector<ReducedView>& reduced, int v, const E
   }
   if (options.grow_plain_regions) {
     for (const Eigen::Vector2d& p : GrowIntoPlainRegions(i, options, seen, &out.mask, &out.grown)) {
-      if (RayOf(i, p, box, {}, surface, &ray)) add_ray(ray);
+      if (RayOf(i, p, box, {}, surface, &ray)) add_ray(ray, ray.t1);
     }
   }
   return out;

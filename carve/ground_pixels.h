@@ -18,14 +18,12 @@
 
 namespace raycarve {
 
-// Ground pixels' rays stop this many voxels above the ground's tolerance (Ground::depth): what
-// lies nearer the plane is left to colour carving.
-constexpr double kGroundClearanceVoxels = 2.0;
-
 // The test of FindPixelsOnSurface (calib/distant_pixels.h) with the ground's plane as the surface,
 // where its foot is on the ground (GroundMap::At): a pixel's ray meets the plane and, if it shows
-// the floor there, crossed empty space until it came within `clearance` of the plane (rays
-// returned with that length). Judged patches must be textured in each quadrant
+// the floor there, crossed empty space until it came within `clearance` of the plane, or until
+// the photos that say so no longer tell its point from the plane's where that is higher (rays
+// returned with that length; what lies nearer the plane is left to colour carving). The pipeline
+// passes the ground's tolerance (Ground::depth): the band of the sparse points on the plane. Judged patches must be textured in each quadrant
 // (DistantOptions::textured_quadrants, set here): the foot of a plain box on a textured floor
 // moves with the floor in photos near each other (they share the box's occlusion of the floor
 // behind it), and its plain half says nothing. A pixel found casts the rays of its stride cell

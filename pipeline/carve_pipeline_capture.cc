@@ -157,8 +157,9 @@ void CarvePipeline::FindGroundPixels() {
     DistantOptions options;
     options.num_threads = request_.options.num_threads;
     options.grow_plain_regions = false;
-    const double voxel = VoxelGrid(project_.bounds.box, request_.options.resolution).voxel_size();
-    const double clearance = run_.ground.depth + kGroundClearanceVoxels * voxel;
+    // The rays stop where the plane's tolerance begins (the band the sparse points on the plane
+    // lie in), or higher where the photos do not tell that from the plane (FindGroundPixels).
+    const double clearance = run_.ground.depth;
     LOG(INFO) << "looking for pixels that show the ground in " << carved_.size() << " photos ...";
     run_.ground_pixels = raycarve::FindGroundPixels(carved_, project_.bounds.box, run_.ground, clearance,
                                                     options, SurfacePointPixels(carved_, surface_points_));

@@ -84,8 +84,8 @@ struct CarveRequest {
   bool distant_free_space = true;
   // Without masks, where the ground is held (hold_ground): photo pixels whose pattern moves
   // between the photos as the ground's plane does (carve/ground_pixels.h) saw the floor across
-  // empty space, and their rays are carved before colouring down to kGroundClearanceVoxels
-  // above the plane's tolerance.
+  // empty space, and their rays are carved before colouring down to the plane's tolerance (or
+  // as far as the photos tell the ray from the plane, where that is less).
   bool ground_free_space = true;
   // options.spread_floor chosen for the capture (--spread_floor auto): with --threshold auto, an
   // object capture without masks (cameras around it) holds each voxel to at least

@@ -127,17 +127,35 @@ TEST(GroundPixels, TheFloorIsFoundAndNoRayEntersAPlainBoxStandingOnIt) {
   const DistantPixels found = FindGroundPixels(scene.views, kVolume, FloorGround(), kClearance, TestOptions());
   ASSERT_EQ(found.masks.size(), scene.views.size());
   EXPECT_EQ(RaysIntoTheObject(scene, found), 0) << found.Summary();
-  // Every ray ends kClearance above the floor, or where it leaves the volume before that.
+  // Every ray ends kClearance or more above the floor. Where it ends above that inside the volume,
+  // two other photos (min_agreeing_views) see its end at least min_parallax from where the ray
+  // meets the floor: the photos told the space up to there from the floor, no nearer to it.
+  const DistantOptions options = TestOptions();
+  int ended_at_clearance = 0, ended_resolved = 0;
   for (const DistantRay& ray : found.rays) {
-    const Eigen::Vector3d end = scene.views[ray.view].centre + ray.length * ray.direction;
+    const Eigen::Vector3d& centre = scene.views[ray.view].centre;
+    const Eigen::Vector3d end = centre + ray.length * ray.direction;
     double t0 = 0.0, t1 = 0.0;
-    ASSERT_TRUE(ClipRayToBox(scene.views[ray.view].centre, ray.direction, kVolume, &t0, &t1));
-    if (ray.length < t1 - 1e-9) {
-      ASSERT_NEAR(end.y(), kClearance, 1e-9);
-    } else {
-      ASSERT_GE(end.y(), kClearance - 1e-9);
+    ASSERT_TRUE(ClipRayToBox(centre, ray.direction, kVolume, &t0, &t1));
+    ASSERT_GE(end.y(), kClearance - 1e-9);
+    if (!(ray.length < t1 - 1e-9)) continue;
+    if (std::abs(end.y() - kClearance) < 1e-9) {
+      ++ended_at_clearance;
+      continue;
     }
+    const Eigen::Vector3d foot = centre + (-centre.y() / ray.direction.y()) * ray.direction;
+    int resolving = 0;
+    for (size_t w = 0; w < scene.views.size(); ++w) {
+      const CalibratedView& other = scene.views[w];
+      if (static_cast<int>(w) == ray.view) continue;
+      const Eigen::Vector2d a = (other.P * end.homogeneous()).hnormalized();
+      const Eigen::Vector2d b = (other.P * foot.homogeneous()).hnormalized();
+      resolving += (a - b).norm() >= options.min_parallax - 1e-6;
+    }
+    ASSERT_GE(resolving, options.min_agreeing_views) << "ray of view " << ray.view << " ends at " << end.transpose();
+    ++ended_resolved;
   }
+  EXPECT_GT(ended_at_clearance + ended_resolved, 1000);
   // Much of the floor the photos see is found. Measured: 23% of the judged pixels on it (the
   // partners asked first, those farthest, see the floor turned round and foreshortened, and the
   // box hides from them what the photo sees of the floor near it).

@@ -9,7 +9,7 @@
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
-#include <pcl/sample_consensus/ransac.h>
+#include <pcl/sample_consensus/msac.h>
 #include <pcl/sample_consensus/sac_model_plane.h>
 
 namespace raycarve {
@@ -104,6 +104,20 @@ bool MeasurePlane(const Eigen::VectorXf& coefficients, const Eigen::Vector3d& ce
   return true;
 }
 
+// How closely `plane` holds `points`: each point within the tolerance scores 1 - d / tolerance, d
+// its distance (the truncated cost of MSAC, Torr and Zisserman 2000, as PCL's takes it), the sum
+// over the points' number. Two planes that hold as many points within the tolerance differ here where one
+// holds them close (a floor's points) and the other only crosses the band (a plane tilted
+// through the floor's points and an object's).
+double CloseHoldScore(const SupportingPlane& plane, const std::vector<Eigen::Vector3d>& points) {
+  double score = 0.0;
+  for (const Eigen::Vector3d& p : points) {
+    const double d = std::abs(plane.normal.dot(p) + plane.offset) / plane.tolerance;
+    if (d <= 1.0) score += 1.0 - d;
+  }
+  return points.empty() ? 0.0 : score / static_cast<double>(points.size());
+}
+
 // `coefficients` refined by least squares on the points of the centred cloud within `tolerance`.
 Eigen::VectorXf Refined(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
                         const Eigen::VectorXf& coefficients, double tolerance) {
@@ -115,9 +129,9 @@ Eigen::VectorXf Refined(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
 }
 
 // The planes that could be a support (at most kMaxBelowShare of the points below it,
-// kMinCamerasAbove of the cameras above it) holding the most points: of any direction, and level
-// with the photos' up (Level: any where the photos do not know up). Planes through random triples
-// of points (a fixed seed), scored on up to 1,000 of the points; empty coefficients where none
+// kMinCamerasAbove of the cameras above it) holding the most points closely (CloseHoldScore): of
+// any direction, and level with the photos' up (Level: any where the photos do not know up).
+// Planes through random triples of points (a fixed seed), scored on up to 1,000 of the points; empty coefficients where none
 // could. Where wrong matches or an object's sides hold more points on another plane than the
 // ground holds, the ground is still the densest plane with (nearly) nothing under it.
 struct SupportCandidates {
@@ -153,12 +167,13 @@ SupportCandidates DrawSupportCandidates(pcl::SampleConsensusModelPlane<pcl::Poin
         !CouldSupport(candidate)) {
       continue;
     }
-    if (candidate.on_plane_share > best_any) {
-      best_any = candidate.on_plane_share;
+    const double score = CloseHoldScore(candidate, scored);
+    if (score > best_any) {
+      best_any = score;
       best.any = coefficients;
     }
-    if (candidate.Level() && candidate.on_plane_share > best_level) {
-      best_level = candidate.on_plane_share;
+    if (candidate.Level() && score > best_level) {
+      best_level = score;
       best.level = coefficients;
     }
   }
@@ -198,13 +213,16 @@ SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
   const pcl::PointCloud<pcl::PointXYZ>::Ptr cloud = CentredCloud(points, centre);
   pcl::SampleConsensusModelPlane<pcl::PointXYZ>::Ptr model(
       new pcl::SampleConsensusModelPlane<pcl::PointXYZ>(cloud));  // fixed seed
-  pcl::RandomSampleConsensus<pcl::PointXYZ> ransac(model, tolerance);
-  ransac.setMaxIterations(1000);
-  if (!ransac.computeModel()) return plane;
+  // MSAC: of the planes through random triples, the one holding the points most closely (the
+  // sum of their distances, each at most the tolerance: CloseHoldScore), not merely the most
+  // within the tolerance.
+  pcl::MEstimatorSampleConsensus<pcl::PointXYZ> msac(model, tolerance);
+  msac.setMaxIterations(1000);
+  if (!msac.computeModel()) return plane;
   pcl::Indices inliers;
-  ransac.getInliers(inliers);
+  msac.getInliers(inliers);
   Eigen::VectorXf coefficients;
-  ransac.getModelCoefficients(coefficients);
+  msac.getModelCoefficients(coefficients);
   Eigen::VectorXf refined = coefficients;
   if (inliers.size() >= 3) model->optimizeModelCoefficients(inliers, coefficients, refined);
   if (!MeasurePlane(refined, centre, points, cameras, up, &plane)) return plane;

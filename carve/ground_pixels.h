@@ -20,16 +20,16 @@ namespace raycarve {
 
 // The test of FindPixelsOnSurface (calib/distant_pixels.h) with the ground's plane as the surface,
 // where its foot is on the ground (GroundMap::At): a pixel's ray meets the plane and, if it shows
-// the floor there, crossed empty space until it came within `clearance` of the plane, or until
-// the photos that say so no longer tell its point from the plane's where that is higher (rays
-// returned with that length; what lies nearer the plane is left to colour carving). The pipeline
-// passes the ground's tolerance (Ground::depth): the band of the sparse points on the plane. Judged patches must be textured in each quadrant
-// (DistantOptions::textured_quadrants, set here): the foot of a plain box on a textured floor
-// moves with the floor in photos near each other (they share the box's occlusion of the floor
-// behind it), and its plain half says nothing. A pixel found casts the rays of its stride cell
-// (DistantOptions::cell_rays, set here). Plain regions are not grown from their rims unless
-// `options.grow_plain_regions` (an object of the floor's colour merges with it). `ground` must not
-// be empty; `observations` as for FindDistantPixels.
+// the floor there, crossed empty space until it came within `clearance` of the plane, or until the
+// photos that say so no longer tell its point from the plane's where that is higher (rays returned
+// with that length; what lies nearer the plane is left to colour carving). The pipeline passes the
+// ground's tolerance (Ground::depth): the band of the sparse points on the plane. Judged patches
+// must be textured in each quadrant (DistantOptions::textured_quadrants, set here): the foot of a
+// plain box on a textured floor moves with the floor in photos near each other (they share the
+// box's occlusion of the floor behind it), and its plain half says nothing. A pixel found casts the
+// rays of its stride cell (DistantOptions::cell_rays, set here). Plain regions are not grown from
+// their rims unless `options.grow_plain_regions` (an object of the floor's colour merges with it).
+// `ground` must not be empty; `observations` as for FindDistantPixels.
 DistantPixels FindGroundPixels(const std::vector<CalibratedView>& views,
                                const Eigen::AlignedBox3d& box,
                                const Ground& ground,

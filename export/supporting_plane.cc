@@ -106,8 +106,8 @@ bool MeasurePlane(const Eigen::VectorXf& coefficients, const Eigen::Vector3d& ce
 
 // How closely `plane` holds `points`: each point within the tolerance scores 1 - d / tolerance, d
 // its distance (the truncated cost of MSAC, Torr and Zisserman 2000, as PCL's takes it), the sum
-// over the points' number. Two planes that hold as many points within the tolerance differ here where one
-// holds them close (a floor's points) and the other only crosses the band (a plane tilted
+// over the points' number. Two planes that hold as many points within the tolerance differ here
+// where one holds them close (a floor's points) and the other only crosses the band (a plane tilted
 // through the floor's points and an object's).
 double CloseHoldScore(const SupportingPlane& plane, const std::vector<Eigen::Vector3d>& points) {
   double score = 0.0;
@@ -130,10 +130,11 @@ Eigen::VectorXf Refined(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
 
 // The planes that could be a support (at most kMaxBelowShare of the points below it,
 // kMinCamerasAbove of the cameras above it) holding the most points closely (CloseHoldScore): of
-// any direction, and level with the photos' up (Level: any where the photos do not know up).
-// Planes through random triples of points (a fixed seed), scored on up to 1,000 of the points; empty coefficients where none
-// could. Where wrong matches or an object's sides hold more points on another plane than the
-// ground holds, the ground is still the densest plane with (nearly) nothing under it.
+// any direction, and level with the photos' up (Level: any where the photos do not know up). Planes
+// through random triples of points (a fixed seed), scored on up to 1,000 of the points; empty
+// coefficients where none could. Where wrong matches or an object's sides hold more points on
+// another plane than the ground holds, the ground is still the densest plane with (nearly) nothing
+// under it.
 struct SupportCandidates {
   Eigen::VectorXf any, level;
 };

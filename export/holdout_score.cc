@@ -80,9 +80,20 @@ cv::Mat SideBySide(const Rendering& rendering, const CalibratedView& view) {
   return strip;
 }
 
+const char* SparseDepthVerdictName(SparseDepthVerdict verdict) {
+  switch (verdict) {
+    case SparseDepthVerdict::kAtDepth: return "at_depth";
+    case SparseDepthVerdict::kHidden: return "hidden";
+    case SparseDepthVerdict::kBehind: return "behind";
+    case SparseDepthVerdict::kUndrawn: return "undrawn";
+  }
+  return "undrawn";
+}
+
 SparseDepthAgreement MeasureSparseDepth(const Rendering& rendering, const CalibratedView& view,
                                         const std::vector<Eigen::Vector3d>& points,
-                                        double tolerance) {
+                                        double tolerance,
+                                        std::vector<SparsePointDepth>* records) {
   CHECK_EQ(rendering.depth.type(), CV_32FC1);
   SparseDepthAgreement agreement;
   for (const Eigen::Vector3d& point : points) {
@@ -93,14 +104,20 @@ SparseDepthAgreement MeasureSparseDepth(const Rendering& rendering, const Calibr
     if (col < 0 || row < 0 || col >= rendering.depth.cols || row >= rendering.depth.rows) continue;
     ++agreement.points;
     const float drawn = rendering.depth.at<float>(row, col);
-    if (!std::isfinite(drawn)) continue;
-    if (std::abs(drawn - depth) <= tolerance) {
+    SparseDepthVerdict verdict = SparseDepthVerdict::kUndrawn;
+    if (!std::isfinite(drawn)) {
+      verdict = SparseDepthVerdict::kUndrawn;
+    } else if (std::abs(drawn - depth) <= tolerance) {
       ++agreement.at_depth;
+      verdict = SparseDepthVerdict::kAtDepth;
     } else if (drawn < depth - tolerance) {
       ++agreement.hidden;
+      verdict = SparseDepthVerdict::kHidden;
     } else {
       ++agreement.behind;
+      verdict = SparseDepthVerdict::kBehind;
     }
+    if (records != nullptr) records->push_back({point, depth, static_cast<double>(drawn), verdict});
   }
   return agreement;
 }

@@ -55,9 +55,20 @@ struct SparseDepthAgreement {
  private:
   double Share(int count) const { return points > 0 ? static_cast<double>(count) / points : 0.0; }
 };
+// One point's verdict, for a look at where the model and the points disagree.
+enum class SparseDepthVerdict { kAtDepth, kHidden, kBehind, kUndrawn };
+const char* SparseDepthVerdictName(SparseDepthVerdict verdict);
+struct SparsePointDepth {
+  Eigen::Vector3d point;
+  double depth = 0.0;        // the point's, along the view's axis
+  double drawn_depth = 0.0;  // the model's at the point's pixel (infinite where nothing is drawn)
+  SparseDepthVerdict verdict = SparseDepthVerdict::kUndrawn;
+};
+// `records`, where given, receives every point counted, in the order given.
 SparseDepthAgreement MeasureSparseDepth(const Rendering& rendering, const CalibratedView& view,
                                         const std::vector<Eigen::Vector3d>& points,
-                                        double tolerance);
+                                        double tolerance,
+                                        std::vector<SparsePointDepth>* records = nullptr);
 
 }  // namespace exporter
 }  // namespace raycarve

@@ -105,6 +105,9 @@ std::string ThresholdsText(const CarveOptions& options, const CarveStatistics& s
   return thresholds;
 }
 
+// How far from a sparse point's depth the model may be drawn and still agree with it.
+double SparseDepthTolerance(const VoxelGrid& grid) { return 2.0 * grid.voxel_size(); }
+
 // The model drawn into `view` and scored; the photo | render | error image written to `out`.
 HeldOutViewScore ScoreView(const ScoredModel& scored,
                            const std::string& render,
@@ -131,7 +134,8 @@ HeldOutViewScore ScoreView(const ScoredModel& scored,
     for (const Eigen::Vector3d& point : seen->second) {
       if (grid.Box().contains(point)) inside.push_back(point);
     }
-    result.sparse_depth = exporter::MeasureSparseDepth(rendering, view, inside, 2.0 * grid.voxel_size());
+    result.sparse_depth = exporter::MeasureSparseDepth(rendering, view, inside, SparseDepthTolerance(grid),
+                                                       &result.sparse_points);
   }
   // The mesh is scored beside the voxel volume it was made from, drawn into the same view.
   result.volume_score = result.score;
@@ -173,6 +177,29 @@ void AverageScores(HoldoutEvaluation* evaluation) {
   evaluation->mean_volume_psnr = volume_psnr / n;
   evaluation->mean_iou = evaluation->iou_views > 0 ? iou / evaluation->iou_views : -1.0;
   evaluation->mean_volume_iou = evaluation->iou_views > 0 ? volume_iou / evaluation->iou_views : -1.0;
+}
+
+// A name as one CSV field: quoted where it holds a comma, a quote or a line break.
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+// Every held-out view's sparse points with the model's verdict, one line each: where the model
+// and the points disagree, to be looked at (or checked against a truth, samples/truth_sparse_depth).
+std::string SparseDepthCsv(const HoldoutEvaluation& evaluation) {
+  std::string csv = "view,x,y,z,depth,drawn_depth,verdict\n";
+  char line[512];
+  for (const HeldOutViewScore& view : evaluation.views) {
+    for (const exporter::SparsePointDepth& p : view.sparse_points) {
+      std::snprintf(line, sizeof(line), ",%.9g,%.9g,%.9g,%.9g,%.9g,%s\n", p.point.x(), p.point.y(), p.point.z(), p.depth, p.drawn_depth,
+                    exporter::SparseDepthVerdictName(p.verdict));
+      csv += CsvField(view.name) + line;
+    }
+  }
+  return csv;
 }
 
 std::string HoldoutJson(const HoldoutOptions& options,
@@ -233,6 +260,7 @@ std::string HoldoutJson(const HoldoutOptions& options,
       .Key("sparse_behind_share").Value(evaluation.sparse_depth.BehindShare())
       .Key("sparse_undrawn_share").Value(evaluation.sparse_depth.UndrawnShare())
       .Key("sparse_depth_tolerance_voxels").Value(2.0)
+      .Key("sparse_depth_tolerance").Value(evaluation.sparse_depth_tolerance)
       .EndObject();
   return json.str();
 }
@@ -265,6 +293,7 @@ HoldoutEvaluation EvaluateHeldOutViews(const CarveRequest& request, const Holdou
   const VoxelGrid grid(pipeline.project().bounds.box, request.options.resolution);
   HoldoutEvaluation evaluation;
   evaluation.render = options.render;
+  evaluation.sparse_depth_tolerance = SparseDepthTolerance(grid);
   ScoredModel scored;
   scored.point_size = grid.voxel_size();
   scored.held_out_points = &pipeline.project().held_out_points;
@@ -296,6 +325,7 @@ HoldoutEvaluation EvaluateHeldOutViews(const CarveRequest& request, const Holdou
       exporter::WriteMeshPly(scored.model.mesh, (out / "mesh.ply").string());
       evaluation.wrote_mesh = true;
     }
+    WriteTextFileAtomically((out / "sparse_depth.csv").string(), SparseDepthCsv(evaluation));
     WriteTextFileAtomically((out / "holdout.json").string(),
                             HoldoutJson(options, pipeline, scored, evaluation));
   });

@@ -29,6 +29,7 @@ struct HeldOutViewScore {
   // The model's depth against the sparse points this view saw (inside the volume, triangulated
   // from two or more other photos), within two voxels.
   exporter::SparseDepthAgreement sparse_depth;
+  std::vector<exporter::SparsePointDepth> sparse_points;  // each point counted, with its verdict
 };
 
 struct HoldoutEvaluation {
@@ -44,7 +45,8 @@ struct HoldoutEvaluation {
   double mean_volume_iou = -1.0;
   // Over every held-out view's sparse points together (SparseDepthAgreement).
   exporter::SparseDepthAgreement sparse_depth;
-  std::string output_folder;  // <output>/holdout: holdout.json, <view>.png, mesh.ply
+  double sparse_depth_tolerance = 0.0;  // two voxels, in the model's units
+  std::string output_folder;  // <output>/holdout: holdout.json, sparse_depth.csv, <view>.png, mesh.ply
 };
 
 // Loads the project holding out every options.every-th photo (their sparse observations too),

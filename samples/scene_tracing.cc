@@ -251,6 +251,33 @@ bool RoomHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
   return point->z() >= 0.0 && point->z() <= kRoomHeight;
 }
 
+double FirstSolidDistance(const SceneGeometry& g, Backdrop backdrop, const Eigen::Vector3d& origin,
+                          const Eigen::Vector3d& direction) {
+  const Hit hit = Trace(g, origin, direction);
+  if (hit.surface != Surface::kNone) return hit.t;
+  const bool down = direction.z() < 0.0 && origin.z() > 0.0;
+  const double to_plane = down ? -origin.z() / direction.z() : kInfinity;
+  const double plane_radius =
+      down ? (origin + to_plane * direction).head<2>().norm() : kInfinity;
+  switch (backdrop) {
+    case Backdrop::kRoom: {
+      Eigen::Vector3d point;
+      return RoomHit(origin, direction, &point) ? (point - origin).norm() : kInfinity;
+    }
+    case Backdrop::kCloudy:
+      return to_plane;
+    case Backdrop::kTwoTone:
+    case Backdrop::kShadowedTable:
+      return plane_radius < 14.0 ? to_plane : kInfinity;
+    case Backdrop::kPatchwork:
+    case Backdrop::kUniform:
+    case Backdrop::kGradient:
+    case Backdrop::kVignetted:
+      return kInfinity;
+  }
+  return kInfinity;
+}
+
 Eigen::Vector3d RoomColour(const Eigen::Vector3d& point) {
   const Eigen::Vector3d noise(ValueNoise(point, 0.15, 11), ValueNoise(point, 0.15, 12),
                               ValueNoise(point, 0.15, 13));

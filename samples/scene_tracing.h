@@ -64,6 +64,12 @@ struct Hit {
 
 // The first surface a ray from `origin` along `direction` (unit) meets.
 Hit Trace(const SceneGeometry& g, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction);
+// How far along a ray from `origin` (inside the room, above the ground) along `direction` (unit)
+// the first solid surface lies: the objects and the ground square (Trace), or what the backdrop
+// puts behind them that a model may hold (the room's floor and wall, the table plane out to a
+// radius of 14, the field); infinity where the ray meets only sky or a backdrop at infinity.
+double FirstSolidDistance(const SceneGeometry& g, Backdrop backdrop, const Eigen::Vector3d& origin,
+                          const Eigen::Vector3d& direction);
 // The room's wall or floor colour at `point` (--backdrop room).
 Eigen::Vector3d RoomColour(const Eigen::Vector3d& point);
 // A surface's colour at a hit; `detail` adds the non-repeating noise of --texture detailed.

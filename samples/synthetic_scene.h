@@ -149,6 +149,9 @@ std::vector<Eigen::Vector3d> SampleRoomSurface(const SyntheticScene& scene,
                                                uint64_t seed,
                                                int min_views);
 
+// The objects of options.scene (the photos are not rendered).
+std::shared_ptr<const SceneGeometry> MakeSceneGeometry(const SyntheticSceneOptions& options);
+
 // Generates the scene; the same options always give the same scene, bit for bit.
 SyntheticScene GenerateSyntheticScene(const SyntheticSceneOptions& options);
 

@@ -10,7 +10,10 @@
 #     at two voxels (raycarve compare --bbox);
 #   - held-out photos: PSNR over the whole photo and inside the truth's silhouettes (the exact
 #     masks, kept apart from the project), and the share of their sparse points (triangulated from
-#     the other photos) the mesh draws at their depth and hides behind something nearer.
+#     the other photos) the mesh draws at their depth and hides behind something nearer; and, as
+#     the truth is known, how many of those points the truth itself hides (wrong matches, points
+#     triangulated off an occluding contour) and the share the mesh hides of those the truth
+#     shows at their depth (samples/truth_sparse_depth on holdout's sparse_depth.csv).
 # Prints a Markdown table and writes out/unmasked_table/table.json.
 #
 # With --sift_points the sparse points are COLMAP's instead of exact samples of the truth
@@ -34,7 +37,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 width=${size%x*} height=${size#*x}
-scripts/setup.sh raycarve >&2
+scripts/setup.sh raycarve truth_sparse_depth >&2
 rc=build/plugin/raycarve
 out=out/unmasked_table
 [ "$sift" = 1 ] && out=out/unmasked_table_sift
@@ -71,6 +74,9 @@ for scene in "room ring" "room arc" "room forward" "patchwork ring" "patchwork a
     # saw): what the photos show of the scene's objects and ground.
     $rc holdout --workspace_path "$dir/scene" --output_path "$dir/$run/truth_scored" --every 4 $flags \
       --score_mask_path "$dir/truth_masks" > "$dir.$run.holdout_truth.log" 2>&1
+    tolerance=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["sparse_depth_tolerance"])' "$dir/$run/holdout/holdout.json")
+    build/samples/truth_sparse_depth "$dir/scene" "$dir/$run/holdout/sparse_depth.csv" "$tolerance" \
+      "$kind" "$backdrop" | tail -1 > "$dir/$run/truth_sparse_depth.json"
     python3 - "$name" "$run" "$dir/$run" >> "$rows" <<'EOF'
 import json, sys
 name, run, folder = sys.argv[1:4]
@@ -78,6 +84,7 @@ report = json.load(open(folder + "/report.json"))
 compare = json.load(open(folder + "/compare.json"))
 holdout = json.load(open(folder + "/holdout/holdout.json"))
 truth_scored = json.load(open(folder + "/truth_scored/holdout/holdout.json"))
+truth_depth = json.load(open(folder + "/truth_sparse_depth.json"))
 def find(obj, key):
     if isinstance(obj, dict):
         if key in obj:
@@ -95,7 +102,10 @@ print(json.dumps({
     "f_score": find(compare, "f_score"),
     "psnr_db": holdout["mean_psnr_db"], "psnr_in_truth_db": truth_scored["mean_psnr_db"],
     "silhouette_iou": truth_scored["mean_silhouette_iou"], "sparse_points": holdout["sparse_points"],
-    "at_depth": holdout["sparse_at_depth_share"], "hidden": holdout["sparse_hidden_share"]}))
+    "at_depth": holdout["sparse_at_depth_share"], "hidden": holdout["sparse_hidden_share"],
+    "truth_hidden": truth_depth["truth_hidden_share"],
+    "hidden_of_truth_at_depth": truth_depth["model_hidden_of_truth_at_depth"],
+    "at_depth_of_truth_at_depth": truth_depth["model_at_depth_of_truth_at_depth"]}))
 EOF
   done
 done
@@ -103,12 +113,13 @@ python3 - "$rows" "$out/table.json" <<'EOF'
 import json, sys
 rows = [json.loads(line) for line in open(sys.argv[1])]
 json.dump(rows, open(sys.argv[2], "w"), indent=1)
-print("| scene | run | capture (box) | on box walls | precision | completeness | F-score | held-out PSNR, whole / in truth | sparse at depth | hidden |")
-print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|")
+print("| scene | run | capture (box) | on box walls | precision | completeness | F-score | held-out PSNR, whole / in truth | sparse at depth | hidden (the truth hides) | of those the truth shows: at depth / hidden |")
+print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
 for r in rows:
-    print("| %s | %s | %s%s | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.2f / %.2f dB | %.1f%% | %.1f%% |" % (
+    print("| %s | %s | %s%s | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.2f / %.2f dB | %.1f%% | %.1f%% (%.1f%%) | %.1f%% / %.1f%% |" % (
         r["scene"], r["run"], r["capture"], " (focus)" if r["around_focus"] else "",
         100 * r["box_wall_share"], 100 * r["precision"], 100 * r["completeness"],
         100 * r["f_score"], r["psnr_db"], r["psnr_in_truth_db"], 100 * r["at_depth"],
-        100 * r["hidden"]))
+        100 * r["hidden"], 100 * r["truth_hidden"], 100 * r["at_depth_of_truth_at_depth"],
+        100 * r["hidden_of_truth_at_depth"]))
 EOF

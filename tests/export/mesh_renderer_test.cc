@@ -61,8 +61,22 @@ TEST(MeasureSparseDepth, PointsAtTheDrawnDepthBehindItInFrontOfItAndOutside) {
       at(35.5, 25.5, 4.0),   // where nothing is drawn
       at(45.5, 10.5, 4.0),   // outside the frame: not counted
       Eigen::Vector3d(0, 0, -3)};  // behind the camera: not counted
-  const SparseDepthAgreement agreement = MeasureSparseDepth(rendering, view, points, 0.5);
+  std::vector<SparsePointDepth> records;
+  const SparseDepthAgreement agreement = MeasureSparseDepth(rendering, view, points, 0.5, &records);
   EXPECT_EQ(agreement.points, 5);
+  // Each point counted, in the order given, with its verdict and both depths.
+  ASSERT_EQ(records.size(), 5u);
+  const SparseDepthVerdict expected[] = {SparseDepthVerdict::kAtDepth, SparseDepthVerdict::kAtDepth,
+                                         SparseDepthVerdict::kHidden, SparseDepthVerdict::kBehind,
+                                         SparseDepthVerdict::kUndrawn};
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(records[i].verdict, expected[i]) << i;
+    EXPECT_TRUE(records[i].point.isApprox(points[i])) << i;
+    EXPECT_NEAR(records[i].depth, view.Depth(points[i]), 1e-9) << i;
+  }
+  EXPECT_NEAR(records[2].drawn_depth, 4.0, 1e-3);
+  EXPECT_TRUE(std::isinf(records[4].drawn_depth));
+  EXPECT_STREQ(SparseDepthVerdictName(records[2].verdict), "hidden");
   EXPECT_EQ(agreement.at_depth, 2);
   EXPECT_EQ(agreement.hidden, 1);
   EXPECT_EQ(agreement.behind, 1);

@@ -9,6 +9,7 @@
 
 #include "calib/input_error.h"
 #include "calib/model_reader.h"
+#include "samples/scene_tracing.h"
 #include "tests/test_support.h"
 #include "tests/scene_options.h"
 
@@ -267,6 +268,41 @@ TEST(SyntheticScene, ExposureAndHighlightsChangeThePhotosNotTheScene) {
     highlight = highlight || cv::countNonZero(changed.reshape(1)) > 20;
   }
   EXPECT_TRUE(highlight);
+}
+
+// The truth that holdout's sparse points are checked against (samples/truth_sparse_depth): the
+// first solid surface along a ray, the objects, the ground square and the backdrop's floor, table
+// or wall, and nothing where only sky lies ahead.
+TEST(SyntheticScene, FirstSolidDistanceMeetsTheObjectsTheGroundAndTheBackdropsSolids) {
+  using scene_tracing::FirstSolidDistance;
+  SyntheticSceneOptions options;
+  const std::shared_ptr<const SceneGeometry> g = MakeSceneGeometry(options);
+  const Eigen::Vector3d camera(0.0, -6.0, 1.0);
+  // Towards the sphere's centre: its near side, whatever the backdrop.
+  const Eigen::Vector3d to_sphere = scene_tracing::kSphereCentre - camera;
+  for (const Backdrop backdrop : {Backdrop::kPatchwork, Backdrop::kRoom, Backdrop::kCloudy}) {
+    EXPECT_NEAR(FirstSolidDistance(*g, backdrop, camera, to_sphere.normalized()),
+                to_sphere.norm() - scene_tracing::kSphereRadius, 1e-9);
+  }
+  // Straight down onto the ground square, beside the objects.
+  EXPECT_NEAR(FirstSolidDistance(*g, Backdrop::kPatchwork, Eigen::Vector3d(1.2, -1.2, 1.0),
+                                 -Eigen::Vector3d::UnitZ()),
+              1.0, 1e-9);
+  // Level, away from the scene: the room's wall 3 away (radius 9), sky in the patchwork.
+  const Eigen::Vector3d away = -Eigen::Vector3d::UnitY();
+  EXPECT_NEAR(FirstSolidDistance(*g, Backdrop::kRoom, camera, away), 3.0, 1e-9);
+  EXPECT_TRUE(std::isinf(FirstSolidDistance(*g, Backdrop::kPatchwork, camera, away)));
+  // Down at 45 degrees away from the scene: the field (or the room's floor) beyond the square.
+  const Eigen::Vector3d down = Eigen::Vector3d(0.0, -1.0, -1.0).normalized();
+  EXPECT_NEAR(FirstSolidDistance(*g, Backdrop::kCloudy, camera, down), std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(FirstSolidDistance(*g, Backdrop::kRoom, camera, down), std::sqrt(2.0), 1e-9);
+  EXPECT_TRUE(std::isinf(FirstSolidDistance(*g, Backdrop::kPatchwork, camera, down)));
+  // The studio table reaches a radius of 14: met at y = -11, not at y = -26.
+  const Eigen::Vector3d steep = Eigen::Vector3d(0.0, -1.0, -0.2).normalized();
+  const Eigen::Vector3d shallow = Eigen::Vector3d(0.0, -1.0, -0.05).normalized();
+  EXPECT_NEAR(FirstSolidDistance(*g, Backdrop::kTwoTone, camera, steep), 5.0 * std::sqrt(1.04), 1e-9);
+  EXPECT_TRUE(std::isinf(FirstSolidDistance(*g, Backdrop::kTwoTone, camera, shallow)));
+  EXPECT_TRUE(std::isinf(FirstSolidDistance(*g, Backdrop::kUniform, camera, steep)));
 }
 
 }  // namespace

@@ -169,6 +169,26 @@ std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid&
   return on_wall;
 }
 
+std::vector<uint8_t> UncoveredVertices(const TriangleMesh& mesh,
+                                       const std::vector<CalibratedView>& views, int min_views) {
+  std::vector<uint8_t> uncovered(mesh.vertices.size(), 0);
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
+    int frames = 0;
+    for (const CalibratedView& view : views) {
+      if (!(view.Depth(p) > 0.0)) continue;
+      const Eigen::Vector2d pixel = view.Project(p);
+      const int col = static_cast<int>(std::floor(pixel.x()));
+      const int row = static_cast<int>(std::floor(pixel.y()));
+      if (col < 0 || row < 0 || col >= view.width || row >= view.height) continue;
+      if (!view.valid.empty() && view.valid.at<uint8_t>(row, col) == 0) continue;
+      if (++frames >= min_views) break;
+    }
+    uncovered[i] = frames < min_views;
+  }
+  return uncovered;
+}
+
 std::vector<uint8_t> GroundFillVertices(const TriangleMesh& mesh, const Ground& ground,
                                         double voxel_size) {
   std::vector<uint8_t> fill(mesh.vertices.size(), 0);
@@ -316,25 +336,39 @@ void RefineModel(const std::vector<CalibratedView>& views, const VoxelGrid& grid
 
 // The walls are found on the final geometry and left out before colouring, so that the colour
 // figures describe the mesh written.
-void MarkAndRemoveWalls(const VoxelGrid& grid, const ModelMeshOptions& options, ModelMesh* model) {
+void MarkAndRemoveWalls(const VoxelGrid& grid, const std::vector<CalibratedView>& views,
+                        const ModelMeshOptions& options, ModelMesh* model) {
   model->on_grid_wall = GridWallVertices(model->mesh, grid);
   model->grid_wall_vertices =
       std::count(model->on_grid_wall.begin(), model->on_grid_wall.end(), uint8_t{1});
   if (!options.remove_grid_walls) return;
   const std::vector<uint8_t> fill =
       GroundFillVertices(model->mesh, options.ground, grid.voxel_size());
-  for (const Eigen::Vector3i& t : model->mesh.triangles) {
-    const bool on_wall =
-        model->on_grid_wall[t[0]] && model->on_grid_wall[t[1]] && model->on_grid_wall[t[2]];
-    model->ground_fill_triangles_removed += !on_wall && fill[t[0]] && fill[t[1]] && fill[t[2]];
+  const std::vector<uint8_t> uncovered = UncoveredVertices(model->mesh, views, options.min_views);
+  const auto all = [](const std::vector<uint8_t>& marks, const Eigen::Vector3i& t) {
+    return marks[t[0]] && marks[t[1]] && marks[t[2]];
+  };
+  std::vector<uint8_t> wall_or_fill = model->on_grid_wall, any = model->on_grid_wall;
+  for (size_t i = 0; i < fill.size(); ++i) {
+    wall_or_fill[i] |= fill[i];
+    any[i] |= fill[i] | uncovered[i];
   }
-  for (size_t i = 0; i < fill.size(); ++i) model->on_grid_wall[i] |= fill[i];
+  for (const Eigen::Vector3i& t : model->mesh.triangles) {
+    const bool on_wall = all(model->on_grid_wall, t);
+    model->ground_fill_triangles_removed += !on_wall && all(fill, t);
+    model->uncovered_triangles_removed += !all(wall_or_fill, t) && all(any, t);
+  }
+  model->on_grid_wall = std::move(any);
   RemoveGridWalls(model, options.sparse_points, 1.5 * grid.voxel_size());
-  if (model->wall_sliver_triangles_removed > 0 || model->ground_fill_triangles_removed > 0) {
+  if (model->wall_sliver_triangles_removed > 0 || model->ground_fill_triangles_removed > 0 ||
+      model->uncovered_triangles_removed > 0) {
     Tell(options, "mesh walls: " + std::to_string(model->wall_triangles_removed) +
                       " triangles on the volume box's walls left out (" +
                       std::to_string(model->ground_fill_triangles_removed) +
-                      " more of the held ground's sides and underside), then " +
+                      " more of the held ground's sides and underside, " +
+                      std::to_string(model->uncovered_triangles_removed) +
+                      " beyond the frames of all but " + std::to_string(options.min_views - 1) +
+                      " photo), then " +
                       std::to_string(model->wall_sliver_triangles_removed) +
                       " triangles of slivers only the walls held to the model (no sparse point "
                       "on them)");
@@ -401,7 +435,7 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     model.self_intersections = UndoSelfIntersections(unrefined, &model.mesh);
     Tell(options, "mesh self-intersections: " + model.self_intersections.Summary());
   }
-  MarkAndRemoveWalls(grid, options, &model);
+  MarkAndRemoveWalls(grid, views, options, &model);
   ColourModel(views, grid, options, &model);
   return model;
 }

@@ -94,6 +94,8 @@ struct ModelMeshOptions {
   // where the box cuts. The box comes from the sparse points with a margin, so it does not lie
   // on a surface they saw. false: kept, the mesh closed by the box.
   bool remove_grid_walls = true;
+  // With remove_grid_walls, the surface beyond the photos' frames (UncoveredVertices with
+  // min_views) is left out with the walls too.
   // The ground the carve held (CarveOptions::ground): with remove_grid_walls, the held solid's
   // sides and underside below the plane (GroundFillVertices) are left out with the walls: they
   // stand for no surface the photos saw. Empty: none.
@@ -135,6 +137,9 @@ struct ModelMesh {
   // Of wall_triangles_removed, those of the ground's fill (all three corners GroundFillVertices)
   // that were not on the walls as well.
   int64_t ground_fill_triangles_removed = 0;
+  // Of wall_triangles_removed, those beyond the photos' frames (all three corners
+  // UncoveredVertices) that were neither on the walls nor of the ground's fill.
+  int64_t uncovered_triangles_removed = 0;
 };
 
 // Leaves out the triangles whose three corners are on the grid's wall (model->on_grid_wall),
@@ -143,6 +148,14 @@ struct ModelMesh {
 // the vertices no triangle uses any more (with their per-vertex data), counting them.
 void RemoveGridWalls(ModelMesh* model, const std::vector<Eigen::Vector3d>& anchors = {},
                      double anchor_radius = 0.0);
+// Per vertex of `mesh`, 1 where fewer than `min_views` of `views` hold it in their frames (in
+// front of the camera, on a pixel of the photo), occlusion aside. The carve never judged what lies
+// there (a voxel that fewer than min_views views see is kept), so a surface there is the edge of
+// what the photos cover, as the box's walls are where the box cuts the scene: not a surface the
+// photos saw. Inside the box of a capture from one side (a scene), the space near the cameras and
+// beside their frames is such; an object's box is held by every photo of a ring.
+std::vector<uint8_t> UncoveredVertices(const TriangleMesh& mesh,
+                                       const std::vector<CalibratedView>& views, int min_views);
 // Per vertex of `mesh` (with normals), 1 where it lies on the wall of `grid` (see
 // ModelMesh::on_grid_wall).
 std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid& grid);

@@ -514,6 +514,27 @@ TEST(CarveExport, TheHeldGroundsSidesAndUndersideAreFillAndItsTopIsNot) {
   EXPECT_EQ(std::count(none.begin(), none.end(), uint8_t{1}), 0);
 }
 
+
+TEST(CarveExport, VerticesBeyondTheFramesOfAllButOnePhotoAreUncovered) {
+  // Two photos facing each other across the origin, 100 px square with a focal length of 100 px:
+  // each frame holds what lies within half its depth of its axis.
+  std::vector<CalibratedView> views = {
+      testing::PinholeViewLookingAtOrigin(Eigen::Vector3d(0, 0, 5), 100, 100, 100.0),
+      testing::PinholeViewLookingAtOrigin(Eigen::Vector3d(0, 0, -5), 100, 100, 100.0)};
+  TriangleMesh mesh;
+  mesh.vertices = {
+      {0.0f, 0.0f, 0.0f},   // in both frames
+      {2.0f, 0.0f, 0.0f},   // in both, near their edges
+      {3.0f, 0.0f, 0.0f},   // beside both
+      {2.2f, 0.0f, 2.0f},   // beside the near photo's frame, in the far one's
+      {0.0f, 0.0f, 6.0f}};  // behind the near photo, in the far one's frame
+  EXPECT_EQ(UncoveredVertices(mesh, views, 2), (std::vector<uint8_t>{0, 0, 1, 1, 1}));
+  EXPECT_EQ(UncoveredVertices(mesh, views, 1), (std::vector<uint8_t>{0, 0, 1, 0, 0}));
+  // A pixel beyond the distorted frame (`valid` 0) holds nothing of the photo.
+  views[1].valid.setTo(0);
+  EXPECT_EQ(UncoveredVertices(mesh, views, 1), (std::vector<uint8_t>{0, 0, 1, 1, 1}));
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

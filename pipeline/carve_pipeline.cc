@@ -401,6 +401,7 @@ void CarvePipeline::MakeSurface() {
   run_.mesh_small_components_removed = model_.small_components_removed;
   run_.mesh_grid_wall_vertices = model_.grid_wall_vertices;
   run_.mesh_wall_triangles_removed = model_.wall_triangles_removed;
+  run_.mesh_uncovered_triangles_removed = model_.uncovered_triangles_removed;
   run_.mesh_triangles_before_walls = model_.triangles_before_walls;
   RecordSeconds("mesh", SecondsSince(start));
 }

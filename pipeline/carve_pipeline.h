@@ -114,11 +114,16 @@ struct CarveRun {
   int64_t mesh_small_components_removed = 0;
   int64_t mesh_grid_wall_vertices = 0;  // on the grid's wall: left out of the cloud
   int64_t mesh_wall_triangles_removed = 0;  // left out of the mesh (on the wall, no sparse point)
+  // Of those, the ones beyond the frames of all but one photo (ModelMesh::uncovered_...).
+  int64_t mesh_uncovered_triangles_removed = 0;
   int64_t mesh_triangles_before_walls = 0;
-  // The share of the mesh's triangles that lay on the box's walls and were left out (0 when none).
+  // The share of the mesh's triangles that lay on the box's walls and were left out (0 when none),
+  // those beyond the photos' frames aside.
   double WallShare() const {
     return mesh_triangles_before_walls > 0
-               ? static_cast<double>(mesh_wall_triangles_removed) / mesh_triangles_before_walls
+               ? static_cast<double>(mesh_wall_triangles_removed -
+                                     mesh_uncovered_triangles_removed) /
+                     mesh_triangles_before_walls
                : 0.0;
   }
   // Cloud.

@@ -84,7 +84,9 @@ std::string MeshShape(const CarveRun& run) {
       t.self_intersecting_pairs == 0) {
     // Where two removed stretches of wall meet at a corner, two sheets of surface touch at a
     // vertex: said, not hidden.
-    return "open where the box cuts the scene" +
+    return std::string(run.mesh_uncovered_triangles_removed > 0
+                           ? "open where the box cuts the scene and beyond the photos' frames"
+                           : "open where the box cuts the scene") +
            (t.non_manifold_vertices > 0
                 ? " (" + std::to_string(t.non_manifold_vertices) +
                       (t.non_manifold_vertices == 1 ? " vertex" : " vertices") +
@@ -378,6 +380,11 @@ void AppendAfterSummary(const CarveRequest& request, const CarveRun& run, std::s
       Appendf(text, "                  %.1f%% of the surface lay on the volume box's walls, where the "
                   "box cuts the scene: left out of the mesh and the cloud\n",
                   100.0 * run.WallShare());
+      if (run.mesh_uncovered_triangles_removed > 0) {
+        Appendf(text, "                  %lld triangles beyond the frames of all but one photo "
+                    "(never judged, kept solid by the carve): left out of the mesh\n",
+                    static_cast<long long>(run.mesh_uncovered_triangles_removed));
+      }
     } else if (run.mesh_grid_wall_vertices > 0) {
       Appendf(text, "                  %lld vertices on the volume box's walls, where the box cuts the "
                   "scene: in the mesh, left out of the cloud\n",

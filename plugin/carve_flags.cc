@@ -97,7 +97,7 @@ void AddCarvingFlags(OptionParser* parser, CarveRequest* request, CarveFlagText*
                      "without masks, where the ground is held: where a photo's pattern moves "
                      "between the photos as the ground's plane does (and as nothing in front of "
                      "it would), its rays saw the floor: carve them before colouring, down to "
-                     "two voxels above the ground");
+                     "the band of the ground plane's sparse points");
   parser->AddDefault("floater_expected_points", &request->options.unsupported_component_points,
                      "carve a piece of the model (26-connected, under a quarter of the largest) "
                      "that holds no reliable sparse point where the points' density on the model "

@@ -7,9 +7,37 @@
 
 #include <glog/logging.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace raycarve {
 namespace exporter {
+
+cv::Mat SsimMap(const cv::Mat& a, const cv::Mat& b) {
+  CHECK(a.type() == CV_8UC3 && b.type() == CV_8UC3 && a.size() == b.size());
+  const double c1 = std::pow(0.01 * 255.0, 2.0), c2 = std::pow(0.03 * 255.0, 2.0);
+  const auto blur = [](const cv::Mat& m) {
+    cv::Mat out;
+    cv::GaussianBlur(m, out, cv::Size(11, 11), 1.5, 1.5, cv::BORDER_REFLECT);
+    return out;
+  };
+  std::vector<cv::Mat> xs, ys;
+  cv::split(a, xs);
+  cv::split(b, ys);
+  cv::Mat sum(a.size(), CV_32FC1, cv::Scalar(0));
+  for (int k = 0; k < 3; ++k) {
+    cv::Mat x, y;
+    xs[k].convertTo(x, CV_32FC1);
+    ys[k].convertTo(y, CV_32FC1);
+    const cv::Mat mx = blur(x), my = blur(y);
+    const cv::Mat mx2 = mx.mul(mx), my2 = my.mul(my), mxy = mx.mul(my);
+    const cv::Mat vx = blur(x.mul(x)) - mx2, vy = blur(y.mul(y)) - my2;
+    const cv::Mat cxy = blur(x.mul(y)) - mxy;
+    cv::Mat map;
+    cv::divide((2.0 * mxy + c1).mul(2.0 * cxy + c2), (mx2 + my2 + c1).mul(vx + vy + c2), map);
+    sum += map;
+  }
+  return sum / 3.0;
+}
 
 HoldoutScore ScoreRendering(const Rendering& rendering, const CalibratedView& view) {
   HoldoutScore score;
@@ -32,6 +60,9 @@ HoldoutScore ScoreRendering(const Rendering& rendering, const CalibratedView& vi
   const double mse = score.scored_pixels == 0 ? 0.0 : squared / (3.0 * score.scored_pixels);
   score.psnr = mse == 0.0 ? std::numeric_limits<double>::infinity()
                           : 10.0 * std::log10(255.0 * 255.0 / mse);
+  if (score.scored_pixels > 0) {
+    score.ssim = cv::mean(SsimMap(view.image, rendering.image), region)[0];
+  }
   if (!view.mask.empty()) {
     const cv::Mat object = view.mask & view.valid;
     const cv::Mat drawn = rendering.silhouette & view.valid;

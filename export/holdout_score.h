@@ -19,7 +19,15 @@ struct HoldoutScore {
   int scored_pixels = 0;        // the union of the rendered silhouette and the photo's object
                                 // mask when it has one; otherwise every pixel with photo data
   double silhouette_iou = -1.0; // rendered silhouette vs the photo's mask; -1 without a mask
+  // Structural similarity (Wang, Bovik, Sheikh and Simoncelli 2004: Gaussian window of sigma 1.5
+  // pixels, C1 = (0.01 * 255)^2, C2 = (0.03 * 255)^2), per RGB channel, its map averaged over the
+  // scored pixels and the channels: 1 for the photo itself. Unlike PSNR it does not prefer a flat
+  // mean colour to the photo's pattern drawn a pixel or two off.
+  double ssim = 0.0;
 };
+
+// The SSIM map of two images of one size (CV_8UC3), the mean of the channels' maps (CV_32FC1).
+cv::Mat SsimMap(const cv::Mat& a, const cv::Mat& b);
 
 // Scores `rendering` against `view` (its undistorted photo, valid pixels and mask).
 HoldoutScore ScoreRendering(const Rendering& rendering, const CalibratedView& view);

@@ -156,13 +156,14 @@ HeldOutViewScore ScoreView(const ScoredModel& scored,
 }
 
 void AverageScores(HoldoutEvaluation* evaluation) {
-  double psnr = 0.0, iou = 0.0, block = 0.0, volume_psnr = 0.0, volume_iou = 0.0;
+  double psnr = 0.0, ssim = 0.0, iou = 0.0, block = 0.0, volume_psnr = 0.0, volume_iou = 0.0;
   for (const HeldOutViewScore& view : evaluation->views) {
     evaluation->sparse_depth.points += view.sparse_depth.points;
     evaluation->sparse_depth.at_depth += view.sparse_depth.at_depth;
     evaluation->sparse_depth.hidden += view.sparse_depth.hidden;
     evaluation->sparse_depth.behind += view.sparse_depth.behind;
     psnr += view.score.psnr;
+    ssim += view.score.ssim;
     block += view.block_psnr;
     volume_psnr += view.volume_score.psnr;
     volume_iou += std::max(0.0, view.volume_score.silhouette_iou);
@@ -173,6 +174,7 @@ void AverageScores(HoldoutEvaluation* evaluation) {
   }
   const double n = static_cast<double>(evaluation->views.size());
   evaluation->mean_psnr = psnr / n;
+  evaluation->mean_ssim = ssim / n;
   evaluation->mean_block_psnr = block / n;
   evaluation->mean_volume_psnr = volume_psnr / n;
   evaluation->mean_iou = evaluation->iou_views > 0 ? iou / evaluation->iou_views : -1.0;
@@ -234,6 +236,7 @@ std::string HoldoutJson(const HoldoutOptions& options,
     json.BeginObject()
         .Key("name").Value(view.name)
         .Key("psnr_db").Value(view.score.psnr)
+        .Key("ssim").Value(view.score.ssim)
         .Key("scored_pixels").Value(view.score.scored_pixels)
         .Key("silhouette_iou").Value(view.score.silhouette_iou)
         .Key("uncoloured_pixels").Value(view.uncoloured_pixels)
@@ -250,6 +253,7 @@ std::string HoldoutJson(const HoldoutOptions& options,
   }
   json.EndArray();
   json.Key("mean_psnr_db").Value(evaluation.mean_psnr)
+      .Key("mean_ssim").Value(evaluation.mean_ssim)
       .Key("mean_silhouette_iou").Value(evaluation.mean_iou)
       .Key("mean_block_mean_psnr_db").Value(evaluation.mean_block_psnr)
       .Key("mean_volume_psnr_db").Value(evaluation.mean_volume_psnr)

@@ -38,6 +38,7 @@ struct HoldoutEvaluation {
   bool wrote_mesh = false;
   std::vector<HeldOutViewScore> views;  // in name order
   double mean_psnr = 0.0;
+  double mean_ssim = 0.0;
   int iou_views = 0;             // views with a mask (silhouette IoU)
   double mean_iou = -1.0;        // -1: no masks
   double mean_block_psnr = 0.0;

@@ -12,19 +12,19 @@ namespace {
 
 // The table of held-out views and the means.
 void PrintEvaluation(const HoldoutEvaluation& evaluation) {
-  std::printf("%-24s %10s %12s %10s %16s\n", "held-out view", "PSNR dB", "scored px", "sil. IoU",
-              "block PSNR dB");
+  std::printf("%-24s %10s %8s %12s %10s %16s\n", "held-out view", "PSNR dB", "SSIM",
+              "scored px", "sil. IoU", "block PSNR dB");
   for (const HeldOutViewScore& view : evaluation.views) {
-    std::printf("%-24s %10.2f %12d %10.3f %10.2f (%dx%d)\n", view.name.c_str(), view.score.psnr,
-                view.score.scored_pixels, view.score.silhouette_iou, view.block_psnr, view.block,
-                view.block);
+    std::printf("%-24s %10.2f %8.3f %12d %10.3f %10.2f (%dx%d)\n", view.name.c_str(),
+                view.score.psnr, view.score.ssim, view.score.scored_pixels,
+                view.score.silhouette_iou, view.block_psnr, view.block, view.block);
   }
   const bool masks = evaluation.iou_views > 0;
-  std::printf("mean over %zu held-out views: PSNR %.2f dB, silhouette IoU %s\n"
+  std::printf("mean over %zu held-out views: PSNR %.2f dB, SSIM %.3f, silhouette IoU %s\n"
               "block PSNR: each photo against its own means over blocks a voxel wide, on the "
               "object: about the most one colour per voxel can score (mean %.2f dB)\n"
               "wrote %s/holdout.json, %s/<view>.png (photo | render | error x4)%s\n",
-              evaluation.views.size(), evaluation.mean_psnr,
+              evaluation.views.size(), evaluation.mean_psnr, evaluation.mean_ssim,
               masks ? std::to_string(evaluation.mean_iou).c_str() : "n/a (no masks)",
               evaluation.mean_block_psnr, evaluation.output_folder.c_str(),
               evaluation.output_folder.c_str(), evaluation.wrote_mesh ? " and mesh.ply" : "");
@@ -55,9 +55,10 @@ int RunHoldout(int argc, char** argv) {
   OptionParser parser(
       "holdout",
       "Held-out evaluation: carves the project without every k-th view, renders the carved model "
-      "into the left-out views, and reports PSNR (over the rendered and the true silhouette where "
-      "there is a mask, else over the whole photo) and silhouette IoU; writes photo | render | "
-      "error images to <output>/holdout/ and holdout.json.");
+      "into the left-out views, and reports PSNR and SSIM (over the rendered and the true "
+      "silhouette where there is a mask, else over the whole photo), silhouette IoU and the share "
+      "of the views' sparse points drawn at their depth; writes photo | render | error images to "
+      "<output>/holdout/, holdout.json and sparse_depth.csv.");
   AddCarveFlags(&parser, &request, &text);
   parser.BeginGroup("Held-out photos");
   parser.AddDefault("every", &options.every, "leave out views 1, 1 + k, 1 + 2k, ... (k >= 2)");

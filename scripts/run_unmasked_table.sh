@@ -8,9 +8,10 @@
 #   - the cloud against the scene's truth (truth.ply: the objects, the ground square, the clutter
 #     and the room's floor and wall) inside the volume carved: precision, completeness and F-score
 #     at two voxels (raycarve compare --bbox);
-#   - held-out photos: PSNR over the whole photo and inside the truth's silhouettes (the exact
-#     masks, kept apart from the project), and the share of their sparse points (triangulated from
-#     the other photos) the mesh draws at their depth and hides behind something nearer; and, as
+#   - held-out photos: PSNR over the whole photo, PSNR and SSIM inside the truth's silhouettes
+#     (the exact masks, kept apart from the project), and the share of their sparse points
+#     (triangulated from the other photos) the mesh draws at their depth and hides behind
+#     something nearer; and, as
 #     the truth is known, how many of those points the truth itself hides (wrong matches, points
 #     triangulated off an occluding contour) and the share the mesh hides of those the truth
 #     shows at their depth (samples/truth_sparse_depth on holdout's sparse_depth.csv).
@@ -101,6 +102,7 @@ print(json.dumps({
     "precision": find(compare, "precision"), "completeness": find(compare, "completeness"),
     "f_score": find(compare, "f_score"),
     "psnr_db": holdout["mean_psnr_db"], "psnr_in_truth_db": truth_scored["mean_psnr_db"],
+    "ssim_in_truth": truth_scored["mean_ssim"],
     "silhouette_iou": truth_scored["mean_silhouette_iou"], "sparse_points": holdout["sparse_points"],
     "at_depth": holdout["sparse_at_depth_share"], "hidden": holdout["sparse_hidden_share"],
     "truth_hidden": truth_depth["truth_hidden_share"],
@@ -113,13 +115,14 @@ python3 - "$rows" "$out/table.json" <<'EOF'
 import json, sys
 rows = [json.loads(line) for line in open(sys.argv[1])]
 json.dump(rows, open(sys.argv[2], "w"), indent=1)
-print("| scene | run | capture (box) | on box walls | precision | completeness | F-score | held-out PSNR, whole / in truth | sparse at depth | hidden (the truth hides) | of those the truth shows: at depth / hidden |")
-print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+print("| scene | run | capture (box) | on box walls | precision | completeness | F-score | held-out PSNR, whole / in truth | SSIM in truth | sparse at depth | hidden (the truth hides) | of those the truth shows: at depth / hidden |")
+print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
 for r in rows:
-    print("| %s | %s | %s%s | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.2f / %.2f dB | %.1f%% | %.1f%% (%.1f%%) | %.1f%% / %.1f%% |" % (
+    print("| %s | %s | %s%s | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.2f / %.2f dB | %.3f | %.1f%% | %.1f%% (%.1f%%) | %.1f%% / %.1f%% |" % (
         r["scene"], r["run"], r["capture"], " (focus)" if r["around_focus"] else "",
         100 * r["box_wall_share"], 100 * r["precision"], 100 * r["completeness"],
-        100 * r["f_score"], r["psnr_db"], r["psnr_in_truth_db"], 100 * r["at_depth"],
+        100 * r["f_score"], r["psnr_db"], r["psnr_in_truth_db"], r["ssim_in_truth"],
+        100 * r["at_depth"],
         100 * r["hidden"], 100 * r["truth_hidden"], 100 * r["at_depth_of_truth_at_depth"],
         100 * r["hidden_of_truth_at_depth"]))
 EOF

@@ -68,6 +68,44 @@ TEST(HoldoutScore, PsnrOverTheSilhouettesAndTheirIou) {
   EXPECT_EQ(SideBySide(rendering, view).size(), cv::Size(300, 80));
 }
 
+TEST(HoldoutScore, SsimIsOneForThePhotoAndPrefersItsPatternShiftedToAFlatMean) {
+  CalibratedView view = View();  // 100x80
+  // Vertical stripes 6 px wide, 40 and 200 in every channel.
+  const auto stripes = [](int shift) {
+    cv::Mat image(80, 100, CV_8UC3);
+    for (int row = 0; row < 80; ++row) {
+      for (int col = 0; col < 100; ++col) {
+        const uint8_t v = ((col + shift) / 6) % 2 ? 200 : 40;
+        image.at<cv::Vec3b>(row, col) = cv::Vec3b(v, v, v);
+      }
+    }
+    return image;
+  };
+  view.image = stripes(0);
+  Rendering rendering;
+  rendering.silhouette = cv::Mat(80, 100, CV_8UC1, cv::Scalar(255));
+  rendering.image = view.image.clone();
+  EXPECT_NEAR(ScoreRendering(rendering, view).ssim, 1.0, 1e-6);
+  // The stripes two pixels off against their flat mean (120): PSNR prefers the flat mean (a third
+  // of the pixels off by 160 against all of them by 80), SSIM the stripes.
+  rendering.image = stripes(2);
+  const HoldoutScore shifted = ScoreRendering(rendering, view);
+  rendering.image.setTo(cv::Scalar(120, 120, 120));
+  const HoldoutScore flat = ScoreRendering(rendering, view);
+  EXPECT_LT(shifted.psnr, flat.psnr);
+  EXPECT_GT(shifted.ssim, 3.0 * flat.ssim);
+  EXPECT_LT(flat.ssim, 0.05);
+  // Scored over the union of silhouettes and mask, as PSNR: a mask on the left half, drawn
+  // exactly there and flat elsewhere, scores the left half only.
+  view.mask = cv::Mat(80, 100, CV_8UC1, cv::Scalar(0));
+  view.mask(cv::Rect(0, 0, 40, 80)).setTo(255);
+  rendering.silhouette.setTo(0);
+  rendering.silhouette(cv::Rect(0, 0, 40, 80)).setTo(255);
+  rendering.image = view.image.clone();
+  rendering.image(cv::Rect(50, 0, 50, 80)).setTo(cv::Scalar(120, 120, 120));
+  EXPECT_NEAR(ScoreRendering(rendering, view).ssim, 1.0, 1e-6);
+}
+
 TEST(HoldoutScore, BlockMeansScoreWhatOneColourPerBlockCanCarry) {
   CalibratedView view = View();  // 100x80
   // 2x2 squares of one colour each: 2x2 blocks lose nothing.

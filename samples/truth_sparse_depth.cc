@@ -8,8 +8,8 @@
 //   truth_sparse_depth PROJECT SPARSE_DEPTH_CSV TOLERANCE SCENE BACKDROP [OUT_CSV]
 // PROJECT is the generated project (its sparse/0 gives the cameras' centres), TOLERANCE the
 // holdout's (holdout.json: sparse_depth_tolerance), SCENE and BACKDROP synth's --scene and
-// --backdrop. Prints a table of the model's verdicts against the truth's, then a JSON line; OUT_CSV,
-// where given, receives the input's lines with the truth's verdict and depth added.
+// --backdrop. Prints a table of the model's verdicts against the truth's, then a JSON line;
+// OUT_CSV, where given, receives the input's lines with the truth's verdict and depth added.
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -69,7 +69,9 @@ int Run(const std::string& project, const std::string& csv_path, double toleranc
         const std::string& scene_name, const std::string& backdrop_name,
         const std::string& out_path) {
   SyntheticSceneOptions options;
-  if (!SceneKindFromString(scene_name, &options.scene)) throw InputError("unknown scene " + scene_name);
+  if (!SceneKindFromString(scene_name, &options.scene)) {
+    throw InputError("unknown scene " + scene_name);
+  }
   if (!BackdropFromString(backdrop_name, &options.backdrop)) {
     throw InputError("unknown backdrop " + backdrop_name);
   }
@@ -137,11 +139,12 @@ int Run(const std::string& project, const std::string& csv_path, double toleranc
   };
   std::printf("{\"points\": %d, \"truth_at_depth_share\": %.4f, \"truth_hidden_share\": %.4f, "
               "\"model_at_depth_share\": %.4f, \"model_hidden_share\": %.4f, "
-              "\"truth_at_depth_points\": %d, \"model_at_depth_of_truth_at_depth\": %.4f, "
+              "\"truth_at_depth_points\": %d, \"truth_hidden_points\": %d, "
+              "\"model_at_depth_of_truth_at_depth\": %.4f, "
               "\"model_hidden_of_truth_at_depth\": %.4f}\n",
               points, share(truth_at_depth), share(truth_hides),
               share(counts[0][0] + counts[0][1] + counts[0][2]),
-              share(counts[1][0] + counts[1][1] + counts[1][2]), truth_at_depth,
+              share(counts[1][0] + counts[1][1] + counts[1][2]), truth_at_depth, truth_hides,
               of_truth(counts[0][0]), of_truth(counts[1][0]));
   return 0;
 }

@@ -23,11 +23,12 @@ void PrintEvaluation(const HoldoutEvaluation& evaluation) {
   std::printf("mean over %zu held-out views: PSNR %.2f dB, SSIM %.3f, silhouette IoU %s\n"
               "block PSNR: each photo against its own means over blocks a voxel wide, on the "
               "object: about the most one colour per voxel can score (mean %.2f dB)\n"
-              "wrote %s/holdout.json, %s/<view>.png (photo | render | error x4)%s\n",
+              "wrote %s/holdout.json, sparse_depth.csv (each sparse point's verdict), "
+              "<view>.png (photo | render | error x4)%s\n",
               evaluation.views.size(), evaluation.mean_psnr, evaluation.mean_ssim,
               masks ? std::to_string(evaluation.mean_iou).c_str() : "n/a (no masks)",
               evaluation.mean_block_psnr, evaluation.output_folder.c_str(),
-              evaluation.output_folder.c_str(), evaluation.wrote_mesh ? " and mesh.ply" : "");
+              evaluation.wrote_mesh ? " and mesh.ply" : "");
   const exporter::SparseDepthAgreement& depth = evaluation.sparse_depth;
   if (depth.points > 0) {
     std::printf("sparse points the held-out photos saw (%d, triangulated from 2+ other photos, "

@@ -14,6 +14,16 @@ double CalibratedView::Depth(const Eigen::Vector3d& world) const {
   return (cam_from_world * world).z();
 }
 
+bool CalibratedView::FramesPoint(const Eigen::Vector3d& world) const {
+  if (!(Depth(world) > 0.0)) return false;
+  const Eigen::Vector2d pixel = Project(world);
+  if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < width && pixel.y() < height)) {
+    return false;
+  }
+  const int col = static_cast<int>(pixel.x()), row = static_cast<int>(pixel.y());
+  return valid.empty() || valid.at<uint8_t>(row, col) != 0;
+}
+
 Eigen::Matrix3d CalibratedView::WorldFromPixel() const {
   return cam_from_world.rotation.toRotationMatrix().transpose() * K.inverse();
 }

@@ -34,6 +34,9 @@ struct CalibratedView {
   }
   // Depth along the optical axis (camera z) of a world point.
   double Depth(const Eigen::Vector3d& world) const;
+  // Whether the photo's frame holds a world point, occlusion aside: in front of the camera, on a
+  // pixel of the photo that holds photo data (`valid`, where set).
+  bool FramesPoint(const Eigen::Vector3d& world) const;
   // Maps homogeneous COLMAP pixel coordinates (x, y, 1) to the world direction of their ray
   // (R^T K^-1; not normalised: a unit step of camera depth).
   Eigen::Matrix3d WorldFromPixel() const;

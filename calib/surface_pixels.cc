@@ -1,7 +1,7 @@
 // The search behind FindDistantPixels and FindGroundPixels (carve/ground_pixels.h):
 // FindPixelsOnSurface of calib/distant_pixels.h, which declares it. Photos reduced, patches
-// compared under the supposed surface's mapping and along each pixel's ray, plain regions judged
-// by their rims.
+// compared under the supposed surface's mapping and along each pixel's ray; plain regions judged
+// by their rims in calib/plain_regions.cc.
 #include "calib/distant_pixels.h"
 
 #include <algorithm>
@@ -16,22 +16,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "calib/pixel.h"
+#include "calib/plain_regions.h"
 #include "calib/ray_box.h"
 
 namespace raycarve {
 
 namespace {
 
-// The verdicts in DistantPixels::masks.
-constexpr uint8_t kDistantJudged = 255;
-constexpr uint8_t kGrown = 200;
-constexpr uint8_t kUndecided = 128;
-constexpr uint8_t kNearer = 64;
-// A plain region is distant when at least this many of the judged pixels on its rim, and this
-// share of them, are distant, and those found nearer are at most this share of the distant.
-constexpr int kMinRimVotes = 3;
-constexpr double kMinRimShare = 0.25;
-constexpr double kMaxRimNearShare = 0.05;
 // A match's correlation loses this much per standard deviation (of the photo's patch) between the
 // two patches' mean colours.
 constexpr double kMeanPenalty = 0.25;
@@ -411,83 +402,6 @@ bool QuadrantsTextured(const std::vector<float>& values, int radius, double text
   return true;
 }
 
-// The plain regions (connected pixels whose patch is not textured) whose rim is mostly found
-// distant: the inside of a patch of sky whose edges move as the sky does. Marks them kGrown in
-// `mask` (which holds the judged pixels' verdicts), counts their pixels in *grown and returns the
-// pixels (COLMAP coordinates) of their rays, every `stride` pixels. A region holding one of
-// `seen` (the photo's own pixels of sparse points inside the volume) is never distant: a plain
-// object that runs into a sky of its colour without an edge has points where it has detail.
-std::vector<Eigen::Vector2d> GrowIntoPlainRegions(const ReducedView& g, const DistantOptions& options,
-                                                  const std::vector<Eigen::Vector2d>& seen,
-                                                  cv::Mat* mask, int64_t* grown) {
-  const int side = 2 * options.patch_radius + 1;
-  cv::Mat mean, square;
-  const cv::Mat grey = Grey(g);
-  cv::boxFilter(grey, mean, CV_32F, cv::Size(side, side));
-  cv::boxFilter(grey.mul(grey), square, CV_32F, cv::Size(side, side));
-  cv::Mat plain(grey.size(), CV_8UC1, cv::Scalar(0));
-  const float limit = static_cast<float>(g.texture * g.texture);
-  for (int row = options.patch_radius; row < grey.rows - options.patch_radius; ++row) {
-    for (int col = options.patch_radius; col < grey.cols - options.patch_radius; ++col) {
-      const float m = mean.at<float>(row, col);
-      if (square.at<float>(row, col) - m * m < limit && g.valid.at<uint8_t>(row, col)) {
-        plain.at<uint8_t>(row, col) = 255;
-      }
-    }
-  }
-  cv::Mat labels;
-  const int count = cv::connectedComponents(plain, labels, 4, CV_32S);
-  // Per region, the verdicts of the judged pixels within reach of it (a patch and a stride).
-  std::vector<int> distant(count, 0), judged(count, 0), nearer(count, 0), size(count, 0);
-  for (int row = 0; row < labels.rows; ++row) {
-    for (int col = 0; col < labels.cols; ++col) ++size[labels.at<int>(row, col)];
-  }
-  const int reach = options.patch_radius + options.stride;
-  std::vector<int> near_labels;
-  for (int row = 0; row < mask->rows; ++row) {
-    for (int col = 0; col < mask->cols; ++col) {
-      const uint8_t verdict = mask->at<uint8_t>(row, col);
-      if (verdict == 0) continue;
-      near_labels.clear();
-      for (int y = std::max(0, row - reach); y <= std::min(labels.rows - 1, row + reach); ++y) {
-        for (int x = std::max(0, col - reach); x <= std::min(labels.cols - 1, col + reach); ++x) {
-          const int label = labels.at<int>(y, x);
-          if (label > 0 && std::find(near_labels.begin(), near_labels.end(), label) == near_labels.end()) {
-            near_labels.push_back(label);
-          }
-        }
-      }
-      for (int label : near_labels) {
-        ++judged[label];
-        if (verdict == kDistantJudged) ++distant[label];
-        if (verdict == kNearer) ++nearer[label];
-      }
-    }
-  }
-  std::vector<uint8_t> holds_point(count, 0);
-  for (const Eigen::Vector2d& pixel : seen) {
-    const Eigen::Vector2d at = OpenCvFromColmap(pixel / g.factor);
-    const int col = static_cast<int>(std::lround(at.x())), row = static_cast<int>(std::lround(at.y()));
-    if (col >= 0 && row >= 0 && col < labels.cols && row < labels.rows) holds_point[labels.at<int>(row, col)] = 1;
-  }
-  std::vector<uint8_t> is_distant(count, 0);
-  for (int label = 1; label < count; ++label) {
-    is_distant[label] = !holds_point[label] && size[label] >= side * side && distant[label] >= kMinRimVotes &&
-                        distant[label] >= kMinRimShare * judged[label] &&
-                        nearer[label] <= kMaxRimNearShare * distant[label];
-  }
-  std::vector<Eigen::Vector2d> pixels;
-  for (int row = 0; row < labels.rows; ++row) {
-    for (int col = 0; col < labels.cols; ++col) {
-      if (!is_distant[labels.at<int>(row, col)]) continue;
-      ++*grown;
-      if (mask->at<uint8_t>(row, col) == 0) mask->at<uint8_t>(row, col) = kGrown;
-      if (row % options.stride == 0 && col % options.stride == 0) pixels.push_back(PixelCentre(row, col));
-    }
-  }
-  return pixels;
-}
-
 // One photo's verdicts (DistantPixels::masks), counts and rays.
 struct PhotoVerdicts {
   std::vector<DistantRay> rays;
@@ -548,7 +462,8 @@ PhotoVerdicts JudgePhoto(const std::vector<ReducedView>& reduced, int v, const E
     }
   }
   if (options.grow_plain_regions) {
-    for (const Eigen::Vector2d& p : GrowIntoPlainRegions(i, options, seen, &out.mask, &out.grown)) {
+    for (const Eigen::Vector2d& p : GrowIntoPlainRegions(Grey(i), i.valid, i.texture, i.factor, options,
+                                                         seen, &out.mask, &out.grown)) {
       if (RayOf(i, p, box, {}, surface, &ray)) add_ray(ray, ray.t1);
     }
   }

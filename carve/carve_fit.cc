@@ -50,14 +50,7 @@ BoxCoverage MeasureBoxCoverage(const std::vector<CalibratedView>& views,
       const Eigen::Vector3d t((i % kSteps + 0.5) / kSteps, ((i / kSteps) % kSteps + 0.5) / kSteps,
                               (i / (kSteps * kSteps) + 0.5) / kSteps);
       const Eigen::Vector3d point = box.min() + box.sizes().cwiseProduct(t);
-      if (!(view.Depth(point) > 0.0)) continue;
-      const Eigen::Vector2d pixel = view.Project(point);
-      if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < view.width &&
-            pixel.y() < view.height)) {
-        continue;
-      }
-      const int col = static_cast<int>(pixel.x()), row = static_cast<int>(pixel.y());
-      if (!view.valid.empty() && view.valid.at<uint8_t>(row, col) == 0) continue;
+      if (!view.FramesPoint(point)) continue;
       ++seen;
       ++seen_by[i];
     }

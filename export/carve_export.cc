@@ -176,13 +176,7 @@ std::vector<uint8_t> UncoveredVertices(const TriangleMesh& mesh,
     const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
     int frames = 0;
     for (const CalibratedView& view : views) {
-      if (!(view.Depth(p) > 0.0)) continue;
-      const Eigen::Vector2d pixel = view.Project(p);
-      const int col = static_cast<int>(std::floor(pixel.x()));
-      const int row = static_cast<int>(std::floor(pixel.y()));
-      if (col < 0 || row < 0 || col >= view.width || row >= view.height) continue;
-      if (!view.valid.empty() && view.valid.at<uint8_t>(row, col) == 0) continue;
-      if (++frames >= min_views) break;
+      if (view.FramesPoint(p) && ++frames >= min_views) break;
     }
     uncovered[i] = frames < min_views;
   }

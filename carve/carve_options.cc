@@ -109,6 +109,10 @@ bool CarveOptions::IsValid(std::string* reason) const {
     *reason = "min_component_voxels must be >= 0";
     return false;
   }
+  if (lod_carve_depth < 0 || lod_carve_depth > 8) {
+    *reason = "lod_carve_depth must be in [0, 8], got " + std::to_string(lod_carve_depth);
+    return false;
+  }
   if (lod_band < 0 || lod_band > 8) {
     *reason = "lod_band must be in [0, 8], got " + std::to_string(lod_band);
     return false;

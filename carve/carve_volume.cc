@@ -214,6 +214,7 @@ void RecordLevelStart(const IncrementalCarver& carver, const CarveOptions& level
   level_statistics->pattern_threshold = level_options.pattern_threshold;
   level_statistics->dimensions = carver.volume().grid().dimensions();
   level_statistics->start_solid = carver.volume().num_solid();
+  level_statistics->interior_held = static_cast<int64_t>(level_options.interior_held.size());
   level_statistics->setup_seconds = setup_seconds;
 }
 
@@ -408,9 +409,13 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
     std::unique_ptr<Volume> start_volume;
     if (level == first_level && level > 0) {
       start_volume = std::move(stages.start);
+      level_options.interior_held = std::move(stages.start_held);
     } else if (level > 0) {
+      const VoxelGrid level_grid(box, resolutions[level]);
       start_volume = std::make_unique<Volume>(
-          RefineVolume(carver->volume(), VoxelGrid(box, resolutions[level]), options.lod_band));
+          RefineVolume(carver->volume(), level_grid, options.lod_band));
+      level_options.interior_held =
+          DeepInteriorVoxels(carver->volume(), level_grid, options.lod_carve_depth);
       carver.reset();  // the coarse level's rays and queue go before the fine level's come
     }
     scaled_views.clear();  // the last level's go before this one's are made

@@ -132,6 +132,16 @@ struct CarveOptions {
   // as keep the coarsest at 64 voxels or more (level_of_detail.h; the command line's default).
   int lod_levels = 1;
   int lod_band = 1;
+  // A finer level refines the coarser level's surface and does not dig through it: its voxels
+  // whose parent lay more than this many coarse voxels inside the coarse solid (26-neighbour
+  // steps to a carved voxel or to the grid's edge) are never carved by the consistency test.
+  // As the band lets a finer level put back what the coarser one carved, this lets it carve what
+  // the coarser one kept, by as much; deeper, a wrong carve at the finer level's lower threshold
+  // would open a hole through a surface that the coarser level judged whole (measured on the
+  // generated unmasked scenes: a striped box holed at 128 voxels, whole at 64). 0: no limit.
+  int lod_carve_depth = 1;
+  // Set by CarveVolume per level: the voxels lod_carve_depth holds (indices, sorted).
+  std::vector<int64_t> interior_held;
   // With levels of detail: a level whose voxels are f = 2^k times the final ones carves the
   // photos reduced f times (block means; ReduceView), so that a voxel covers about as many
   // pixels at every level (fewer while any photo's shorter side would drop below

@@ -38,6 +38,9 @@ struct CarveStages {
   int first_level = 0;  // the levels before it are skipped: `start` is where it begins
   int last_level = -1;  // the levels after it are skipped (-1: up to the final level)
   std::unique_ptr<Volume> start;  // first_level's start volume; needed when first_level > 0
+  // first_level's voxels held by CarveOptions::lod_carve_depth (DeepInteriorVoxels of the level
+  // before it), when first_level > 0.
+  std::vector<int64_t> start_held;
   // The final level's views when they differ from the carve's (a tile's; not owned).
   const std::vector<CalibratedView>* final_views = nullptr;
   // The final level's thresholds, when known (FinalLevelThresholds): not estimated again there.

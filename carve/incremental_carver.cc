@@ -180,7 +180,8 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
   }
   // Made for the distant rays alone: the known surface protects only when asked.
   if (!options.protect_surface_points) std::vector<cv::Mat>().swap(known_depth_);
-  if (options.protect_surface_points || !options.ground.empty()) {
+  if (options.protect_surface_points || !options.ground.empty() ||
+      !options.interior_held.empty()) {
     protected_.assign((volume_.grid().num_voxels() + 63) / 64, 0);
   }
   if (options.protect_surface_points) {
@@ -188,6 +189,7 @@ IncrementalCarver::IncrementalCarver(const std::vector<CalibratedView>& views,
       protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
     }
   }
+  for (int64_t voxel : options.interior_held) protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
   for (int64_t voxel : ground_held_) protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);
   for (int64_t voxel : GroundHitVoxels(views, volume_.grid(), options)) {
     protected_[voxel >> 6] |= uint64_t{1} << (voxel & 63);

@@ -96,6 +96,35 @@ Volume RefineRegion(const Volume& coarse, const VoxelGrid& fine, const Eigen::Ve
   return Volume(fine, std::move(solid));
 }
 
+std::vector<int64_t> DeepInteriorVoxels(const Volume& coarse, const VoxelGrid& fine, int depth) {
+  return DeepInteriorRegion(coarse, fine, Eigen::Vector3i::Zero(), depth);
+}
+
+std::vector<int64_t> DeepInteriorRegion(const Volume& coarse, const VoxelGrid& fine,
+                                        const Eigen::Vector3i& offset, int depth) {
+  std::vector<int64_t> deep;
+  if (depth <= 0) return deep;
+  const VoxelGrid& grid = coarse.grid();
+  const Eigen::Vector3i& n = grid.dimensions();
+  const Eigen::Vector3i& m = fine.dimensions();
+  CHECK_NEAR(fine.voxel_size() * 2.0, grid.voxel_size(), 1e-12 * grid.voxel_size());
+  CHECK((offset.array() >= 0).all() && ((offset + m).array() <= 2 * n.array()).all());
+  // Within `depth` steps of a carved coarse voxel; the grid's edge counts as carved.
+  std::vector<uint8_t> near(grid.num_voxels());
+  for (int64_t index = 0; index < grid.num_voxels(); ++index) near[index] = !coarse.IsSolid(index);
+  for (int step = 0; step < depth; ++step) Dilate(n, &near);
+  for (int z = 0; z < m.z(); ++z) {
+    for (int y = 0; y < m.y(); ++y) {
+      for (int x = 0; x < m.x(); ++x) {
+        const Eigen::Vector3i parent = (Eigen::Vector3i(x, y, z) + offset) / 2;
+        if ((parent.array() < depth).any() || (parent.array() >= n.array() - depth).any()) continue;
+        if (!near[grid.Index(parent)]) deep.push_back(fine.Index(Eigen::Vector3i(x, y, z)));
+      }
+    }
+  }
+  return deep;
+}
+
 Volume DilateSolid(const Volume& volume, int band) {
   const VoxelGrid& grid = volume.grid();
   std::vector<uint8_t> keep(grid.num_voxels());

@@ -36,6 +36,8 @@ struct LevelStatistics {
   double first_pass_threshold = 0.0;
   double first_pass_seconds = 0.0;
   int64_t protected_kept = 0;  // evaluations that kept a protected voxel found inconsistent
+  // Voxels deeper in the coarser level's solid than CarveOptions::lod_carve_depth (held).
+  int64_t interior_held = 0;
   Eigen::Vector3i dimensions = Eigen::Vector3i::Zero();
   int64_t start_solid = 0;  // solid voxels when the level began (after refinement and hull)
   int64_t carved = 0;            // by every means: hull, sight lines, colour, specks
@@ -66,6 +68,17 @@ bool LevelResolutions(int resolution, int levels, std::vector<int>* resolutions,
 // voxel size, with at most twice its voxels along each axis (CHECKed; VoxelGrid gives this for
 // resolutions r and 2r over one box).
 Volume RefineVolume(const Volume& coarse, const VoxelGrid& fine, int band = 1);
+
+// The voxels of `fine` (the coarse grid halved, as for RefineVolume) whose parent lies more than
+// `depth` coarse voxels inside the solid of `coarse`: every coarse voxel within `depth` steps
+// (26-neighbourhood) of it is solid and inside the grid (CarveOptions::lod_carve_depth). Sorted
+// indices into `fine`; none for depth <= 0.
+std::vector<int64_t> DeepInteriorVoxels(const Volume& coarse, const VoxelGrid& fine, int depth);
+
+// DeepInteriorVoxels for part of the finer grid: `fine` is the region of it that starts at voxel
+// `offset` (VoxelGrid::Region); indices into the region.
+std::vector<int64_t> DeepInteriorRegion(const Volume& coarse, const VoxelGrid& fine,
+                                        const Eigen::Vector3i& offset, int depth);
 
 // RefineVolume for part of the finer grid: `fine` is the region of it that starts at voxel
 // `offset` (VoxelGrid::Region), and gets the same voxels as that part of RefineVolume's volume.

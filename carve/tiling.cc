@@ -221,6 +221,7 @@ TileCarve CarveTile(const std::vector<CalibratedView>& views,
   stages.first_level = num_levels - 1;
   stages.start = std::make_unique<Volume>(
       RefineRegion(band, region, tile.lo, /*band=*/0));
+  stages.start_held = DeepInteriorRegion(coarse.volume, region, tile.lo, options.lod_carve_depth);
   stages.final_views = &tile_views;
   stages.final_thresholds_given = true;
   stages.final_threshold = coarse.final_threshold;
@@ -278,6 +279,7 @@ CarveResult FinishTiledCarve(const std::vector<CalibratedView>& views,
                              const Eigen::AlignedBox3d& box,
                              const CarveOptions& options,
                              Volume joined,
+                             const Volume& coarse,
                              double final_threshold,
                              double final_pattern_threshold,
                              const std::function<void(const CarveProgress&)>& progress,
@@ -287,6 +289,7 @@ CarveResult FinishTiledCarve(const std::vector<CalibratedView>& views,
   CHECK(joined.grid().dimensions() == VoxelGrid(box, options.resolution).dimensions());
   CarveStages stages;
   stages.first_level = num_levels - 1;
+  stages.start_held = DeepInteriorVoxels(coarse, joined.grid(), options.lod_carve_depth);
   stages.start = std::make_unique<Volume>(std::move(joined));
   stages.final_thresholds_given = true;
   stages.final_threshold = final_threshold;

@@ -122,11 +122,13 @@ Volume JoinTileCores(const VoxelGrid& grid,
                      const std::vector<TileRegion>& tiles,
                      const std::vector<std::vector<uint64_t>>& cores);
 
-// Step 3: what CarveVolume returns, from the joined cores.
+// Step 3: what CarveVolume returns, from the joined cores and step 1's volume (`coarse`: what
+// CarveOptions::lod_carve_depth holds).
 CarveResult FinishTiledCarve(const std::vector<CalibratedView>& views,
                              const Eigen::AlignedBox3d& box,
                              const CarveOptions& options,
                              Volume joined,
+                             const Volume& coarse,
                              double final_threshold,
                              double final_pattern_threshold,
                              const std::function<void(const CarveProgress&)>& progress = {},

@@ -43,6 +43,12 @@ struct PipelineScope {
 
 // A carve joined from tiles (`raycarve tile merge`): the plan it came from, and the final
 // threshold its tiles judged with.
+// The tiles' joined cores (JoinTileCores) and the coarse levels' volume they were carved from.
+struct JoinedTiles {
+  Volume joined;
+  Volume coarse;
+};
+
 struct TiledCarveInfo {
   std::string plan_id;
   int jobs = 0;  // 0: not a tiled carve
@@ -169,16 +175,16 @@ class CarvePipeline {
   void WriteOutputs();  // every file into the staging folder, then moved into place
 
   // Every stage as Run does, with the carve from the tiles' joined cores (CarveFromTiles): `join`
-  // makes them, for the grid of the project as loaded (it throws InputError where they do not
-  // fit it).
-  const CarveRun& RunFromTiles(const std::function<Volume(const VoxelGrid&)>& join,
+  // makes them and reads the coarse volume, for the grid of the project as loaded (it throws
+  // InputError where they do not fit it).
+  const CarveRun& RunFromTiles(const std::function<JoinedTiles(const VoxelGrid&)>& join,
                                const TiledCarveInfo& tiled);
 
   // A carve split into tiles (carve/tiling.h; `raycarve tile`), after CheckVolume: the coarse
   // levels, one tile, and the carve stage from the tiles' joined cores (in place of Carve).
   CoarseCarve CarveCoarse() const;
   TileCarve CarveTileOf(const CoarseCarve& coarse, const TileRegion& tile) const;
-  void CarveFromTiles(Volume joined, const TiledCarveInfo& tiled);
+  void CarveFromTiles(JoinedTiles tiles, const TiledCarveInfo& tiled);
 
   // A carve of the carved views with other options (their surface points filled in), without
   // touching run(): benchmark's methods. Throws InputError when the carve does not fit.

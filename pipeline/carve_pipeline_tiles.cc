@@ -8,8 +8,8 @@
 
 namespace raycarve {
 
-const CarveRun& CarvePipeline::RunFromTiles(const std::function<Volume(const VoxelGrid&)>& join,
-                                            const TiledCarveInfo& tiled) {
+const CarveRun& CarvePipeline::RunFromTiles(
+    const std::function<JoinedTiles(const VoxelGrid&)>& join, const TiledCarveInfo& tiled) {
   LockOutputs();
   LoadViews();
   AgreeMasks();
@@ -41,13 +41,13 @@ TileCarve CarvePipeline::CarveTileOf(const CoarseCarve& coarse, const TileRegion
   return carved;
 }
 
-void CarvePipeline::CarveFromTiles(Volume joined, const TiledCarveInfo& tiled) {
+void CarvePipeline::CarveFromTiles(JoinedTiles tiles, const TiledCarveInfo& tiled) {
   CHECK(loaded_);
   run_.tiled = tiled;
   LOG(INFO) << "carving on from the tiles' joined volume with the whole volume's visibility ...";
   run_.result = std::make_unique<CarveResult>(FinishTiledCarve(
-      carved_, project_.bounds.box, FilledOptions(request_.options), std::move(joined),
-      tiled.final_threshold, tiled.final_pattern_threshold, scope_.progress,
+      carved_, project_.bounds.box, FilledOptions(request_.options), std::move(tiles.joined),
+      tiles.coarse, tiled.final_threshold, tiled.final_pattern_threshold, scope_.progress,
       request_.progress_seconds));
   RecordCarve();
 }

@@ -41,6 +41,7 @@ void WriteOptions(const CarveRequest& request, const CarveRun& run, JsonWriter& 
                                    : request.options.lod_levels)
       .Key("lod_levels_automatic").Value(request.options.lod_levels == kAutomaticLevels)
       .Key("lod_band").Value(request.options.lod_band)
+      .Key("lod_carve_depth").Value(request.options.lod_carve_depth)
       .Key("lod_reduce_images").Value(request.options.lod_reduce_images)
       .Key("supersample").Value(request.options.supersample)
       .Key("lod_threshold_scale").Value(request.options.lod_threshold_scale)
@@ -333,6 +334,7 @@ void WriteLevels(const CarveRequest& request, const CarveRun& run, JsonWriter& j
           .EndObject();
     }
     json.Key("protected_kept").Value(level.protected_kept)
+        .Key("interior_held").Value(level.interior_held)
         .Key("start_solid").Value(level.start_solid)
         .Key("carved").Value(level.carved)
         .Key("evaluated").Value(level.evaluated)

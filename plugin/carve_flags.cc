@@ -160,6 +160,10 @@ void AddLevelFlags(OptionParser* parser, CarveRequest* request) {
                      "keep the coarsest level at 64 voxels or more (128: 2, 256: 3)");
   parser->AddDefault("lod_band", &request->options.lod_band,
                      "voxels put back around what survived a coarse level before refining");
+  parser->AddDefault("lod_carve_depth", &request->options.lod_carve_depth,
+                     "a finer level carves at most this many coarse voxels into what the "
+                     "coarser level kept (it refines the surface, it does not dig through it); "
+                     "0: no limit");
   parser->AddDefault("lod_reduce_images", &request->options.lod_reduce_images,
                      "coarse levels carve photos reduced by the level's voxel scale (block "
                      "means): a voxel covers about as many pixels at every level");

@@ -346,7 +346,8 @@ int RunTileMerge(int argc, char** argv) {
           throw InputError(plan_path + ": the plan's grid is not what the project gives now: "
                            "the project changed since the plan; run raycarve tile plan again");
         }
-        return JoinTileCores(grid, regions, cores);
+        return JoinedTiles{JoinTileCores(grid, regions, cores),
+                           ReadCoarse(pipeline, plan, folder).volume};
       },
       tiled);
   std::fputs(CarveSummaryText(request, run).c_str(), stdout);

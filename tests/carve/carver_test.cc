@@ -146,6 +146,36 @@ TEST(CarveVolume, AThresholdSoTightThatNothingIsConsistentCarvesEverythingSeenTw
   }
 }
 
+// CarveOptions::lod_carve_depth's held voxels (interior_held) are never carved by the test:
+// nothing is consistent, everything else seen twice goes.
+TEST(IncrementalCarver, HeldInteriorVoxelsSurviveATestThatFindsThemInconsistent) {
+  const SyntheticScene scene = Scene(4, 80, 60);
+  const std::vector<CalibratedView> views = testing::SceneViews(scene);
+  CarveOptions options = Options(20, -1.0);
+  const VoxelGrid grid(scene.object_box, 20);
+  const Eigen::Vector3d centre = (grid.dimensions().cast<double>() - Eigen::Vector3d::Ones()) / 2;
+  for (int64_t i = 0; i < grid.num_voxels(); ++i) {
+    if ((grid.Voxel(i).cast<double>() - centre).norm() <= 3.0) options.interior_held.push_back(i);
+  }
+  ASSERT_GT(options.interior_held.size(), 50u);
+  for (const bool held : {false, true}) {
+    CarveOptions run = options;
+    if (!held) run.interior_held.clear();
+    IncrementalCarver carver(views, scene.object_box, run);
+    while (carver.Step()) {
+    }
+    int64_t solid = 0;
+    for (int64_t i : options.interior_held) solid += carver.volume().IsSolid(i);
+    if (held) {
+      EXPECT_EQ(solid, static_cast<int64_t>(options.interior_held.size()));
+      EXPECT_GT(carver.protected_kept(), 0);
+    } else {
+      EXPECT_EQ(solid, 0);  // without the hold the test carves them all
+    }
+    EXPECT_GT(carver.carved(), 1000);
+  }
+}
+
 // Two carvings are the same: counts, every voxel, and every surface voxel's colour and pixels.
 void ExpectSameCarving(const CarveResult& a, const CarveResult& b, const std::string& context) {
   EXPECT_EQ(a.statistics.carved, b.statistics.carved) << context;

@@ -226,7 +226,8 @@ TEST(TiledCarve, JoinsToTheSingleCarveWithinOneVoxel) {
   }
   const Volume joined = JoinTileCores(grid, tiles, cores);
   const CarveResult tiled = FinishTiledCarve(views, scene.object_box, options, joined,
-                                             coarse.final_threshold, coarse.final_pattern_threshold);
+                                             coarse.volume, coarse.final_threshold,
+                                             coarse.final_pattern_threshold);
   EXPECT_EQ(tiled.volume.grid().dimensions(), grid.dimensions());
   EXPECT_EQ(tiled.surface.size(), static_cast<size_t>(tiled.volume.num_surface()));
   const VolumeAgreement agreement = CompareVolumes(single.volume, tiled.volume);

@@ -9,6 +9,11 @@ std::string CarveStatistics::FreeSpaceSummary() const {
   text << "free space: " << free_space_sight_lines << " sight lines from the photos to the sparse "
        << "points they saw carved " << free_space_carved << " voxels (" << free_space_level0_carved
        << " at the first level) in " << free_space_seconds << " s";
+  if (free_space_through_ground > 0) {
+    text << "; " << free_space_through_ground
+         << " more would have passed down through the held ground, to points under it (wrong "
+            "matches), and were not drawn";
+  }
   return text.str();
 }
 

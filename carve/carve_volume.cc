@@ -248,6 +248,7 @@ void RecordLevelEnd(const IncrementalCarver& carver, LevelStatistics* level_stat
   level_statistics->free_space_carved = carver.free_space().carved;
   statistics->free_space_carved += carver.free_space().carved;
   statistics->free_space_sight_lines = carver.free_space().sight_lines;
+  statistics->free_space_through_ground = carver.free_space().through_ground;
   statistics->free_space_seconds += carver.free_space().seconds;
   statistics->distant_carved += carver.distant().carved;
   statistics->distant_rays = carver.distant().sight_lines;

@@ -272,6 +272,8 @@ struct CarveStatistics {
   int64_t free_space_carved = 0;
   int64_t free_space_level0_carved = 0;
   int64_t free_space_sight_lines = 0;
+  // Of the final level's, those not drawn: down through the held ground (CarveFreeSpace).
+  int64_t free_space_through_ground = 0;
   double free_space_seconds = 0.0;
   // Voxels removed by the distant pixels' rays (CarveOptions::distant_rays, final level); the rays
   // that crossed the grid.

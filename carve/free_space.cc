@@ -1,10 +1,12 @@
 #include "carve/free_space.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <thread>
 
 #include "carve/known_surface.h"
@@ -137,9 +139,13 @@ FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
                                    const std::vector<SurfacePoint>& points,
                                    double margin_voxels,
                                    Volume* volume,
-                                   int num_threads) {
+                                   int num_threads,
+                                   const Ground& ground) {
   const VoxelGrid& grid = volume->grid();
   const double margin = margin_voxels * grid.voxel_size();
+  std::unique_ptr<GroundMap> ground_map;
+  if (!ground.empty()) ground_map = std::make_unique<GroundMap>(ground);
+  std::atomic<int64_t> through_ground{0};
   // One line per (point, view): the k-th point's views in turn.
   std::vector<std::pair<uint32_t, uint32_t>> sightings;
   for (size_t p = 0; p < points.size(); ++p) {
@@ -154,6 +160,15 @@ FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
     if (!(facing.norm() > 0.0)) return false;
     facing.normalize();
     const Eigen::Vector3d& centre = views[point.views[sightings[index].second]].centre;
+    if (ground_map != nullptr) {
+      const double above = ground_map->Height(centre), below = -ground_map->Height(point.xyz);
+      if (above > 0.0 && below > ground.depth &&
+          ground_map->At(centre + above / (above + below) * (point.xyz - centre)) ==
+              GroundMap::Foot::kGround) {
+        ++through_ground;
+        return false;
+      }
+    }
     const Eigen::Vector3d to_point = point.xyz - centre;
     const double length = to_point.norm();
     // The line stops `margin` above that plane (at most kMaxSlant margins along the line): a
@@ -165,7 +180,10 @@ FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
     SegmentVoxels(grid, centre, centre + (1.0 - stop / length) * to_point, voxels);
     return !voxels->empty();
   };
-  return CarveLines(sightings.size(), draw, points, {}, volume, num_threads);
+  FreeSpaceStatistics statistics = CarveLines(sightings.size(), draw, points, {}, volume,
+                                              num_threads);
+  statistics.through_ground = through_ground;
+  return statistics;
 }
 
 FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,

@@ -5,6 +5,7 @@
 
 #include "calib/calibrated_view.h"
 #include "calib/distant_pixels.h"
+#include "carve/ground.h"
 #include "carve/surface_evidence.h"
 #include "carve/volume.h"
 
@@ -13,6 +14,7 @@ namespace raycarve {
 struct FreeSpaceStatistics {
   int64_t sight_lines = 0;  // (point, view) pairs whose sight line crosses the grid
   int64_t carved = 0;       // solid voxels carved
+  int64_t through_ground = 0;  // sight lines not drawn: down through the held ground
   double seconds = 0.0;
 };
 
@@ -26,11 +28,16 @@ struct FreeSpaceStatistics {
 // carved. Only solid voxels are carved; `points`' views index `views`. The voxels are found on
 // `num_threads` threads (< 1: one per hardware thread) and carved in index order: the result does
 // not depend on the count. Cost: one step per voxel a sight line passes (Amanatides-Woo).
+// With a `ground` (CarveOptions::ground): a line that passes down through the ground's plane
+// where the plane is ground (GroundMap::Foot::kGround) is not drawn: its point lies under the
+// floor the carve holds, where a photo above could not have seen it (a wrong match; a step down
+// opens a hole in the ground, and a line through the hole is drawn).
 FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
                                    const std::vector<SurfacePoint>& points,
                                    double margin_voxels,
                                    Volume* volume,
-                                   int num_threads = 1);
+                                   int num_threads = 1,
+                                   const Ground& ground = Ground());
 
 // Empty space from the distant pixels (calib/distant_pixels.h): a photo pixel that shows
 // something beyond the volume saw across all of it, so every solid voxel its ray passes through is

@@ -104,7 +104,7 @@ Volume PreCarved(const std::vector<CalibratedView>& views,
   *ground_held = std::move(below.held);
   if (options.free_space_margin_voxels > 0.0 && !options.surface_points.empty()) {
     *free_space = CarveFreeSpace(views, options.surface_points, options.free_space_margin_voxels,
-                                 &volume, options.num_threads);
+                                 &volume, options.num_threads, options.ground);
   }
   if (options.protect_surface_points || !options.distant_rays.empty()) {
     *known_depth = KnownSurfaceDepths(views, volume.grid(), options.surface_points);

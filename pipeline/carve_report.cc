@@ -255,6 +255,7 @@ void WriteStatistics(const CarveRequest& request, const CarveRun& run, JsonWrite
       .Key("free_space").BeginObject()
           .Key("margin_voxels").Value(request.options.free_space_margin_voxels)
           .Key("sight_lines").Value(s.free_space_sight_lines)
+          .Key("through_ground_not_drawn").Value(s.free_space_through_ground)
           .Key("voxels").Value(s.free_space_carved)
           .Key("voxels_first_level").Value(s.free_space_level0_carved)
           .Key("seconds").Value(s.free_space_seconds)

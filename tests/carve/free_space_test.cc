@@ -137,6 +137,51 @@ TEST(CarveFreeSpace, NoPointsOrAZeroMarginCarveOnlyWhatTheLinesReach) {
   EXPECT_TRUE(volume.IsSolid(Eigen::Vector3i(4, 5, 9)));
 }
 
+// A point under the held ground (a plane at z = 0.5 whose footprint covers x < 0.5) seen from
+// above: its line would pass down through the ground, and is not drawn; the same point where the
+// line crosses the plane beyond the ground (x > 0.5), or near a hole in it, is drawn.
+TEST(CarveFreeSpace, NoSightLinePassesDownThroughTheHeldGround) {
+  const VoxelGrid grid(Eigen::AlignedBox3d(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()), 10);
+  const std::vector<uint64_t> all((grid.num_voxels() + 63) / 64, ~uint64_t{0});
+  Ground ground;
+  ground.normal = Eigen::Vector3d::UnitZ();
+  ground.offset = -0.5;
+  ground.depth = 0.05;
+  ground.radius = 0.15;
+  for (double x = 0.05; x < 0.5; x += 0.1) {
+    for (double y = 0.05; y < 1.0; y += 0.1) ground.footprint.emplace_back(x, y, 0.5);
+  }
+  std::vector<CalibratedView> views(1);
+  SurfacePoint point;
+  point.xyz = Eigen::Vector3d(0.25, 0.55, 0.25);  // 0.25 under the plane
+  point.views = {0};
+  views[0].centre = Eigen::Vector3d(0.25, 0.55, 5.0);  // straight above: crosses at x = 0.25
+  Volume held(grid, all);
+  EXPECT_EQ(CarveFreeSpace(views, {point}, 2.0, &held, 1, ground).sight_lines, 0);
+  EXPECT_EQ(held.num_solid(), grid.num_voxels());
+  // Without the ground the line is drawn down to two voxels short of the point (z = 0.45).
+  Volume open(grid, all);
+  EXPECT_EQ(CarveFreeSpace(views, {point}, 2.0, &open, 1).sight_lines, 1);
+  EXPECT_FALSE(open.IsSolid(Eigen::Vector3i(2, 5, 5)));
+  // A hole in the ground where the line crosses: drawn.
+  Ground holed = ground;
+  holed.holes.emplace_back(0.25, 0.55, 0.5);
+  Volume through_hole(grid, all);
+  EXPECT_EQ(CarveFreeSpace(views, {point}, 2.0, &through_hole, 1, holed).sight_lines, 1);
+  EXPECT_FALSE(through_hole.IsSolid(Eigen::Vector3i(2, 5, 5)));
+  // A point beyond the ground's edge, under the plane (a step down): drawn.
+  point.xyz = Eigen::Vector3d(0.85, 0.55, 0.25);
+  views[0].centre = Eigen::Vector3d(0.85, 0.55, 5.0);
+  Volume beyond(grid, all);
+  EXPECT_EQ(CarveFreeSpace(views, {point}, 2.0, &beyond, 1, ground).sight_lines, 1);
+  EXPECT_FALSE(beyond.IsSolid(Eigen::Vector3i(8, 5, 5)));
+  // A point on the ground (within its depth): drawn.
+  point.xyz = Eigen::Vector3d(0.25, 0.55, 0.47);
+  views[0].centre = Eigen::Vector3d(0.25, 0.55, 5.0);
+  Volume on(grid, all);
+  EXPECT_EQ(CarveFreeSpace(views, {point}, 2.0, &on, 1, ground).sight_lines, 1);
+}
+
 // A distant pixel's ray carves its whole column; where a sparse point the photo saw lies near
 // the pixel, the ray stops two voxels short of it; the voxels to keep stay; a ray with a length
 // stops there.

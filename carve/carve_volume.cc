@@ -252,6 +252,7 @@ void RecordLevelEnd(const IncrementalCarver& carver, LevelStatistics* level_stat
   statistics->free_space_seconds += carver.free_space().seconds;
   statistics->distant_carved += carver.distant().carved;
   statistics->distant_rays = carver.distant().sight_lines;
+  statistics->distant_through_ground = carver.distant().through_ground;
   statistics->ground_seen_carved += carver.ground_seen().carved;
   statistics->ground_seen_rays = carver.ground_seen().sight_lines;
   level_statistics->evaluated = carver.evaluated();

@@ -279,6 +279,7 @@ struct CarveStatistics {
   // that crossed the grid.
   int64_t distant_carved = 0;
   int64_t distant_rays = 0;
+  int64_t distant_through_ground = 0;  // rays not drawn: down through the held ground
   // Likewise for the ground pixels' rays (those with a finite length).
   int64_t ground_seen_carved = 0;
   int64_t ground_seen_rays = 0;

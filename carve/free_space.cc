@@ -193,8 +193,12 @@ FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
                                      const std::vector<int64_t>& keep,
                                      Volume* volume,
                                      int num_threads,
-                                     const std::vector<cv::Mat>* known_depth) {
+                                     const std::vector<cv::Mat>* known_depth,
+                                     const Ground& ground) {
   const VoxelGrid& grid = volume->grid();
+  std::unique_ptr<GroundMap> ground_map;
+  if (!ground.empty()) ground_map = std::make_unique<GroundMap>(ground);
+  std::atomic<int64_t> through_ground{0};
   std::vector<cv::Mat> made;
   if (known_depth == nullptr) made = KnownSurfaceDepths(views, grid, points);
   const std::vector<cv::Mat>& known = known_depth != nullptr ? *known_depth : made;
@@ -207,6 +211,14 @@ FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
     // Camera depth per unit along the ray.
     const double depth_rate = (view.cam_from_world.rotation * ray.direction).z();
     if (!(depth_rate > 0.0)) return false;
+    if (ground_map != nullptr && std::isinf(ray.length)) {
+      const double above = ground_map->Height(centre), fall = -ray.direction.dot(ground.normal);
+      if (above > 0.0 && fall > 0.0 &&
+          ground_map->At(centre + (above / fall) * ray.direction) == GroundMap::Foot::kGround) {
+        ++through_ground;
+        return false;
+      }
+    }
     double length = std::min(ray.length, (box.center() - centre).norm() + beyond);
     if (!known[ray.view].empty()) {
       const Eigen::Vector2d pixel = view.Project(centre + ray.direction);
@@ -220,7 +232,9 @@ FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
     SegmentVoxels(grid, centre, centre + length * ray.direction, voxels);
     return !voxels->empty();
   };
-  return CarveLines(rays.size(), draw, points, keep, volume, num_threads);
+  FreeSpaceStatistics statistics = CarveLines(rays.size(), draw, points, keep, volume, num_threads);
+  statistics.through_ground = through_ground;
+  return statistics;
 }
 
 }  // namespace raycarve

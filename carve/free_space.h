@@ -47,6 +47,9 @@ FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
 // is. A voxel holding a surface point, and the voxels in `keep` (the held ground), are never
 // carved. `rays`' views index `views`. Same threads and order as CarveFreeSpace. `known_depth`:
 // KnownSurfaceDepths of the views, grid and points when already made (null: made here).
+// With a `ground`: a ray of unbounded length that passes down through the plane where it is
+// ground is not drawn (as in CarveFreeSpace): the pixel would show the ground there, not
+// something beyond the volume (a pixel at an object's edge, misjudged).
 FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
                                      const std::vector<DistantRay>& rays,
                                      const std::vector<SurfacePoint>& points,
@@ -54,7 +57,8 @@ FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
                                      const std::vector<int64_t>& keep,
                                      Volume* volume,
                                      int num_threads = 1,
-                                     const std::vector<cv::Mat>* known_depth = nullptr);
+                                     const std::vector<cv::Mat>* known_depth = nullptr,
+                                     const Ground& ground = Ground());
 
 // The voxels of `grid` that the segment from `from` to `to` passes through, in order (a voxel
 // whose closed cube the segment only touches at an edge or corner may or may not be listed),

@@ -119,7 +119,8 @@ Volume PreCarved(const std::vector<CalibratedView>& views,
     for (int kind = 0; kind < 2; ++kind) {
       if (rays[kind].empty()) continue;
       *statistics[kind] = CarveDistantRays(views, rays[kind], options.surface_points, margin,
-                                           *ground_held, &volume, options.num_threads, known_depth);
+                                           *ground_held, &volume, options.num_threads, known_depth,
+                                           options.ground);
     }
   }
   return volume;

@@ -72,7 +72,12 @@ void LogCarve(const CarveOptions& options, const CarveStatistics& s) {
   if (s.free_space_sight_lines > 0) LOG(INFO) << s.FreeSpaceSummary();
   if (s.distant_rays > 0) {
     LOG(INFO) << "distant free space: " << s.distant_rays << " rays of distant pixels carved "
-              << s.distant_carved << " voxels";
+              << s.distant_carved << " voxels"
+              << (s.distant_through_ground > 0
+                      ? "; " + std::to_string(s.distant_through_ground) +
+                            " more would have passed down through the held ground, and were not "
+                            "drawn"
+                      : std::string());
   }
   if (s.unsupported_components > 0) LOG(INFO) << s.FloaterSummary();
   if (s.silhouette_repair.views > 0) LOG(INFO) << s.silhouette_repair.Summary();

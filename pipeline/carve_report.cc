@@ -214,6 +214,7 @@ void WriteCapture(const CarveRun& run, JsonWriter& json) {
       .Key("plain_region_pixels").Value(distant.grown)
       .Key("distant_rays").Value(s.distant_rays)
       .Key("distant_voxels_carved").Value(s.distant_carved)
+      .Key("distant_through_ground_not_drawn").Value(s.distant_through_ground)
       .Key("seconds").Value(distant.seconds)
       .EndObject();
   const DistantPixels& ground = run.ground_pixels;

@@ -219,5 +219,42 @@ TEST(CarveDistantRays, CarveTheWholeRayOrStopShortOfTheKnownSurface) {
   EXPECT_EQ(CarveDistantRays(views, {DistantRay{0, -ray.direction}}, {}, 2.0, {}, &behind).carved, 0);
 }
 
+// A distant pixel's ray that passes down through the held ground (a plane at z = -0.1 whose
+// footprint covers x < 0) is not drawn: the pixel would show the ground. Past the ground's edge
+// (x > 0), or a ray with a length (a ground pixel's), it is.
+TEST(CarveDistantRays, NoRayPassesDownThroughTheHeldGround) {
+  const VoxelGrid grid(Eigen::AlignedBox3d(Eigen::Vector3d::Constant(-0.5), Eigen::Vector3d::Constant(0.5)), 10);
+  const std::vector<uint64_t> all((grid.num_voxels() + 63) / 64, ~uint64_t{0});
+  const std::vector<CalibratedView> views = {
+      testing::PinholeViewLookingAtOrigin(Eigen::Vector3d(0, 0, 5), 100, 100, 100.0)};
+  Ground ground;
+  ground.normal = Eigen::Vector3d::UnitZ();
+  ground.offset = 0.1;
+  ground.depth = 0.05;
+  ground.radius = 0.15;
+  for (double x = -0.45; x < 0.0; x += 0.1) {
+    for (double y = -0.45; y < 0.5; y += 0.1) ground.footprint.emplace_back(x, y, -0.1);
+  }
+  const Eigen::Vector3d on_ground(-0.25, 0.05, -0.1), past_edge(0.25, 0.05, -0.1);
+  const DistantRay into_ground{0, (on_ground - views[0].centre).normalized()};
+  const DistantRay past{0, (past_edge - views[0].centre).normalized()};
+  Volume volume(grid, all);
+  FreeSpaceStatistics s =
+      CarveDistantRays(views, {into_ground, past}, {}, 2.0, {}, &volume, 1, nullptr, ground);
+  EXPECT_EQ(s.sight_lines, 1);
+  EXPECT_EQ(s.through_ground, 1);
+  EXPECT_TRUE(volume.IsSolid(grid.VoxelOf(on_ground + Eigen::Vector3d(0, 0, 0.3))));
+  EXPECT_FALSE(volume.IsSolid(grid.VoxelOf(past_edge + Eigen::Vector3d(0, 0, 0.3))));
+  // Without the ground both are drawn; a ray with a length is drawn through it.
+  Volume open(grid, all);
+  EXPECT_EQ(CarveDistantRays(views, {into_ground, past}, {}, 2.0, {}, &open).sight_lines, 2);
+  DistantRay bounded = into_ground;
+  bounded.length = (on_ground - views[0].centre).norm();
+  Volume bounded_volume(grid, all);
+  s = CarveDistantRays(views, {bounded}, {}, 2.0, {}, &bounded_volume, 1, nullptr, ground);
+  EXPECT_EQ(s.sight_lines, 1);
+  EXPECT_EQ(s.through_ground, 0);
+}
+
 }  // namespace
 }  // namespace raycarve

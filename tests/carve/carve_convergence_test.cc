@@ -157,16 +157,22 @@ TEST(CarveVolume, AutomaticSupersamplingEnlargesThePhotosOnlyForVoxelsFinerThanT
   EXPECT_NE(reason.find("supersample"), std::string::npos) << reason;
 }
 
+// Three levels of detail (12, 24, 48 voxels) with a band of 2, each finer level carving at most
+// `carve_depth` coarse voxels into the coarser level's solid (0: as deep as it finds voxels
+// inconsistent).
+CarveOptions ThreeLevels(int carve_depth) {
+  CarveOptions options = Options(48, 30.0);
+  options.lod_levels = 3;
+  options.lod_band = 2;
+  options.lod_carve_depth = carve_depth;
+  return options;
+}
+
 TEST(CarveVolume, LevelsOfDetailAndEvidenceOrderReachPhotoConsistentVolumesOfTheFinalGrid) {
   const SyntheticScene scene = Scene(6, 160, 120);
   const std::vector<CalibratedView> views = testing::SceneViews(scene);
   const CarveResult single = CarveVolume(views, scene.object_box, Options(48, 30.0));
-  CarveOptions options = Options(48, 30.0);
-  options.lod_levels = 3;
-  options.lod_band = 2;
-  // A finer level carving as deep as it finds inconsistent voxels; the default limit (below)
-  // holds some of them.
-  options.lod_carve_depth = 0;
+  CarveOptions options = ThreeLevels(0);
   const CarveResult lod = CarveVolume(views, scene.object_box, options);
   ASSERT_EQ(lod.statistics.levels.size(), 3u);
   EXPECT_EQ(lod.statistics.levels[0].resolution, 12);
@@ -239,13 +245,11 @@ TEST(CarveVolume, LevelsOfDetailAndEvidenceOrderReachPhotoConsistentVolumesOfThe
     EXPECT_GT(JudgedSurfaceNearTruth(*result), 0.5);
   }
 
-  // At the default lod_carve_depth a finer level holds the voxels deeper than one coarse voxel
-  // in the coarser level's solid: judged surface near the truth measured 0.641 (a coarsest level
-  // of 12 voxels keeps more than the defaults' coarsest of 64 or more).
-  options = Options(48, 30.0);
-  options.lod_levels = 3;
-  options.lod_band = 2;
-  const CarveResult limited = CarveVolume(views, scene.object_box, options);
+  // At the default lod_carve_depth (1) a finer level holds the voxels deeper than one coarse
+  // voxel in the coarser level's solid: judged surface near the truth measured 0.641 (a coarsest
+  // level of 12 voxels keeps more than the defaults' coarsest of 64 or more).
+  ASSERT_EQ(CarveOptions().lod_carve_depth, 1);
+  const CarveResult limited = CarveVolume(views, scene.object_box, ThreeLevels(1));
   ASSERT_EQ(limited.statistics.levels.size(), 3u);
   EXPECT_EQ(limited.statistics.levels[0].interior_held, 0);
   EXPECT_GT(limited.statistics.levels[1].interior_held, 0);

@@ -197,6 +197,7 @@ CarveOptions LevelOptions(const CarveOptions& options, int level_resolution, int
   level_options.correct_view_count = correct_view_count;
   level_options.resolution = level_resolution;
   level_options.lod_levels = 1;
+  level_options.interior_held.clear();  // set per level from the coarser one (CarveLevels)
   if (level + 1 < num_levels) level_options.distant_rays.clear();  // see CarveOptions
   level_options.threshold =
       options.threshold * std::pow(options.lod_threshold_scale, num_levels - 1 - level);

@@ -133,6 +133,15 @@ FreeSpaceStatistics CarveLines(size_t count,
   return statistics;
 }
 
+// Whether the line from `from` (above the ground's plane) along `direction` passes down through
+// the plane where the plane is ground (the crossing at any distance along the line).
+bool CrossesOntoGround(const GroundMap& ground, const Eigen::Vector3d& from,
+                       const Eigen::Vector3d& direction) {
+  const double above = ground.Height(from), fall = above - ground.Height(from + direction);
+  return above > 0.0 && fall > 0.0 &&
+         ground.At(from + (above / fall) * direction) == GroundMap::Foot::kGround;
+}
+
 }  // namespace
 
 FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
@@ -160,14 +169,10 @@ FreeSpaceStatistics CarveFreeSpace(const std::vector<CalibratedView>& views,
     if (!(facing.norm() > 0.0)) return false;
     facing.normalize();
     const Eigen::Vector3d& centre = views[point.views[sightings[index].second]].centre;
-    if (ground_map != nullptr) {
-      const double above = ground_map->Height(centre), below = -ground_map->Height(point.xyz);
-      if (above > 0.0 && below > ground.depth &&
-          ground_map->At(centre + above / (above + below) * (point.xyz - centre)) ==
-              GroundMap::Foot::kGround) {
-        ++through_ground;
-        return false;
-      }
+    if (ground_map != nullptr && -ground_map->Height(point.xyz) > ground.depth &&
+        CrossesOntoGround(*ground_map, centre, point.xyz - centre)) {
+      ++through_ground;
+      return false;
     }
     const Eigen::Vector3d to_point = point.xyz - centre;
     const double length = to_point.norm();
@@ -211,13 +216,10 @@ FreeSpaceStatistics CarveDistantRays(const std::vector<CalibratedView>& views,
     // Camera depth per unit along the ray.
     const double depth_rate = (view.cam_from_world.rotation * ray.direction).z();
     if (!(depth_rate > 0.0)) return false;
-    if (ground_map != nullptr && std::isinf(ray.length)) {
-      const double above = ground_map->Height(centre), fall = -ray.direction.dot(ground.normal);
-      if (above > 0.0 && fall > 0.0 &&
-          ground_map->At(centre + (above / fall) * ray.direction) == GroundMap::Foot::kGround) {
-        ++through_ground;
-        return false;
-      }
+    if (ground_map != nullptr && std::isinf(ray.length) &&
+        CrossesOntoGround(*ground_map, centre, ray.direction)) {
+      ++through_ground;
+      return false;
     }
     double length = std::min(ray.length, (box.center() - centre).norm() + beyond);
     if (!known[ray.view].empty()) {

@@ -105,8 +105,11 @@ std::string ThresholdsText(const CarveOptions& options, const CarveStatistics& s
   return thresholds;
 }
 
-// How far from a sparse point's depth the model may be drawn and still agree with it.
-double SparseDepthTolerance(const VoxelGrid& grid) { return 2.0 * grid.voxel_size(); }
+// How far from a sparse point's depth the model may be drawn and still agree with it, in voxels.
+constexpr double kSparseDepthToleranceVoxels = 2.0;
+double SparseDepthTolerance(const VoxelGrid& grid) {
+  return kSparseDepthToleranceVoxels * grid.voxel_size();
+}
 
 // The model drawn into `view` and scored; the photo | render | error image written to `out`.
 HeldOutViewScore ScoreView(const ScoredModel& scored,
@@ -134,8 +137,8 @@ HeldOutViewScore ScoreView(const ScoredModel& scored,
     for (const Eigen::Vector3d& point : seen->second) {
       if (grid.Box().contains(point)) inside.push_back(point);
     }
-    result.sparse_depth = exporter::MeasureSparseDepth(rendering, view, inside, SparseDepthTolerance(grid),
-                                                       &result.sparse_points);
+    result.sparse_depth = exporter::MeasureSparseDepth(
+        rendering, view, inside, SparseDepthTolerance(grid), &result.sparse_points);
   }
   // The mesh is scored beside the voxel volume it was made from, drawn into the same view.
   result.volume_score = result.score;
@@ -196,7 +199,8 @@ std::string SparseDepthCsv(const HoldoutEvaluation& evaluation) {
   char line[512];
   for (const HeldOutViewScore& view : evaluation.views) {
     for (const exporter::SparsePointDepth& p : view.sparse_points) {
-      std::snprintf(line, sizeof(line), ",%.9g,%.9g,%.9g,%.9g,%.9g,%s\n", p.point.x(), p.point.y(), p.point.z(), p.depth, p.drawn_depth,
+      std::snprintf(line, sizeof(line), ",%.9g,%.9g,%.9g,%.9g,%.9g,%s\n", p.point.x(), p.point.y(),
+                    p.point.z(), p.depth, p.drawn_depth,
                     exporter::SparseDepthVerdictName(p.verdict));
       csv += CsvField(view.name) + line;
     }
@@ -263,7 +267,7 @@ std::string HoldoutJson(const HoldoutOptions& options,
       .Key("sparse_hidden_share").Value(evaluation.sparse_depth.HiddenShare())
       .Key("sparse_behind_share").Value(evaluation.sparse_depth.BehindShare())
       .Key("sparse_undrawn_share").Value(evaluation.sparse_depth.UndrawnShare())
-      .Key("sparse_depth_tolerance_voxels").Value(2.0)
+      .Key("sparse_depth_tolerance_voxels").Value(kSparseDepthToleranceVoxels)
       .Key("sparse_depth_tolerance").Value(evaluation.sparse_depth_tolerance)
       .EndObject();
   return json.str();

@@ -429,6 +429,17 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     model.self_intersections = UndoSelfIntersections(unrefined, &model.mesh);
     Tell(options, "mesh self-intersections: " + model.self_intersections.Summary());
   }
+  if (!options.support.empty()) {
+    const std::vector<Eigen::Vector3f> before = model.mesh.vertices;
+    model.levelling = LevelOntoSupport(options.support, grid.voxel_size(), &model.mesh);
+    if (options.undo_self_intersections && model.levelling.vertices > 0) {
+      // Where levelling a thin surface's top took it through its underside, that part stays.
+      const SelfIntersectionRepair undone = UndoSelfIntersections(before, &model.mesh);
+      model.levelling.undone = undone.vertices_moved_back;
+      model.self_intersections.pairs_after = undone.pairs_after;
+    }
+    Tell(options, "mesh levelling: " + model.levelling.Summary());
+  }
   MarkAndRemoveWalls(grid, views, options, &model);
   ColourModel(views, grid, options, &model);
   return model;

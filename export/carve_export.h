@@ -13,6 +13,7 @@
 #include "export/point_cloud_io.h"
 #include "export/mesh_self_intersection.h"
 #include "export/mesh_texture.h"
+#include "export/support_levelling.h"
 #include "export/surface_mesh.h"
 
 namespace raycarve {
@@ -100,6 +101,10 @@ struct ModelMeshOptions {
   // sides and underside below the plane (GroundFillVertices) are left out with the walls: they
   // stand for no surface the photos saw. Empty: none.
   Ground ground;
+  // The plane the subject stands on where the sparse points show it (its footprint), held or
+  // not: after the silhouette fit, the mesh facing up within two voxels of it is levelled onto
+  // it (LevelOntoSupport). Empty: not levelled.
+  Ground support;
   // Threads for refining and colouring (0 or less: every core); the mesh does not depend on it.
   int num_threads = 0;
   // After colouring, a texture atlas from the photos (TextureMeshFromPhotos): each triangle
@@ -120,6 +125,7 @@ struct ModelMesh {
   double final_smoothing_mean_move = 0.0;  // world units, over all vertices
   MeshPartsSummary parts;
   SilhouetteFitSummary silhouettes;
+  SupportLevelling levelling;
   SelfIntersectionRepair self_intersections;
   MeshColouringSummary colouring;
   MeshTextureSummary texture;

@@ -389,6 +389,7 @@ void CarvePipeline::MakeSurface() {
   const Clock::time_point start = Clock::now();
   exporter::ModelMeshOptions options = request_.mesh;
   options.ground = run_.ground;
+  if (request_.level_support) options.support = run_.support;
   for (const SurfacePoint& point : surface_points_) options.sparse_points.push_back(point.xyz);
   // Each step's line as it ends: the mesh stage can take longer than the carve.
   options.progress = [](const std::string& line) { LOG(INFO) << line; };
@@ -400,6 +401,7 @@ void CarvePipeline::MakeSurface() {
   run_.mesh_refinement = model_.refinement;
   run_.mesh_parts = model_.parts;
   run_.mesh_silhouettes = model_.silhouettes;
+  run_.mesh_levelling = model_.levelling;
   run_.mesh_self_intersections = model_.self_intersections;
   run_.mesh_texture = model_.texture;
   run_.mesh_final_smoothing_mean_move = model_.final_smoothing_mean_move;

@@ -69,6 +69,9 @@ struct CarveRun {
   exporter::SupportingPlane plane;  // the plane the subject stands on
   // The ground under it held solid by the carve (CarveRequest::hold_ground); empty: none.
   Ground ground;
+  // The plane's footprint (the sparse points on it), masked or not: the mesh is levelled onto it
+  // (CarveRequest::level_support); empty: no plane, or no point on it.
+  Ground support;
   std::string ground_reason;  // why there is none, or where it is
   // The distant pixels (CarveRequest::distant_free_space): what was judged and found; `rays` is
   // left empty here (the carve takes them).
@@ -116,6 +119,7 @@ struct CarveRun {
   exporter::MeshTextureSummary mesh_texture;
   exporter::MeshPartsSummary mesh_parts;
   exporter::SilhouetteFitSummary mesh_silhouettes;
+  exporter::SupportLevelling mesh_levelling;
   double mesh_final_smoothing_mean_move = 0.0;  // world units
   int64_t mesh_small_components_removed = 0;
   int64_t mesh_grid_wall_vertices = 0;  // on the grid's wall: left out of the cloud

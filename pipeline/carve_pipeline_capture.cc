@@ -65,13 +65,8 @@ void CarvePipeline::DecideObjectRules() {
 
 void CarvePipeline::DecideGround() {
   run_.ground = Ground();
-  if (!run_.plane.found) {
-    run_.ground_reason = "no supporting plane";
-  } else if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
-    run_.ground_reason = "masks bound the subject";
-  } else if (!request_.hold_ground) {
-    run_.ground_reason = "--hold_ground 0";
-  } else {
+  run_.support = Ground();
+  if (run_.plane.found) {
     // The floor runs on beyond the box: its points around the box too (the box's margin has
     // none of its own), those of the carved photos.
     const Eigen::AlignedBox3d& box = project_.bounds.box;
@@ -85,7 +80,16 @@ void CarvePipeline::DecideGround() {
       if (static_cast<int>(point.views.size()) >= kCheckedTrack) checked.push_back(point.xyz);
     }
     const bool enough = static_cast<int>(checked.size()) >= kMinCheckedPoints;
-    run_.ground = exporter::GroundUnder(run_.plane, points, enough ? checked : points);
+    run_.support = exporter::GroundUnder(run_.plane, points, enough ? checked : points);
+  }
+  if (!run_.plane.found) {
+    run_.ground_reason = "no supporting plane";
+  } else if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
+    run_.ground_reason = "masks bound the subject";
+  } else if (!request_.hold_ground) {
+    run_.ground_reason = "--hold_ground 0";
+  } else {
+    run_.ground = run_.support;
     std::ostringstream text;
     text.precision(3);
     if (run_.ground.empty()) {

@@ -1,0 +1,37 @@
+#pragma once
+// Levelling the mesh onto the plane the subject stands on (a table, a floor, a mat): the carve
+// leaves such a surface a voxel thick and the photos, which see it at a slant, cannot place it
+// within that voxel; the sparse points on it can.
+
+#include <cstdint>
+#include <string>
+
+#include "carve/ground.h"
+#include "export/surface_mesh.h"
+
+namespace raycarve {
+namespace exporter {
+
+struct SupportLevelling {
+  int64_t vertices = 0;      // vertices moved onto (or towards) the plane
+  double mean_move = 0.0;    // world units, over those vertices
+  double band = 0.0;
+  int64_t undone = 0;        // of them, moved back where levelling made the mesh fold         // world units: how far from the plane a vertex could be levelled
+  std::string Summary() const;
+};
+
+// A vertex faces up when its normal is within this many degrees of the plane's normal. The
+// sides of what stands on the plane face sideways, its underside down; a carved slab's top is
+// tilted by the voxels' steps, at most 45 degrees, and by refinement's noise.
+constexpr double kLevelledNormalDegrees = 60.0;
+
+// Moves each vertex of `mesh` that faces up (kLevelledNormalDegrees) and lies within
+// `voxel_size` of the plane of `support`, above or below, onto the plane, and one that faces
+// down (a thin top's underside) to half a voxel below it, where it is higher; one within two
+// voxels part of the way (all of it at one voxel, none at two, so that the surface joins what
+// stays); only where the sparse points show the plane: the vertex's foot on the plane is on
+// `support`'s footprint (GroundMap::At). Recomputes the normals. An empty `support` moves nothing.
+SupportLevelling LevelOntoSupport(const Ground& support, double voxel_size, TriangleMesh* mesh);
+
+}  // namespace exporter
+}  // namespace raycarve

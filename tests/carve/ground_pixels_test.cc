@@ -9,6 +9,7 @@
 
 #include "calib/pixel.h"
 #include "calib/ray_box.h"
+#include "tests/ground_fixture.h"
 #include "tests/test_support.h"
 
 namespace raycarve {
@@ -66,15 +67,8 @@ Rendered Render(bool textured_box) {
 
 // The floor as the sparse points would show it: points every 0.2 over [-2, 2]^2.
 Ground FloorGround() {
-  Ground ground;
-  ground.normal = Eigen::Vector3d::UnitY();
-  ground.offset = 0.0;
-  ground.depth = 0.02;
-  ground.radius = 0.3;
-  for (int i = -10; i <= 10; ++i) {
-    for (int j = -10; j <= 10; ++j) ground.footprint.emplace_back(0.2 * i, 0.0, 0.2 * j);
-  }
-  return ground;
+  return testing::GridGround(/*axis=*/1, /*half=*/2.0, /*spacing=*/0.2, /*depth=*/0.02,
+                             /*radius=*/0.3, /*outline=*/false);
 }
 
 constexpr double kClearance = 0.06;

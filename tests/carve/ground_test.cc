@@ -9,21 +9,16 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "tests/ground_fixture.h"
+
 namespace raycarve {
 namespace {
 
 // The floor's sparse points every 0.1 over the square [-1, 1]^2 at z = 0, its hull the square's
 // corners, reaching 0.2; one point seen 0.5 below the plane at (1.5, 1.5) (a step down).
 Ground SquareFloor() {
-  Ground ground;
-  ground.normal = Eigen::Vector3d::UnitZ();
-  ground.offset = 0.0;
-  ground.depth = 0.07;
-  ground.radius = 0.2;
-  for (int i = -10; i <= 10; ++i) {
-    for (int j = -10; j <= 10; ++j) ground.footprint.emplace_back(0.1 * i, 0.1 * j, 0.0);
-  }
-  ground.outline = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  Ground ground = testing::GridGround(/*axis=*/2, /*half=*/1.0, /*spacing=*/0.1, /*depth=*/0.07,
+                                      /*radius=*/0.2, /*outline=*/true);
   ground.holes = {{1.5, 1.5, 0.0}};
   return ground;
 }
@@ -47,7 +42,9 @@ TEST(GroundVoxels, HoldsWhatLiesUnderTheFloorAndNothingElse) {
       EXPECT_TRUE(held.count(index)) << c.transpose();
     }
     // Never above that, never beyond the square's reach (0.2 and a raster cell).
-    if (c.z() > -0.17 || edge > 1.3) EXPECT_FALSE(held.count(index)) << c.transpose();
+    if (c.z() > -0.17 || edge > 1.3) {
+      EXPECT_FALSE(held.count(index)) << c.transpose();
+    }
   }
   EXPECT_EQ(under_square, 22 * 22 * 8);  // centres -1.05..1.05, 8 layers from -0.25 to -0.95
   EXPECT_TRUE(GroundVoxels(kGrid, Ground()).empty());
@@ -66,8 +63,12 @@ TEST(BeyondGroundVoxels, EmptiesBelowThePlanePastTheFloorButNotNearAPointSeenThe
     const Eigen::Vector3d c = kGrid.Centre(kGrid.Voxel(index));
     const double edge = std::max(std::abs(c.x()), std::abs(c.y()));
     const double to_hole = (c.head<2>() - Eigen::Vector2d(1.5, 1.5)).norm();
-    if (c.z() < -0.17 && edge > 1.3 && to_hole > 0.3) EXPECT_TRUE(empty.count(index)) << c.transpose();
-    if (c.z() > -0.17 || edge < 1.1 || to_hole < 0.15) EXPECT_FALSE(empty.count(index)) << c.transpose();
+    if (c.z() < -0.17 && edge > 1.3 && to_hole > 0.3) {
+      EXPECT_TRUE(empty.count(index)) << c.transpose();
+    }
+    if (c.z() > -0.17 || edge < 1.1 || to_hole < 0.15) {
+      EXPECT_FALSE(empty.count(index)) << c.transpose();
+    }
   }
 }
 

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "export/surface_mesh.h"
+#include "tests/ground_fixture.h"
 
 namespace raycarve {
 namespace exporter {
@@ -33,16 +34,8 @@ TriangleMesh Box(const Eigen::Vector3f& low, const Eigen::Vector3f& high) {
 
 // The plane z = 0, its sparse points over [-1, 1]^2.
 Ground PlaneZ0() {
-  Ground ground;
-  ground.normal = Eigen::Vector3d::UnitZ();
-  ground.offset = 0.0;
-  ground.depth = 0.01;
-  ground.radius = 0.3;
-  for (double x = -1.0; x <= 1.0; x += 0.25) {
-    for (double y = -1.0; y <= 1.0; y += 0.25) ground.footprint.emplace_back(x, y, 0.0);
-  }
-  ground.outline = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
-  return ground;
+  return testing::GridGround(/*axis=*/2, /*half=*/1.0, /*spacing=*/0.25, /*depth=*/0.01,
+                             /*radius=*/0.3, /*outline=*/true);
 }
 
 TEST(LevelOntoSupport, AThinTopNearThePlaneLiesOnItWithItsUndersideBelow) {

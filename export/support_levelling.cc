@@ -11,7 +11,7 @@ namespace exporter {
 std::string SupportLevelling::Summary() const {
   std::ostringstream text;
   text.precision(3);
-  text << vertices << " vertices facing up or down within " << band
+  text << vertices << " vertices within " << band
        << " of the supporting plane levelled onto it (mean move " << mean_move << ")";
   if (undone > 0) text << ", " << undone << " moved back where that made the mesh fold";
   return text.str();
@@ -30,18 +30,15 @@ SupportLevelling LevelOntoSupport(const Ground& support, double voxel_size, Tria
     const Eigen::Vector3d vertex = mesh->vertices[i].cast<double>();
     const double height = map.Height(vertex);
     if (std::abs(height) >= levelling.band) continue;
+    if (map.At(vertex) != GroundMap::Foot::kGround) continue;
+    // Onto the plane; the underside of a thin top (a mat), facing down, to half a voxel under it
+    // at least, so that the top levelled onto the plane stays above it. What faces sideways goes
+    // onto the plane too: refinement's wrinkles tilt single normals of the top, which left where
+    // they were would stand up as spikes through the levelled triangles around them; the foot of
+    // a wall standing on the plane is on it already.
     const double facing = support.normal.dot(mesh->normals[i].cast<double>());
-    // Facing up: onto the plane. Facing down (the underside of a thin top, a mat): to half a
-    // voxel under it at least, so that the top levelled onto the plane stays above it.
-    double target;
-    if (facing >= min_cos) {
-      target = 0.0;
-    } else if (facing <= -min_cos) {
-      target = std::min(height, -0.5 * voxel_size);
-    } else {
-      continue;
-    }
-    if (target == height || map.At(vertex) != GroundMap::Foot::kGround) continue;
+    const double target = facing <= -min_cos ? std::min(height, -0.5 * voxel_size) : 0.0;
+    if (target == height) continue;
     // All the way within a voxel, then less, to nothing at two.
     const double share = std::min(1.0, 2.0 - std::abs(height) / voxel_size);
     mesh->vertices[i] = (vertex + share * (target - height) * support.normal).cast<float>();

@@ -20,17 +20,16 @@ struct SupportLevelling {
   std::string Summary() const;
 };
 
-// A vertex faces up when its normal is within this many degrees of the plane's normal. The
-// sides of what stands on the plane face sideways, its underside down; a carved slab's top is
-// tilted by the voxels' steps, at most 45 degrees, and by refinement's noise.
+// A vertex faces down when its normal is within this many degrees of the plane's opposite: the
+// underside of a thin top (a mat), which goes under the plane rather than onto it.
 constexpr double kLevelledNormalDegrees = 60.0;
 
-// Moves each vertex of `mesh` that faces up (kLevelledNormalDegrees) and lies within
-// `voxel_size` of the plane of `support`, above or below, onto the plane, and one that faces
-// down (a thin top's underside) to half a voxel below it, where it is higher; one within two
-// voxels part of the way (all of it at one voxel, none at two, so that the surface joins what
-// stays); only where the sparse points show the plane: the vertex's foot on the plane is on
-// `support`'s footprint (GroundMap::At). Recomputes the normals. An empty `support` moves nothing.
+// Moves each vertex of `mesh` that lies within `voxel_size` of the plane of `support`, above or
+// below, onto the plane, but one that faces down (kLevelledNormalDegrees) to half a voxel below
+// it where it is higher; one within two voxels part of the way (all of it at one voxel, none at
+// two, so that the surface joins what stays); only where the sparse points show the plane: the
+// vertex's foot on the plane is on `support`'s footprint (GroundMap::At). Recomputes the normals.
+// An empty `support` moves nothing.
 SupportLevelling LevelOntoSupport(const Ground& support, double voxel_size, TriangleMesh* mesh);
 
 }  // namespace exporter

@@ -2,6 +2,7 @@
 // (a mat), one farther off, one beyond the plane's sparse points, and a tall block.
 #include "export/support_levelling.h"
 
+#include <cmath>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -64,6 +65,18 @@ TEST(LevelOntoSupport, PartWayBetweenOneAndTwoVoxelsNoneBeyond) {
   const TriangleMesh original = far;
   EXPECT_EQ(LevelOntoSupport(PlaneZ0(), kVoxel, &far).vertices, 0);
   EXPECT_EQ(far.vertices, original.vertices);
+}
+
+TEST(LevelOntoSupport, ASidewaysFacingVertexNearThePlaneGoesOntoItAsTheTopDoes) {
+  // A fin standing across the plane's band: its long sides outweigh its ends and its top, so
+  // every corner faces sideways. Its foot (0.2 voxels up) goes onto the plane, its top (1.2
+  // voxels up) 0.8 of the way: nothing near the plane is left standing as a spike.
+  TriangleMesh mesh = Box({-0.5f, -0.005f, 0.01f}, {0.5f, 0.005f, 0.06f});
+  for (int k = 0; k < 8; ++k) ASSERT_LT(std::abs(mesh.normals[k].z()), 0.5f) << k;
+  EXPECT_EQ(LevelOntoSupport(PlaneZ0(), kVoxel, &mesh).vertices, 8);
+  for (int k = 0; k < 8; ++k) {
+    EXPECT_NEAR(mesh.vertices[k].z(), k & 4 ? 0.06 * 0.2 : 0.0, 1e-6) << k;
+  }
 }
 
 TEST(LevelOntoSupport, OnlyWhereThePlanesPointsAre) {

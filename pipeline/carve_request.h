@@ -78,8 +78,8 @@ struct CarveRequest {
   // lies under it, where its points are, is held solid (CarveOptions::ground): colour carving
   // through a plain or repeating floor would open it and show the photos the volume under it.
   bool hold_ground = true;
-  // Smooth mesh: where the sparse points show a supporting plane, masked or not, the mesh facing
-  // up near it is levelled onto it where its points are (ModelMeshOptions::support).
+  // Smooth mesh: where the sparse points show a supporting plane, masked or not, the mesh
+  // near it is levelled onto it where its points are (ModelMeshOptions::support).
   bool level_support = true;
   // Without masks: photo pixels whose pattern moves between the photos as something beyond the
   // volume would (sky, clouds, far hills; calib/distant_pixels.h) saw across the volume, and

@@ -13,6 +13,7 @@
 #include "export/volume_renderer.h"
 #include "samples/synthetic_scene.h"
 #include "tests/carve/carve_fixture.h"
+#include "tests/ground_fixture.h"
 #include "tests/test_support.h"
 
 namespace raycarve {
@@ -247,6 +248,54 @@ MaskedCarve CarveMaskedScene() {
   carve.resolution = 64;
   CarveResult result = CarveVolume(views, scene.object_box, carve);
   return MaskedCarve{std::move(views), std::move(result)};
+}
+
+TEST(CarveExport, TheMeshOverTheGroundSquareIsLevelledOntoItsPlane) {
+  // The generated scene's ground square lies on z = 0 with nothing under it; carved with masks
+  // it is a slab a voxel thick whose refined top wanders within that voxel. Given the plane and
+  // the square as the sparse points would show them, the top lies on the plane.
+  const MaskedCarve carved = CarveMaskedScene();
+  const double voxel = carved.result.volume.grid().voxel_size();
+  ModelMeshOptions options;
+  const ModelMesh plain = MeshCarvedModel(carved.result, carved.views, options);
+  options.support = testing::GridGround(/*axis=*/2, /*half=*/1.5, /*spacing=*/0.1,
+                                        /*depth=*/0.02, /*radius=*/0.2, /*outline=*/true);
+  const ModelMesh levelled = MeshCarvedModel(carved.result, carved.views, options);
+  EXPECT_GT(levelled.levelling.vertices, 0);
+  EXPECT_EQ(plain.levelling.vertices, 0);
+  // The square's top away from the ball (centre (0.45, 0.35), radius 0.55) and the box
+  // ([-1.05, -0.2] x [-0.75, 0.05]): the share of its vertices on the plane, to a hundredth of
+  // a voxel.
+  struct Top {
+    double on_plane_share = 0.0;  // within a hundredth of a voxel of it
+    double mean_height = 0.0;     // |z|, in voxels
+  };
+  const auto top_of = [voxel](const TriangleMesh& mesh) {
+    int top = 0, on = 0;
+    double height = 0.0;
+    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+      const Eigen::Vector3f& v = mesh.vertices[i];
+      if (std::max(std::abs(v.x()), std::abs(v.y())) > 1.4f || mesh.normals[i].z() < 0.5f) continue;
+      if (std::abs(v.z()) > 2.0 * voxel) continue;
+      if (Eigen::Vector2f(v.x() - 0.45f, v.y() - 0.35f).norm() < 0.75f) continue;
+      if (v.x() > -1.2f && v.x() < -0.05f && v.y() > -0.9f && v.y() < 0.2f) continue;
+      ++top;
+      on += std::abs(v.z()) < 0.01 * voxel;
+      height += std::abs(v.z()) / voxel;
+    }
+    EXPECT_GT(top, 50);
+    return Top{static_cast<double>(on) / std::max(top, 1), height / std::max(top, 1)};
+  };
+  const Top before = top_of(plain.mesh), after = top_of(levelled.mesh);
+  std::cout << "the square's top on the plane: " << before.on_plane_share << " as refined (mean "
+            << before.mean_height << " voxels off), " << after.on_plane_share << " levelled ("
+            << after.mean_height << "); " << levelled.levelling.Summary() << "\n";
+  // Measured: none on it as refined (0.59 voxels off on average), 46% levelled (0.09 off; the rest
+  // is where levelling folded the mesh and was undone, or between one and two voxels off).
+  EXPECT_GT(after.on_plane_share, before.on_plane_share + 0.3);
+  EXPECT_LT(after.mean_height, 0.5 * before.mean_height);
+  // What levelling folded was undone: the mesh bounds a solid.
+  EXPECT_EQ(AnalyseTopology(levelled.mesh).self_intersecting_pairs, 0);
 }
 
 TEST(CarveExport, RefinementPassesStopWhenTheMeshStopsMoving) {

@@ -433,7 +433,7 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     const std::vector<Eigen::Vector3f> before = model.mesh.vertices;
     model.levelling = LevelOntoSupport(options.support, grid.voxel_size(), &model.mesh);
     if (options.undo_self_intersections && model.levelling.vertices > 0) {
-      // Where levelling a thin surface's top took it through its underside, that part stays.
+      // Where levelling made triangles pass through each other, those vertices go back.
       const SelfIntersectionRepair undone = UndoSelfIntersections(before, &model.mesh);
       model.levelling.undone = undone.vertices_moved_back;
       model.self_intersections.pairs_after = undone.pairs_after;

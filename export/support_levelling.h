@@ -15,8 +15,8 @@ namespace exporter {
 struct SupportLevelling {
   int64_t vertices = 0;      // vertices moved onto (or towards) the plane
   double mean_move = 0.0;    // world units, over those vertices
-  double band = 0.0;
-  int64_t undone = 0;        // of them, moved back where levelling made the mesh fold         // world units: how far from the plane a vertex could be levelled
+  double band = 0.0;         // world units: how far from the plane a vertex could be levelled
+  int64_t undone = 0;        // of them, moved back where levelling made the mesh fold
   std::string Summary() const;
 };
 

@@ -109,6 +109,7 @@ std::string Bounds::Summary() const {
     if (num_unframed > 0) text << ", " << num_unframed << " of the room around (framed by few photos)";
     text << " dropped; " << num_trimmed_outside << " trimmed as outliers)";
     if (around_focus) text << ", narrowed to the points framed around the cameras' focus";
+    if (around_hull) text << ", narrowed to the masks' visual hull";
     if (depth_tried_points > 0) {
       text << ", narrowed to the " << depth_resolved_points << " of " << depth_tried_points
            << " points the photos place in depth to two voxels";

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <thread>
+#include <cstdio>
+#include <cstdlib>
 
 #include <opencv2/imgproc.hpp>
 
@@ -160,6 +162,101 @@ VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
   statistics.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return statistics;
+}
+
+HullBox VisualHullBox(const std::vector<CalibratedView>& views,
+                      const std::vector<Eigen::Vector3d>& points,
+                      const Eigen::AlignedBox3d& box,
+                      int resolution,
+                      int num_threads,
+                      int min_background_views) {
+  const auto start = std::chrono::steady_clock::now();
+  HullBox hull;
+  hull.box = box;
+  Volume volume{VoxelGrid(box, resolution)};
+  const VisualHullStatistics carved =
+      CarveVisualHull(views, &volume, num_threads, min_background_views);
+  if (carved.views_with_masks == 0) return hull;
+  const VoxelGrid& grid = volume.grid();
+  // The hull's voxels that two or more photos frame (their centres): what fewer frame is never
+  // judged by colour nor meshed (the carve keeps it solid and leaves it out of the model).
+  std::vector<int32_t> label(grid.num_voxels(), -1);  // -2: kept, not yet labelled
+  for (int64_t index = 0; index < grid.num_voxels(); ++index) {
+    if (!volume.IsSolid(index)) continue;
+    const Eigen::Vector3d centre = grid.Centre(grid.Voxel(index));
+    int framed = 0;
+    for (const CalibratedView& view : views) {
+      if (view.FramesPoint(centre) && ++framed >= 2) break;
+    }
+    if (framed >= 2) label[index] = -2;
+  }
+  // Its pieces (26-connected), each with its voxels' box and the sparse points inside it.
+  struct Piece {
+    Eigen::AlignedBox3d box;
+    int64_t voxels = 0;
+    int points = 0;
+  };
+  std::vector<Piece> pieces;
+  std::vector<int64_t> queue;
+  for (int64_t seed = 0; seed < grid.num_voxels(); ++seed) {
+    if (label[seed] != -2) continue;
+    const int32_t id = static_cast<int32_t>(pieces.size());
+    pieces.emplace_back();
+    Piece& piece = pieces.back();
+    label[seed] = id;
+    queue.assign(1, seed);
+    while (!queue.empty()) {
+      const int64_t index = queue.back();
+      queue.pop_back();
+      const Eigen::Vector3i voxel = grid.Voxel(index);
+      piece.box.extend(grid.Corner(voxel, 0));
+      piece.box.extend(grid.Corner(voxel, 7));
+      ++piece.voxels;
+      for (int dz = -1; dz <= 1; ++dz) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Eigen::Vector3i next = voxel + Eigen::Vector3i(dx, dy, dz);
+            if (!grid.Contains(next)) continue;
+            const int64_t n = grid.Index(next);
+            if (label[n] != -2) continue;
+            label[n] = id;
+            queue.push_back(n);
+          }
+        }
+      }
+    }
+  }
+  int points_in_hull = 0;
+  for (const Eigen::Vector3d& point : points) {
+    const Eigen::Vector3i voxel = grid.VoxelOf(point);
+    if (!grid.Contains(voxel)) continue;
+    const int32_t id = label[grid.Index(voxel)];
+    if (id < 0) continue;
+    ++pieces[id].points;
+    ++points_in_hull;
+  }
+  // The object is where the masks and the sparse points agree: pieces holding a share of the
+  // points (masks that call part of the surroundings object, such as a sky unlike the backdrop,
+  // leave pieces with none). Without points in the hull, every piece.
+  Eigen::AlignedBox3d kept;  // empty
+  for (const Piece& piece : pieces) {
+    if (points_in_hull > 0 &&
+        piece.points < std::max(1.0, kHullPiecePointShare * points_in_hull)) {
+      continue;
+    }
+    kept.extend(piece.box);
+    hull.voxels += piece.voxels;
+    hull.points += piece.points;
+    ++hull.pieces;
+  }
+  hull.pieces_left = static_cast<int>(pieces.size()) - hull.pieces;
+  if (!kept.isEmpty()) {
+    const Eigen::Vector3d grow = Eigen::Vector3d::Constant(grid.voxel_size());
+    kept = Eigen::AlignedBox3d(kept.min() - grow, kept.max() + grow);
+  }
+  hull.box = kept;
+  hull.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return hull;
 }
 
 }  // namespace raycarve

@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "calib/calibrated_view.h"
 #include "carve/volume.h"
 
@@ -27,5 +29,28 @@ VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
                                      Volume* volume,
                                      int num_threads = 1,
                                      int min_background_views = 1);
+
+// Where the masks put the object inside `box`: the visual hull of `views`' masks (CarveVisualHull
+// with `min_background_views`) on a grid of `resolution` voxels along the box's longest side,
+// less what fewer than two photos frame (their centres), cut into 26-connected pieces; the box
+// of the pieces that hold at least kHullPiecePointShare of the sparse `points` in the hull
+// (every piece when none is there), grown by one of those voxels. A voxel only partly on the
+// object stays, so the hull holds the object and the box holds the hull. `box` itself when no
+// view has a mask; empty when the masks leave nothing.
+constexpr double kHullPiecePointShare = 0.05;
+struct HullBox {
+  Eigen::AlignedBox3d box;
+  int64_t voxels = 0;    // the coarse hull's voxels in the pieces kept
+  int points = 0;        // sparse points in them
+  int pieces = 0;        // pieces kept
+  int pieces_left = 0;   // pieces with too few sparse points
+  double seconds = 0.0;
+};
+HullBox VisualHullBox(const std::vector<CalibratedView>& views,
+                      const std::vector<Eigen::Vector3d>& points,
+                      const Eigen::AlignedBox3d& box,
+                      int resolution,
+                      int num_threads,
+                      int min_background_views);
 
 }  // namespace raycarve

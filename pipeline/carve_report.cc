@@ -146,6 +146,7 @@ void WriteBounds(const CarveRun& run, JsonWriter& json) {
       .Key("max").Value(JsonArray(run.bounds.box.max()))
       .Key("explicit").Value(run.bounds.is_explicit)
       .Key("around_focus").Value(run.bounds.around_focus)
+      .Key("around_hull").Value(run.bounds.around_hull)
       .Key("depth_resolved_points").Value(run.bounds.depth_resolved_points)
       .Key("depth_tried_points").Value(run.bounds.depth_tried_points)
       .EndObject();

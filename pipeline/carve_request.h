@@ -40,7 +40,8 @@ struct BoundsRequest {
   // What the capture is, for the box: "object" (the box around the cameras' common focus,
   // CaptureLayout::focus_box), "scene" (every sparse point the filters keep), or "auto": object
   // when the cameras stand around a point and the photos have no masks (masks already bound an
-  // object), else scene.
+  // object), else scene. With masks, unless "scene", the box is narrowed to the masks' visual
+  // hull where the sparse points are (NarrowToMaskedHull).
   std::string capture = "auto";
 };
 

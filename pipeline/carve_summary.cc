@@ -126,6 +126,10 @@ std::string CaptureText(const CarveRun& run) {
   const std::string next_line = "\n                  ";
   std::string text = run.layout.Summary();
   if (run.bounds.around_focus) text += next_line + "the volume: the box around their focus";
+  if (run.bounds.around_hull) {
+    text += next_line + "the volume: the box around what the masks call the object (where the "
+            "sparse points are)";
+  }
   if (run.bounds.depth_tried_points > 0) {
     text += next_line + "the volume: the " + std::to_string(run.bounds.depth_resolved_points) +
             " of " + std::to_string(run.bounds.depth_tried_points) +

@@ -145,9 +145,33 @@ bool CaptureIsMasked(const ViewReaderSummary& summary) {
   return summary.masks_from_files + summary.masks_from_backdrop > MinorityBackdropMasks(summary);
 }
 
+void NarrowToMaskedHull(LoadedProject* project) {
+  const HullBox hull = VisualHullBox(
+      project->views, CheckedPoints(project->reconstruction, project->bounds.box),
+      project->bounds.box, kHullBoxResolution, /*num_threads=*/0, kHullBoxBackgroundViews);
+  const Eigen::Vector3d before = project->bounds.box.sizes();
+  const Eigen::AlignedBox3d box = hull.box.intersection(project->bounds.box);
+  if (box.isEmpty() || box.isApprox(project->bounds.box)) return;
+  if (box.sizes().maxCoeff() > kHullBoxMaxSide * before.maxCoeff()) {
+    LOG(INFO) << std::setprecision(3) << "volume: the masks' visual hull spans "
+              << box.sizes().maxCoeff() / before.maxCoeff()
+              << " of the box the sparse points gave: the box kept";
+    return;
+  }
+  project->bounds.box = box;
+  project->bounds.around_hull = true;
+  LOG(INFO) << std::setprecision(3) << "volume: the box around what the masks call the object ("
+            << "their visual hull on a grid of " << kHullBoxResolution << ": " << hull.pieces
+            << " pieces of " << hull.voxels << " voxels holding " << hull.points
+            << " sparse points, " << hull.pieces_left << " pieces with too few left out; "
+            << hull.seconds << " s): extent " << box.sizes().transpose()
+            << " of " << before.transpose() << " the sparse points gave";
+}
+
 void ChooseCaptureBox(const BoundsRequest& request, int resolution, LoadedProject* project) {
   if (project->bounds.is_explicit || request.capture == "scene") return;
   const bool masked = CaptureIsMasked(project->view_summary);
+  if (masked) NarrowToMaskedHull(project);
   const CaptureLayout& layout = project->layout;
   const bool object = request.capture == "object" || (layout.object_centred && !masked);
   if (!object) {

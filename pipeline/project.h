@@ -123,6 +123,18 @@ int MinorityBackdropMasks(const ViewReaderSummary& summary);
 // Whether the capture is carved with masks once MinorityBackdropMasks are dropped.
 bool CaptureIsMasked(const ViewReaderSummary& summary);
 
+// Masked captures: the box narrowed to the masks' visual hull (VisualHullBox on a grid of
+// kHullBoxResolution, a voxel carved where kHullBoxBackgroundViews views show it on background,
+// as AgreeMasks does), marked Bounds::around_hull. The sparse points of the surroundings (a
+// field, a floor, a wall, which the masks call background) otherwise widen the box and coarsen
+// the object's voxels. Narrowed only where the hull's box is at most kHullBoxMaxSide of the
+// box's longest side (its voxels a third finer or more): a box the points already fit to the
+// object is kept as it is.
+constexpr int kHullBoxResolution = 96;
+constexpr double kHullBoxMaxSide = 0.75;
+constexpr int kHullBoxBackgroundViews = 2;
+void NarrowToMaskedHull(LoadedProject* project);
+
 // The capture's box (BoundsRequest::capture): for an object, the computed box narrowed to the
 // one around the cameras' focus (CaptureLayout::focus_box), marked Bounds::around_focus; for a
 // scene found by --capture auto without masks, narrowed to the sparse points its photos place in

@@ -278,7 +278,8 @@ void AddBoundsFlags(OptionParser* parser, BoundsRequest* bounds) {
                      "what the photos show, for the volume's box: object (the box around the "
                      "sparse points framed where the cameras' axes meet), scene (every sparse "
                      "point the filters below keep), auto: object when the cameras stand around a "
-                     "point and the photos have no masks",
+                     "point and the photos have no masks; with masks (unless scene), the box "
+                     "narrowed to the masks' visual hull where the sparse points are",
                      {"auto", "object", "scene"});
   parser->AddDefault("min_track_length", &bounds->options.min_track_length,
                      "sparse points seen in fewer images are ignored when bounding the volume");

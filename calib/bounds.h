@@ -44,6 +44,7 @@ struct Bounds {
   bool is_explicit = false;     // given by the user, not computed
   bool around_focus = false;    // the box around the cameras' focus (CaptureLayout::focus_box)
   bool around_hull = false;     // narrowed to the masks' visual hull (VisualHullBox)
+  Eigen::AlignedBox3d points_box;  // when around_hull: the box the sparse points gave
   // A scene's box narrowed to the sparse points its photos place in depth to a voxel
   // (ResolveSceneDepth): their number, of the points tried; 0 of 0 when not narrowed.
   int depth_resolved_points = 0;

@@ -29,6 +29,8 @@ namespace {
 // The default resolution is lowered to what the photos resolve, but not below this: a coarser
 // grid than this says the photos are too small for the volume, and the refusal says so.
 constexpr int kMinLoweredResolution = 16;
+// The fewest pixels a voxel spans when the box was narrowed to the masks' hull (see above).
+constexpr double kNarrowedVoxelPixels = 3.0;
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -237,6 +239,27 @@ void CarvePipeline::CheckVolume() {
         static_cast<int>(std::floor(request_.options.resolution * run_.voxel_pixels));
   };
   measure();
+  if (!request_.resolution_given && project_.bounds.around_hull) {
+    // The box narrowed to the masks' hull makes the voxels finer; held out, voxels of 3-4 px
+    // scored best and ones of about 2 px worse (Middlebury at 256, generated scenes: docs/
+    // studies/2026-12-06-hull-box.md). No finer than that, nor than the points' box gave.
+    const double wide =
+        VoxelGrid(project_.bounds.points_box, request_.options.resolution).voxel_size() / pixel;
+    const double least = std::min(kNarrowedVoxelPixels, wide);
+    if (run_.voxel_pixels < least) {
+      const int resolution = std::max(
+          kMinLoweredResolution,
+          static_cast<int>(std::floor(request_.options.resolution * run_.voxel_pixels / least)));
+      LOG(INFO) << "the box narrowed to the masks' hull: carving at --resolution " << resolution
+                << " instead of the default " << request_.options.resolution
+                << ", so that a voxel spans " << least << " pixels of the photos, not "
+                << run_.voxel_pixels << " (give --resolution to choose)";
+      run_.hull_resolution_from = request_.options.resolution;
+      run_.hull_resolution = resolution;
+      request_.options.resolution = resolution;
+      measure();
+    }
+  }
   char text[96];
   std::snprintf(text, sizeof(text), "a voxel would span %.2f pixels of the photos", run_.voxel_pixels);
   if (!request_.resolution_given && run_.voxel_pixels < 1.0 && run_.supported_resolution >= kMinLoweredResolution) {

@@ -104,6 +104,10 @@ struct CarveRun {
   int supported_resolution = 0;
   // The default --resolution when it was lowered to supported_resolution (0: not lowered).
   int resolution_lowered_from = 0;
+  // The default --resolution when the box narrowed to the masks' hull (Bounds::around_hull) was
+  // carved coarser, so that a voxel spans kNarrowedVoxelPixels (0: not).
+  int hull_resolution_from = 0;
+  int hull_resolution = 0;  // ... and the resolution carved
   // Masks agree.
   MaskAgreementStatistics mask_agreement;
   // Carve.

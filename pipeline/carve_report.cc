@@ -154,6 +154,7 @@ void WriteBounds(const CarveRun& run, JsonWriter& json) {
       .Key("voxel_pixels").Value(run.voxel_pixels)
       .Key("supported_resolution").Value(run.supported_resolution)
       .Key("default_lowered_from").Value(run.resolution_lowered_from)
+      .Key("hull_lowered_from").Value(run.hull_resolution_from)
       .EndObject();
 }
 

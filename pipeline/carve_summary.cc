@@ -107,6 +107,12 @@ std::string ResolutionText(const CarveRun& run) {
                   "  resolution      the default %d lowered to %d: the photos resolve no finer "
                   "(--resolution chooses)",
                   run.voxel_pixels, run.resolution_lowered_from, run.supported_resolution);
+  } else if (run.hull_resolution_from > 0) {
+    std::snprintf(text, sizeof(text),
+                  ", a voxel spans %.2f px of the photos\n"
+                  "  resolution      the default %d lowered to %d in the box narrowed to the "
+                  "masks: finer voxels scored worse (--resolution chooses)",
+                  run.voxel_pixels, run.hull_resolution_from, run.hull_resolution);
   } else if (run.voxel_pixels >= 1.0) {
     std::snprintf(text, sizeof(text), ", a voxel spans %.2f px of the photos", run.voxel_pixels);
   } else {

@@ -158,6 +158,7 @@ void NarrowToMaskedHull(LoadedProject* project) {
               << " of the box the sparse points gave: the box kept";
     return;
   }
+  project->bounds.points_box = project->bounds.box;
   project->bounds.box = box;
   project->bounds.around_hull = true;
   LOG(INFO) << std::setprecision(3) << "volume: the box around what the masks call the object ("

@@ -128,6 +128,7 @@ TEST(UnmaskedCapture, MasksGivenInARoomNarrowTheBoxToTheSubject) {
   EXPECT_NE(output.find("the volume: the box around what the masks call the object"),
             std::string::npos)
       << output;
+  EXPECT_NE(output.find("in the box narrowed to the masks"), std::string::npos) << output;
   const std::string report = testing::ReadFileBytes(scene + "/raycarve/report.json");
   EXPECT_NE(report.find("\"around_hull\": true"), std::string::npos);
   // --capture scene keeps the points' box.
@@ -138,8 +139,14 @@ TEST(UnmaskedCapture, MasksGivenInARoomNarrowTheBoxToTheSubject) {
       << output;
   const std::string points_box = testing::ReadFileBytes(root + "/points_box/report.json");
   EXPECT_NE(points_box.find("\"around_hull\": false"), std::string::npos);
-  // Measured: voxels 0.0251 against 0.0349.
-  EXPECT_LT(JsonNumber(report, "voxel_size"), 0.75 * JsonNumber(points_box, "voxel_size"));
+  // The narrower box would make a voxel span 1.37 pixels of these small photos against the
+  // points' box's 1.97: the default resolution is lowered so that it spans as many as before
+  // (no fewer than 3 where the points' box gave more), and the box holds fewer voxels.
+  EXPECT_EQ(JsonNumber(report, "hull_lowered_from"), 128);
+  EXPECT_EQ(JsonNumber(points_box, "hull_lowered_from"), 0);
+  EXPECT_NEAR(JsonNumber(report, "voxel_size"), JsonNumber(points_box, "voxel_size"),
+              0.02 * JsonNumber(points_box, "voxel_size"));
+  EXPECT_LT(JsonNumber(report, "num_voxels"), 0.6 * JsonNumber(points_box, "num_voxels"));
   // Nothing of the subject is cut: the cloud against the truth inside the narrower box (measured:
   // F-score 99.5%), and the held-out photos' silhouettes (measured: IoU 0.985). (Their PSNR is
   // not compared: on 9 photos of 320x240 it swings by 1-2 dB with the grid, either way; on 36 of

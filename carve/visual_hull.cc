@@ -235,13 +235,23 @@ HullBox VisualHullBox(const std::vector<CalibratedView>& views,
     ++pieces[id].points;
     ++points_in_hull;
   }
-  // The object is where the masks and the sparse points agree: pieces holding a share of the
-  // points (masks that call part of the surroundings object, such as a sky unlike the backdrop,
-  // leave pieces with none). Without points in the hull, every piece.
+  // The object is where the masks and the sparse points agree: the piece holding the most points,
+  // and those as densely pointed (points per voxel) within kHullPieceDensityShare (a second object
+  // beside the first) with kHullPieceMinPoints or more. Masks that call part of the surroundings
+  // object, such as a sky unlike the backdrop, leave pieces with none or a few stray ones.
+  // Without points in the hull, every piece.
+  const Piece* most = nullptr;
+  for (const Piece& piece : pieces) {
+    if (most == nullptr || piece.points > most->points) most = &piece;
+  }
+  const double least_density =
+      most == nullptr ? 0.0
+                      : kHullPieceDensityShare * most->points / static_cast<double>(most->voxels);
   Eigen::AlignedBox3d kept;  // empty
   for (const Piece& piece : pieces) {
-    if (points_in_hull > 0 &&
-        piece.points < std::max(1.0, kHullPiecePointShare * points_in_hull)) {
+    if (points_in_hull > 0 && &piece != most &&
+        (piece.points < kHullPieceMinPoints ||
+         piece.points < least_density * static_cast<double>(piece.voxels))) {
       continue;
     }
     kept.extend(piece.box);

@@ -33,17 +33,19 @@ VisualHullStatistics CarveVisualHull(const std::vector<CalibratedView>& views,
 // Where the masks put the object inside `box`: the visual hull of `views`' masks (CarveVisualHull
 // with `min_background_views`) on a grid of `resolution` voxels along the box's longest side,
 // less what fewer than two photos frame (their centres), cut into 26-connected pieces; the box
-// of the pieces that hold at least kHullPiecePointShare of the sparse `points` in the hull
-// (every piece when none is there), grown by one of those voxels. A voxel only partly on the
+// of the piece that holds the most of the sparse `points` and of those that hold at least
+// kHullPieceMinPoints at a density (points per voxel) of at least kHullPieceDensityShare of its
+// own (every piece when no point is in the hull), grown by one of those voxels. A voxel only partly on the
 // object stays, so the hull holds the object and the box holds the hull. `box` itself when no
 // view has a mask; empty when the masks leave nothing.
-constexpr double kHullPiecePointShare = 0.05;
+constexpr int kHullPieceMinPoints = 3;
+constexpr double kHullPieceDensityShare = 0.1;
 struct HullBox {
   Eigen::AlignedBox3d box;
   int64_t voxels = 0;    // the coarse hull's voxels in the pieces kept
   int points = 0;        // sparse points in them
   int pieces = 0;        // pieces kept
-  int pieces_left = 0;   // pieces with too few sparse points
+  int pieces_left = 0;   // pieces with too few sparse points for their size
   double seconds = 0.0;
 };
 HullBox VisualHullBox(const std::vector<CalibratedView>& views,

@@ -1,5 +1,7 @@
 #include "carve/visual_hull.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "carve/footprint.h"
@@ -164,7 +166,12 @@ TEST(VisualHullBox, HoldsTheObjectAndLeavesOutAPieceWithoutSparsePoints) {
   ASSERT_GT(truth.size(), 5000u);
   const std::vector<Eigen::Vector3d> points(truth.begin(), truth.begin() + 300);
 
-  const HullBox hull = VisualHullBox(views, points, box, 64, 2, 2);
+  // Two stray points there (wrong matches) do not make it an object.
+  std::vector<Eigen::Vector3d> with_strays = points;
+  with_strays.push_back(spurious);
+  with_strays.push_back(spurious + Eigen::Vector3d::Constant(0.01 * size.maxCoeff()));
+
+  const HullBox hull = VisualHullBox(views, with_strays, box, 64, 2, 2);
   EXPECT_EQ(hull.pieces, 1);
   EXPECT_GE(hull.pieces_left, 1);
   EXPECT_EQ(hull.points, 300);
@@ -179,6 +186,17 @@ TEST(VisualHullBox, HoldsTheObjectAndLeavesOutAPieceWithoutSparsePoints) {
   for (int axis = 0; axis < 2; ++axis) {
     EXPECT_LT(hull.box.sizes()[axis], 0.6 * box.sizes()[axis]) << "axis " << axis;
   }
+
+  // A second object there, its surface as densely pointed as the first's: it counts.
+  std::vector<Eigen::Vector3d> second = points;
+  const double side = 0.1 * size.maxCoeff();
+  for (int i = 0; i < 30; ++i) {
+    second.push_back(spurious + 0.4 * side * Eigen::Vector3d(std::cos(i), std::sin(i), (i % 5 - 2) / 2.0));
+  }
+  const HullBox both = VisualHullBox(views, second, box, 64, 2, 2);
+  EXPECT_EQ(both.pieces, 2);
+  EXPECT_TRUE(both.box.contains(spurious));
+  EXPECT_TRUE(both.box.contains(hull.box));
 
   // Without sparse points every piece counts: the spurious one too.
   const HullBox every = VisualHullBox(views, {}, box, 64, 2, 2);

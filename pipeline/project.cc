@@ -151,7 +151,11 @@ void NarrowToMaskedHull(LoadedProject* project) {
       project->bounds.box, kHullBoxResolution, /*num_threads=*/0, kHullBoxBackgroundViews);
   const Eigen::Vector3d before = project->bounds.box.sizes();
   const Eigen::AlignedBox3d box = hull.box.intersection(project->bounds.box);
-  if (box.isEmpty() || box.isApprox(project->bounds.box)) return;
+  if (box.isEmpty()) {
+    LOG(INFO) << "volume: the masks' visual hull leaves nothing that two photos frame: the box "
+                 "kept";
+    return;
+  }
   if (box.sizes().maxCoeff() > kHullBoxMaxSide * before.maxCoeff()) {
     LOG(INFO) << std::setprecision(3) << "volume: the masks' visual hull spans "
               << box.sizes().maxCoeff() / before.maxCoeff()

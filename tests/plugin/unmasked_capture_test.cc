@@ -156,6 +156,30 @@ TEST(UnmaskedCapture, MasksGivenInARoomNarrowTheBoxToTheSubject) {
   EXPECT_GT(JsonNumber(narrowed, "mean_silhouette_iou"), 0.97);
 }
 
+// At 640x480 the narrowed box at the default 128 voxels would make a voxel span 2.7 pixels
+// against the points' box's 3.9: the resolution is lowered so that it spans 3. A resolution
+// given is kept.
+TEST(UnmaskedCapture, TheNarrowedBoxsVoxelSpansThreePixelsAtTheDefault) {
+  const std::string root = testing::MakeTemporaryDirectory("masked_room_vga");
+  const std::string scene = SceneWithoutMasks(root, "--backdrop room --width 640 --height 480");
+  const std::string masks = " --mask_path " + root + "/truth_masks";
+  std::string output;
+  ASSERT_EQ(RunRaycarve("carve --workspace_path " + scene + masks, &output), 0) << output;
+  const std::string report = testing::ReadFileBytes(scene + "/raycarve/report.json");
+  EXPECT_NE(report.find("\"around_hull\": true"), std::string::npos);
+  EXPECT_EQ(JsonNumber(report, "hull_lowered_from"), 128);
+  EXPECT_NEAR(JsonNumber(report, "voxel_pixels"), 3.0, 0.05);
+  ASSERT_EQ(RunRaycarve("carve --workspace_path " + scene + masks +
+                            " --resolution 128 --output_path " + root + "/given",
+                        &output),
+            0)
+      << output;
+  const std::string given = testing::ReadFileBytes(root + "/given/report.json");
+  EXPECT_EQ(JsonNumber(given, "hull_lowered_from"), 0);
+  EXPECT_LT(JsonNumber(given, "voxel_pixels"), 2.9);
+  EXPECT_GT(JsonNumber(given, "voxel_pixels"), 2.0);
+}
+
 // An object amid clutter: blocks standing around it, some between the arc of cameras and the
 // objects. The box around the cameras' focus grows to hold the sparse points that hide parts of
 // the subject from some photos, so that the carve sees what stands in front of the subject

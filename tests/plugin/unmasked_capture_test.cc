@@ -119,12 +119,23 @@ TEST(UnmaskedCapture, TheSubjectIsCarvedInItsOwnBoxWithoutTheBoxsWalls) {
 // The same room with the subject's masks given: the masks bound the subject, but the room's
 // sparse points still widen the box the points give. The box is narrowed to the masks' visual
 // hull where the sparse points are, and the subject's voxels become finer.
+// The room scene (SceneWithoutMasks with --backdrop room and `flags`) in <root>, carved at the
+// defaults with its exact masks given: the scene; the carve's output in *output.
+std::string MaskedRoomCarved(const std::string& root, const std::string& flags,
+                             std::string* output) {
+  const std::string scene = SceneWithoutMasks(root, "--backdrop room" + flags);
+  EXPECT_EQ(RunRaycarve("carve --workspace_path " + scene + " --mask_path " + root + "/truth_masks",
+                        output),
+            0)
+      << *output;
+  return scene;
+}
+
 TEST(UnmaskedCapture, MasksGivenInARoomNarrowTheBoxToTheSubject) {
   const std::string root = testing::MakeTemporaryDirectory("masked_room");
-  const std::string scene = SceneWithoutMasks(root, "--backdrop room");
-  const std::string masks = " --mask_path " + root + "/truth_masks";
   std::string output;
-  ASSERT_EQ(RunRaycarve("carve --workspace_path " + scene + masks, &output), 0) << output;
+  const std::string scene = MaskedRoomCarved(root, "", &output);
+  const std::string masks = " --mask_path " + root + "/truth_masks";
   EXPECT_NE(output.find("the volume: the box around what the masks call the object"),
             std::string::npos)
       << output;
@@ -161,10 +172,9 @@ TEST(UnmaskedCapture, MasksGivenInARoomNarrowTheBoxToTheSubject) {
 // given is kept.
 TEST(UnmaskedCapture, TheNarrowedBoxsVoxelSpansThreePixelsAtTheDefault) {
   const std::string root = testing::MakeTemporaryDirectory("masked_room_vga");
-  const std::string scene = SceneWithoutMasks(root, "--backdrop room --width 640 --height 480");
-  const std::string masks = " --mask_path " + root + "/truth_masks";
   std::string output;
-  ASSERT_EQ(RunRaycarve("carve --workspace_path " + scene + masks, &output), 0) << output;
+  const std::string scene = MaskedRoomCarved(root, " --width 640 --height 480", &output);
+  const std::string masks = " --mask_path " + root + "/truth_masks";
   const std::string report = testing::ReadFileBytes(scene + "/raycarve/report.json");
   EXPECT_NE(report.find("\"around_hull\": true"), std::string::npos);
   EXPECT_EQ(JsonNumber(report, "hull_lowered_from"), 128);

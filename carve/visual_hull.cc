@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <thread>
-#include <cstdio>
-#include <cstdlib>
 
 #include <opencv2/imgproc.hpp>
 

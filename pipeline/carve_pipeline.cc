@@ -29,7 +29,8 @@ namespace {
 // The default resolution is lowered to what the photos resolve, but not below this: a coarser
 // grid than this says the photos are too small for the volume, and the refusal says so.
 constexpr int kMinLoweredResolution = 16;
-// The fewest pixels a voxel spans when the box was narrowed to the masks' hull (see above).
+// The fewest pixels a voxel spans, at the default resolution, when the box was narrowed to the
+// masks' hull (CarvePipeline::CheckVolume).
 constexpr double kNarrowedVoxelPixels = 3.0;
 
 namespace fs = std::filesystem;
@@ -240,9 +241,9 @@ void CarvePipeline::CheckVolume() {
   };
   measure();
   if (!request_.resolution_given && project_.bounds.around_hull) {
-    // The box narrowed to the masks' hull makes the voxels finer; held out, voxels of 3-4 px
+    // The box narrowed to the masks' hull makes the voxels finer; held out, voxels of 3-5 px
     // scored best and ones of about 2 px worse (Middlebury at 256, generated scenes: docs/
-    // studies/2026-12-06-hull-box.md). No finer than that, nor than the points' box gave.
+    // studies/2026-12-06-hull-box.md). No finer than 3 px, nor than the points' box gave.
     const double wide =
         VoxelGrid(project_.bounds.points_box, request_.options.resolution).voxel_size() / pixel;
     const double least = std::min(kNarrowedVoxelPixels, wide);

@@ -1,3 +1,4 @@
+#include "export/mesh_renderer.h"
 #include "export/carve_export.h"
 
 #include <algorithm>
@@ -183,6 +184,28 @@ std::vector<uint8_t> UncoveredVertices(const TriangleMesh& mesh,
   return uncovered;
 }
 
+std::vector<uint8_t> UnseenVertices(const TriangleMesh& mesh, const std::vector<CalibratedView>& views,
+                                    int min_views, double tolerance) {
+  std::vector<int> seen(mesh.vertices.size(), 0);
+  for (const CalibratedView& view : views) {
+    const cv::Mat depths = RenderMeshDepth(mesh, view);
+    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+      if (seen[i] >= min_views) continue;
+      const Eigen::Vector3d image = view.P * mesh.vertices[i].cast<double>().homogeneous();
+      const double depth = image.z();
+      if (!(depth > 0.0)) continue;
+      const double col = std::floor(image.x() / depth), row = std::floor(image.y() / depth);
+      if (!(col >= 0.0 && row >= 0.0 && col < view.width && row < view.height)) continue;
+      const int c = static_cast<int>(col), r = static_cast<int>(row);
+      if (view.valid.at<uint8_t>(r, c) == 0) continue;
+      if (depth <= depths.at<float>(r, c) + tolerance) ++seen[i];
+    }
+  }
+  std::vector<uint8_t> unseen(mesh.vertices.size(), 0);
+  for (size_t i = 0; i < seen.size(); ++i) unseen[i] = seen[i] < min_views;
+  return unseen;
+}
+
 std::vector<uint8_t> GroundFillVertices(const TriangleMesh& mesh, const Ground& ground,
                                         double voxel_size) {
   std::vector<uint8_t> fill(mesh.vertices.size(), 0);
@@ -339,30 +362,38 @@ void MarkAndRemoveWalls(const VoxelGrid& grid, const std::vector<CalibratedView>
   const std::vector<uint8_t> fill =
       GroundFillVertices(model->mesh, options.ground, grid.voxel_size());
   const std::vector<uint8_t> uncovered = UncoveredVertices(model->mesh, views, options.min_views);
+  const std::vector<uint8_t> unseen =
+      options.remove_unseen
+          ? UnseenVertices(model->mesh, views, options.min_views, grid.voxel_size())
+          : std::vector<uint8_t>(model->mesh.vertices.size(), 0);
   const auto all = [](const std::vector<uint8_t>& marks, const Eigen::Vector3i& t) {
     return marks[t[0]] && marks[t[1]] && marks[t[2]];
   };
-  std::vector<uint8_t> wall_or_fill = model->on_grid_wall, any = model->on_grid_wall;
-  for (size_t i = 0; i < fill.size(); ++i) {
-    wall_or_fill[i] |= fill[i];
-    any[i] |= fill[i] | uncovered[i];
-  }
+  std::vector<uint8_t> wall_or_fill = model->on_grid_wall, framed_out, any;
+  for (size_t i = 0; i < fill.size(); ++i) wall_or_fill[i] |= fill[i];
+  framed_out = wall_or_fill;
+  for (size_t i = 0; i < fill.size(); ++i) framed_out[i] |= uncovered[i];
+  any = framed_out;
+  for (size_t i = 0; i < fill.size(); ++i) any[i] |= unseen[i];
   for (const Eigen::Vector3i& t : model->mesh.triangles) {
     const bool on_wall = all(model->on_grid_wall, t);
     model->ground_fill_triangles_removed += !on_wall && all(fill, t);
-    model->uncovered_triangles_removed += !all(wall_or_fill, t) && all(any, t);
+    model->uncovered_triangles_removed += !all(wall_or_fill, t) && all(framed_out, t);
+    model->unseen_triangles_removed += !all(framed_out, t) && all(any, t);
   }
   model->on_grid_wall = std::move(any);
   RemoveGridWalls(model, options.sparse_points, 1.5 * grid.voxel_size());
   if (model->wall_sliver_triangles_removed > 0 || model->ground_fill_triangles_removed > 0 ||
-      model->uncovered_triangles_removed > 0) {
+      model->uncovered_triangles_removed > 0 || model->unseen_triangles_removed > 0) {
     Tell(options, "mesh walls: " + std::to_string(model->wall_triangles_removed) +
                       " triangles on the volume box's walls left out (" +
                       std::to_string(model->ground_fill_triangles_removed) +
                       " more of the held ground's sides and underside, " +
                       std::to_string(model->uncovered_triangles_removed) +
                       " beyond the frames of all but " + std::to_string(options.min_views - 1) +
-                      " photo), then " +
+                      " photo, " + std::to_string(model->unseen_triangles_removed) +
+                      " seen by fewer than " + std::to_string(options.min_views) +
+                      " photos), then " +
                       std::to_string(model->wall_sliver_triangles_removed) +
                       " triangles of slivers only the walls held to the model (no sparse point "
                       "on them)");

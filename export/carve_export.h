@@ -97,6 +97,12 @@ struct ModelMeshOptions {
   bool remove_grid_walls = true;
   // With remove_grid_walls, the surface beyond the photos' frames (UncoveredVertices with
   // min_views) is left out with the walls too.
+  // With remove_grid_walls, on a capture from one side (a scene), the surface that fewer than
+  // min_views photos see, the model's own occlusion included (UnseenVertices), is left out with
+  // the walls too: behind each subject, where every camera's view is blocked, the carve judged
+  // nothing and kept the space solid, a fin of the subject's shadow running on to the box's far
+  // side. Off for an object (cameras around it), whose closed mesh keeps what it hides (its foot).
+  bool remove_unseen = false;
   // The ground the carve held (CarveOptions::ground): with remove_grid_walls, the held solid's
   // sides and underside below the plane (GroundFillVertices) are left out with the walls: they
   // stand for no surface the photos saw. Empty: none.
@@ -146,6 +152,9 @@ struct ModelMesh {
   // Of wall_triangles_removed, those beyond the photos' frames (all three corners
   // UncoveredVertices) that were neither on the walls nor of the ground's fill.
   int64_t uncovered_triangles_removed = 0;
+  // Of wall_triangles_removed, those fewer than min_views photos see (all three corners
+  // UnseenVertices, with ModelMeshOptions::remove_unseen) that none of the above took.
+  int64_t unseen_triangles_removed = 0;
 };
 
 // Leaves out the triangles whose three corners are on the grid's wall (model->on_grid_wall),
@@ -162,6 +171,11 @@ void RemoveGridWalls(ModelMesh* model, const std::vector<Eigen::Vector3d>& ancho
 // beside their frames is such; an object's box is held by every photo of a ring.
 std::vector<uint8_t> UncoveredVertices(const TriangleMesh& mesh,
                                        const std::vector<CalibratedView>& views, int min_views);
+// Per vertex of `mesh`, 1 where fewer than `min_views` of `views` see it: in the frame and no
+// more than `tolerance` behind the nearest surface of the mesh there (RenderMeshDepth, both
+// faces). UncoveredVertices with the mesh's own occlusion: what fewer see, the carve never judged.
+std::vector<uint8_t> UnseenVertices(const TriangleMesh& mesh, const std::vector<CalibratedView>& views,
+                                    int min_views, double tolerance);
 // Per vertex of `mesh` (with normals), 1 where it lies on the wall of `grid` (see
 // ModelMesh::on_grid_wall).
 std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid& grid);

@@ -413,6 +413,7 @@ void CarvePipeline::MakeSurface() {
   const Clock::time_point start = Clock::now();
   exporter::ModelMeshOptions options = request_.mesh;
   options.ground = run_.ground;
+  options.remove_unseen = !CaptureIsObject();
   if (request_.level_support) options.support = run_.support;
   for (const SurfacePoint& point : surface_points_) options.sparse_points.push_back(point.xyz);
   // Each step's line as it ends: the mesh stage can take longer than the carve.
@@ -433,6 +434,7 @@ void CarvePipeline::MakeSurface() {
   run_.mesh_grid_wall_vertices = model_.grid_wall_vertices;
   run_.mesh_wall_triangles_removed = model_.wall_triangles_removed;
   run_.mesh_uncovered_triangles_removed = model_.uncovered_triangles_removed;
+  run_.mesh_unseen_triangles_removed = model_.unseen_triangles_removed;
   run_.mesh_triangles_before_walls = model_.triangles_before_walls;
   RecordSeconds("mesh", SecondsSince(start));
 }

@@ -130,13 +130,16 @@ struct CarveRun {
   int64_t mesh_wall_triangles_removed = 0;  // left out of the mesh (on the wall, no sparse point)
   // Of those, the ones beyond the frames of all but one photo (ModelMesh::uncovered_...).
   int64_t mesh_uncovered_triangles_removed = 0;
+  // And the ones fewer than two photos see (a scene's: ModelMesh::unseen_...).
+  int64_t mesh_unseen_triangles_removed = 0;
   int64_t mesh_triangles_before_walls = 0;
   // The share of the mesh's triangles that lay on the box's walls and were left out (0 when none),
   // those beyond the photos' frames aside.
   double WallShare() const {
     return mesh_triangles_before_walls > 0
                ? static_cast<double>(mesh_wall_triangles_removed -
-                                     mesh_uncovered_triangles_removed) /
+                                     mesh_uncovered_triangles_removed -
+                                     mesh_unseen_triangles_removed) /
                      mesh_triangles_before_walls
                : 0.0;
   }
@@ -226,6 +229,9 @@ class CarvePipeline {
   // Why the automatic rules for an object without masks (the spread floor, the threshold's seen
   // views) do not apply; "" where they do.
   std::string ObjectRulesWithheld() const;
+  // Whether the capture is taken as an object (cameras around it) rather than a scene seen from
+  // one side: --capture, or the cameras' layout.
+  bool CaptureIsObject() const;
   // run_.spread_floor and run_.threshold_seen_views, once the masks are decided
   void DecideObjectRules();
   void FindDistant();   // distant_rays_ and run_.distant, once the masks are decided

@@ -14,15 +14,17 @@
 
 namespace raycarve {
 
+bool CarvePipeline::CaptureIsObject() const {
+  return request_.bounds.capture == "object" ||
+         (request_.bounds.capture == "auto" && run_.layout.object_centred);
+}
+
 std::string CarvePipeline::ObjectRulesWithheld() const {
   if (!request_.options.auto_threshold) return "--threshold given";
   if (run_.masks_from_files + run_.masks_from_backdrop > 0) {
     return "masks (their threshold keeps the surface)";
   }
-  if (request_.bounds.capture == "scene" ||
-      (request_.bounds.capture == "auto" && !run_.layout.object_centred)) {
-    return "a scene (seen from one side)";
-  }
+  if (!CaptureIsObject()) return "a scene (seen from one side)";
   return "";
 }
 

@@ -429,6 +429,7 @@ void WriteMesh(const CarveRequest& request, const CarveRun& run, JsonWriter& jso
         .Key("remove_box_walls").Value(request.mesh.remove_grid_walls)
         .Key("box_wall_triangles_removed").Value(run.mesh_wall_triangles_removed)
         .Key("beyond_frames_triangles_removed").Value(run.mesh_uncovered_triangles_removed)
+        .Key("unseen_triangles_removed").Value(run.mesh_unseen_triangles_removed)
         .Key("box_wall_share").Value(run.WallShare())
         .Key("boundary_edges").Value(static_cast<int64_t>(t.boundary_edges))
         .Key("non_manifold_edges").Value(static_cast<int64_t>(t.non_manifold_edges))

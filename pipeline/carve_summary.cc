@@ -87,6 +87,8 @@ std::string MeshShape(const CarveRun& run) {
     return std::string(run.mesh_uncovered_triangles_removed > 0
                            ? "open where the box cuts the scene and beyond the photos' frames"
                            : "open where the box cuts the scene") +
+           (run.mesh_unseen_triangles_removed > 0 ? std::string(" and behind the subjects")
+                                                  : std::string()) +
            (t.non_manifold_vertices > 0
                 ? " (" + std::to_string(t.non_manifold_vertices) +
                       (t.non_manifold_vertices == 1 ? " vertex" : " vertices") +
@@ -394,6 +396,11 @@ void AppendAfterSummary(const CarveRequest& request, const CarveRun& run, std::s
         Appendf(text, "                  %lld triangles beyond the frames of all but one photo "
                     "(never judged, kept solid by the carve): left out of the mesh\n",
                     static_cast<long long>(run.mesh_uncovered_triangles_removed));
+      }
+      if (run.mesh_unseen_triangles_removed > 0) {
+        Appendf(text, "                  %lld triangles fewer than two photos see, behind the subjects "
+                    "from every camera (never judged, kept solid by the carve): left out of the mesh\n",
+                    static_cast<long long>(run.mesh_unseen_triangles_removed));
       }
     } else if (run.mesh_grid_wall_vertices > 0) {
       Appendf(text, "                  %lld vertices on the volume box's walls, where the box cuts the "

@@ -222,8 +222,10 @@ void AddMeshFlags(OptionParser* parser, CarveRequest* request) {
   parser->AddDefault("mesh_remove_box_walls", &request->mesh.remove_grid_walls,
                      "smooth mesh: leave out the surface on the volume box's walls (where the box "
                      "cuts the scene, e.g. a table or the ground running on beyond it, or a "
-                     "backdrop seen through it); the mesh is open there. 0: keep it, the mesh "
-                     "closed by the box");
+                     "backdrop seen through it); the mesh is open there. With it, the surface "
+                     "fewer than two photos' frames hold and, on a scene (cameras facing one "
+                     "way), the surface fewer than two photos see behind the subjects are left "
+                     "out too. 0: keep it all, the mesh closed by the box");
   parser->AddDefault("mesh_undo_self_intersections", &request->mesh.undo_self_intersections,
                      "smooth mesh: where refinement and smoothing made triangles pass through "
                      "each other, move their vertices back towards the surface before "

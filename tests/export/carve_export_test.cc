@@ -584,6 +584,31 @@ TEST(CarveExport, VerticesBeyondTheFramesOfAllButOnePhotoAreUncovered) {
   EXPECT_EQ(UncoveredVertices(mesh, views, 1), (std::vector<uint8_t>{0, 0, 1, 1, 1}));
 }
 
+TEST(CarveExport, VerticesBehindAnOccluderFromEveryPhotoAreUnseen) {
+  // Three photos side by side at z = 5 looking at the origin, a square of 2 x 2 at z = 0 between
+  // them and what lies behind it; 100 px square, focal length 100 px.
+  std::vector<CalibratedView> views;
+  for (double x : {-1.0, 0.0, 1.0}) {
+    views.push_back(testing::PinholeViewLookingAtOrigin(Eigen::Vector3d(x, 0, 5), 100, 100, 100.0));
+  }
+  TriangleMesh mesh;
+  mesh.vertices = {{-1.0f, -1.0f, 0.0f}, {1.0f, -1.0f, 0.0f}, {1.0f, 1.0f, 0.0f}, {-1.0f, 1.0f, 0.0f},
+                   {0.0f, 0.0f, 0.5f},    // in front of the square: every photo sees it
+                   {0.0f, 0.0f, -0.5f},   // behind its middle: none does
+                   {1.05f, 0.0f, -1.0f},  // behind its edge: the photo at x = 1 sees past the edge
+                   {0.0f, 0.0f, 0.02f}};  // on the square's near side within the tolerance
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  EXPECT_EQ(UnseenVertices(mesh, views, 2, 0.05), (std::vector<uint8_t>{0, 0, 0, 0, 0, 1, 1, 0}));
+  EXPECT_EQ(UnseenVertices(mesh, views, 1, 0.05), (std::vector<uint8_t>{0, 0, 0, 0, 0, 1, 0, 0}));
+  // A vertex just behind the surface, within the tolerance, counts as on it.
+  mesh.vertices[7].z() = -0.02f;
+  EXPECT_EQ(UnseenVertices(mesh, views, 2, 0.05)[7], 0);
+  EXPECT_EQ(UnseenVertices(mesh, views, 2, 0.01)[7], 1);
+  // A pixel beyond the distorted frame (`valid` 0) sees nothing.
+  views[2].valid.setTo(0);
+  EXPECT_EQ(UnseenVertices(mesh, views, 1, 0.05)[6], 1);
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

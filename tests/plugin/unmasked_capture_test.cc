@@ -80,6 +80,8 @@ TEST(UnmaskedCapture, TheSubjectIsCarvedInItsOwnBoxWithoutTheBoxsWalls) {
   EXPECT_NE(report.find("\"kind\": \"object\""), std::string::npos);
   EXPECT_NE(report.find("\"around_focus\": true"), std::string::npos);
   EXPECT_GT(JsonNumber(report, "box_wall_triangles_removed"), 0);
+  // An object's closed mesh keeps what no photo sees (its foot, its underside).
+  EXPECT_EQ(JsonNumber(report, "unseen_triangles_removed"), 0);
   // The floor under the subject: found from the sparse points, said in the summary.
   EXPECT_NE(report.find("\"supporting_plane\": {\n      \"found\": true"), std::string::npos)
       << report.substr(report.find("\"supporting_plane\""), 200);
@@ -283,6 +285,10 @@ TEST(UnmaskedCapture, ForwardFacingPhotosAreASceneBoxedToTheDepthTheyPlace) {
   // towards the seen space is no surface: left out of the mesh.
   EXPECT_GT(JsonNumber(report, "beyond_frames_triangles_removed"), 0);
   EXPECT_NE(output.find("beyond the frames of all but one photo"), std::string::npos) << output;
+  // Behind the sphere and the box, where every photo's view is blocked, the carve judged nothing
+  // and kept the space solid: its surface is left out too.
+  EXPECT_GT(JsonNumber(report, "unseen_triangles_removed"), 0);
+  EXPECT_NE(output.find("behind the subjects from every camera"), std::string::npos) << output;
   // The generated points are exact: the densest plane is the ground itself.
   EXPECT_NE(report.find("\"densest_plane_passed_over\": false"), std::string::npos);
   EXPECT_EQ(report.find("densest_plane_on_share"), std::string::npos);

@@ -84,11 +84,13 @@ std::string MeshShape(const CarveRun& run) {
       t.self_intersecting_pairs == 0) {
     // Where two removed stretches of wall meet at a corner, two sheets of surface touch at a
     // vertex: said, not hidden.
-    return std::string(run.mesh_uncovered_triangles_removed > 0
-                           ? "open where the box cuts the scene and beyond the photos' frames"
-                           : "open where the box cuts the scene") +
-           (run.mesh_unseen_triangles_removed > 0 ? std::string(" and behind the subjects")
-                                                  : std::string()) +
+    const bool framed_out = run.mesh_uncovered_triangles_removed > 0;
+    const bool behind = run.mesh_unseen_triangles_removed > 0;
+    return std::string("open where the box cuts the scene") +
+           (framed_out && behind ? ", beyond the photos' frames and behind the subjects"
+            : framed_out         ? " and beyond the photos' frames"
+            : behind             ? " and behind the subjects"
+                                 : "") +
            (t.non_manifold_vertices > 0
                 ? " (" + std::to_string(t.non_manifold_vertices) +
                       (t.non_manifold_vertices == 1 ? " vertex" : " vertices") +

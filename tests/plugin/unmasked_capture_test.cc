@@ -289,6 +289,10 @@ TEST(UnmaskedCapture, ForwardFacingPhotosAreASceneBoxedToTheDepthTheyPlace) {
   // and kept the space solid: its surface is left out too.
   EXPECT_GT(JsonNumber(report, "unseen_triangles_removed"), 0);
   EXPECT_NE(output.find("behind the subjects from every camera"), std::string::npos) << output;
+  EXPECT_NE(output.find("open where the box cuts the scene, beyond the photos' frames and behind "
+                        "the subjects"),
+            std::string::npos)
+      << output;
   // The generated points are exact: the densest plane is the ground itself.
   EXPECT_NE(report.find("\"densest_plane_passed_over\": false"), std::string::npos);
   EXPECT_EQ(report.find("densest_plane_on_share"), std::string::npos);

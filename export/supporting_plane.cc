@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include <Eigen/Eigenvalues>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -44,6 +45,10 @@ std::string SupportingPlane::Summary() const {
        << "% of the cameras above it";
   if (angle_to_photos_up >= 0.0) {
     text << ", " << angle_to_photos_up << " degrees from the photos' up";
+  }
+  if (spread_ratio >= 0.0) {
+    text << ", its points spread " << spread_ratio << " x as wide as all the points"
+         << (found_by_spread ? " (a floor around what stands on it)" : "");
   }
   if (densest_on_share >= 0.0) {
     text << " (passed over: the densest plane, " << 100.0 * densest_on_share << "% on it and "
@@ -181,8 +186,40 @@ SupportCandidates DrawSupportCandidates(pcl::SampleConsensusModelPlane<pcl::Poin
   return best;
 }
 
+// The area over which a set of points spreads along a plane with axes u, v: the square root of
+// the determinant of their 2-D covariance (0 for fewer than 3 points).
+double SpreadAlong(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& u,
+                   const Eigen::Vector3d& v) {
+  if (points.size() < 3) return 0.0;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector3d& p : points) mean += Eigen::Vector2d(u.dot(p), v.dot(p));
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector2d q = Eigen::Vector2d(u.dot(p), v.dot(p)) - mean;
+    covariance += q * q.transpose();
+  }
+  covariance /= static_cast<double>(points.size());
+  return std::sqrt(std::max(0.0, covariance.determinant()));
+}
+
+// The spread of the points on `plane` along it against all the points' (SupportingPlane::
+// spread_ratio), and their number.
+double SpreadRatio(const SupportingPlane& plane, const std::vector<Eigen::Vector3d>& points,
+                   int* on_count) {
+  std::vector<Eigen::Vector3d> on;
+  for (const Eigen::Vector3d& p : points) {
+    if (std::abs(plane.normal.dot(p) + plane.offset) <= plane.tolerance) on.push_back(p);
+  }
+  *on_count = static_cast<int>(on.size());
+  const Eigen::Vector3d u = plane.normal.unitOrthogonal(), v = plane.normal.cross(u);
+  const double all = SpreadAlong(points, u, v);
+  return all > 0.0 ? SpreadAlong(on, u, v) / all : 0.0;
+}
+
 // A candidate's plane refined on all the points and measured into *plane: whether it is a support
-// with nothing below it (kMinSupportShareWithNothingBelow on it; level where `level_only`).
+// with nothing below it (kMinSupportShareWithNothingBelow on it; level where `level_only`, and
+// then also one whose points spread as widely as all the points: kMinWideSupportSpread).
 bool AcceptCandidate(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
                      const Eigen::VectorXf& coefficients, const Eigen::Vector3d& centre,
                      const std::vector<Eigen::Vector3d>& points,
@@ -193,12 +230,68 @@ bool AcceptCandidate(pcl::SampleConsensusModelPlane<pcl::PointXYZ>& model,
                     plane)) {
     return false;
   }
-  plane->found = plane->on_plane_share >= kMinSupportShareWithNothingBelow &&
-                 CouldSupport(*plane) && (!level_only || plane->Level());
+  // A support has nothing under it: the points just under the plane may be its own that a tilt
+  // left out (SettleOnPoints). The settled plane is taken where it leaves fewer points under it
+  // and holds as many on it or more.
+  Eigen::Vector3d normal = plane->normal;
+  double offset = plane->offset;
+  if (SettleOnPoints(points, plane->tolerance, &normal, &offset)) {
+    Eigen::VectorXf settled(4);
+    settled << static_cast<float>(normal.x()), static_cast<float>(normal.y()),
+        static_cast<float>(normal.z()), static_cast<float>(offset + normal.dot(centre));
+    SupportingPlane measured = *plane;
+    if (MeasurePlane(settled, centre, points, cameras, up, &measured) &&
+        measured.below_share < plane->below_share &&
+        measured.on_plane_share >= plane->on_plane_share) {
+      *plane = measured;
+    }
+  }
+  if (!CouldSupport(*plane) || (level_only && !plane->Level())) return false;
+  if (plane->on_plane_share >= kMinSupportShareWithNothingBelow) {
+    plane->found = true;
+    return true;
+  }
+  if (!level_only || !up.Known() || plane->below_share > kMaxBelowShareWide) return false;
+  int on = 0;
+  plane->spread_ratio = SpreadRatio(*plane, points, &on);
+  plane->found_by_spread =
+      on >= kMinWideSupportPoints && plane->spread_ratio >= kMinWideSupportSpread;
+  plane->found = plane->found_by_spread;
   return plane->found;
 }
 
 }  // namespace
+
+bool SettleOnPoints(const std::vector<Eigen::Vector3d>& points, double tolerance,
+                    Eigen::Vector3d* normal, double* offset) {
+  std::vector<size_t> held;
+  bool moved = false;
+  for (int round = 0; round < kMaxSettleRounds; ++round) {
+    std::vector<size_t> next;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (size_t i = 0; i < points.size(); ++i) {
+      const double d = normal->dot(points[i]) + *offset;
+      if (d <= tolerance && d >= -kUnderReach * tolerance) {
+        next.push_back(i);
+        mean += points[i];
+      }
+    }
+    if (next == held || next.size() < 3) break;
+    held = std::move(next);
+    mean /= static_cast<double>(held.size());
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (size_t i : held) scatter += (points[i] - mean) * (points[i] - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+    Eigen::Vector3d fitted = eigen.eigenvectors().col(0);  // the least spread: the normal
+    if (!(fitted.norm() > 0.0)) break;
+    fitted.normalize();
+    if (fitted.dot(*normal) < 0.0) fitted = -fitted;
+    *normal = fitted;
+    *offset = -fitted.dot(mean);
+    moved = true;
+  }
+  return moved;
+}
 
 SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
                                    const std::vector<Eigen::Vector3d>& cameras,

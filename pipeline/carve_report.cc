@@ -187,6 +187,8 @@ void WriteCapture(const CarveRun& run, JsonWriter& json) {
       .Key("on_plane_share").Value(plane.on_plane_share)
       .Key("below_share").Value(plane.below_share)
       .Key("cameras_above_share").Value(plane.cameras_above_share)
+      .Key("spread_ratio").Value(plane.spread_ratio)
+      .Key("found_by_spread").Value(plane.found_by_spread)
       .Key("densest_plane_passed_over").Value(plane.densest_on_share >= 0.0);
   if (plane.densest_on_share >= 0.0) {
     json.Key("densest_plane_on_share").Value(plane.densest_on_share)

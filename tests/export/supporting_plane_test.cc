@@ -1,6 +1,7 @@
 // The supporting plane against scenes whose answer is known: an object on a tilted table seen
 // from above, a ball with no table, a table seen from below, a floor under a denser slanted roof,
-// a floor in front of a denser backdrop wall and a floor under a tilted band of loose points.
+// a floor in front of a denser backdrop wall, a floor under a tilted band of loose points and a
+// floor at a grazing angle holding few points; a tilted plane settling on a floor's points.
 #include "export/supporting_plane.h"
 
 #include <cmath>
@@ -269,6 +270,112 @@ TEST(FitSupportingPlane, TheFloorHoldingItsPointsCloselyBeforeATiltedBandHolding
   EXPECT_GT(plane.normal.z(), std::cos(0.5 * M_PI / 180.0)) << plane.Summary();
   // Refined by least squares on the points within the tolerance: the band's few there lift it.
   EXPECT_NEAR(plane.offset, 0.0, 0.2 * kTolerance) << plane.Summary();
+}
+
+// Cameras on a ring at eye level: the floor is seen at a grazing angle and holds few of the
+// points (under a tenth), fewer than the ball and the box on it, or the wall behind them. No plane
+// holding a tenth of them could be a support, but the floor's points spread around what stands on
+// it, more widely than all the points do; the ball's cap, where it touches the floor, spreads a
+// fraction as wide, and without the floor no level plane is taken.
+TEST(FitSupportingPlane, AFloorSeenAtAGrazingAngleSpreadsAroundWhatStandsOnIt) {
+  std::mt19937_64 random(13);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Eigen::Vector3d> floor, above, cameras;
+  constexpr double kTolerance = 0.03;
+  for (int i = 0; i < 40; ++i) {  // the floor: a disc of radius 2.5, heights off by 0.6 tolerances
+    const double r = 2.5 * std::sqrt(unit(random)), a = 2.0 * M_PI * unit(random);
+    floor.emplace_back(r * std::cos(a), r * std::sin(a), kTolerance * (1.2 * unit(random) - 0.6));
+  }
+  for (int i = 0; i < 300; ++i) {  // a ball of radius 0.5 resting on it
+    const double z = 2.0 * unit(random) - 1.0, a = 2.0 * M_PI * unit(random);
+    const double s = std::sqrt(1.0 - z * z);
+    above.emplace_back(0.5 * s * std::cos(a), 0.5 * s * std::sin(a), 0.5 + 0.5 * z);
+  }
+  for (int i = 0; i < 160; ++i) {  // a box of 0.8 x 0.8 x 0.8 beside it, no points underneath
+    const double a = 0.8 * unit(random), b = 0.8 * unit(random);
+    const int face = i % 5;
+    above.emplace_back(0.6 + (face == 0 ? 0.0 : face == 1 ? 0.8 : a),
+                       -0.4 + (face == 2 ? 0.0 : face == 3 ? 0.8 : b),
+                       face < 2 ? b : face < 4 ? a : 0.8);
+  }
+  for (int i = 0; i < 150; ++i) {  // the wall behind, from the floor up
+    above.emplace_back(4.0 * unit(random) - 2.0, 2.0, 2.0 * unit(random));
+  }
+  std::vector<Rigid3d> poses;
+  for (int i = 0; i < 24; ++i) {
+    const double a = 2.0 * M_PI * i / 24.0;
+    cameras.emplace_back(5.0 * std::cos(a), 5.0 * std::sin(a), 0.6);
+    poses.push_back(LevelCamera(cameras.back(), {0.0, 0.0, 0.4}, 0));
+  }
+  const PhotosUp up = EstimatePhotosUp(poses);
+  ASSERT_TRUE(up.Known());
+  std::vector<Eigen::Vector3d> points = above;
+  points.insert(points.end(), floor.begin(), floor.end());
+
+  const SupportingPlane plane = FitSupportingPlane(points, cameras, up, kTolerance);
+  ASSERT_TRUE(plane.found) << plane.Summary();
+  EXPECT_TRUE(plane.found_by_spread);
+  // Level: the floor's points, not a plane tilted through some of them and the box's foot.
+  EXPECT_GT(plane.normal.z(), std::cos(0.5 * M_PI / 180.0)) << plane.Summary();
+  EXPECT_NEAR(plane.offset, 0.0, 0.25 * kTolerance) << plane.Summary();
+  EXPECT_LT(plane.on_plane_share, kMinSupportShareWithNothingBelow);
+  EXPECT_GE(plane.spread_ratio, kMinWideSupportSpread);
+  EXPECT_NE(plane.Summary().find("a floor around what stands on it"), std::string::npos);
+  // Without the photos' up, nothing says which plane is level: the wide rule is not applied.
+  EXPECT_FALSE(FitSupportingPlane(points, cameras, PhotosUp(), kTolerance).found_by_spread);
+
+  // Without the floor: the ball's cap at z = 0 holds nothing below it but spreads a fraction as
+  // widely as the points; the wall, with the cameras in front of it, is taken as before.
+  const SupportingPlane no_floor = FitSupportingPlane(above, cameras, up, kTolerance);
+  EXPECT_FALSE(no_floor.found_by_spread) << no_floor.Summary();
+  EXPECT_FALSE(no_floor.found && no_floor.Level()) << no_floor.Summary();
+  // A ball alone.
+  const std::vector<Eigen::Vector3d> ball(above.begin(), above.begin() + 300);
+  EXPECT_FALSE(FitSupportingPlane(ball, cameras, up, kTolerance).found);
+}
+
+// A plane tilted 3 degrees through a floor's points (and the foot of a wall on it) settles on the
+// floor: the floor's points it leaves just under it pull it down, and it holds them all; points
+// further under (wrong matches) stay out of it.
+TEST(SettleOnPoints, ATiltedPlaneSettlesOnTheFloorsPoints) {
+  std::mt19937_64 random(17);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  constexpr double kTolerance = 0.03;
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 200; ++i) {  // the floor, 2 x 2, heights off by half a tolerance at most
+    points.emplace_back(2.0 * unit(random) - 1.0, 2.0 * unit(random) - 1.0,
+                        kTolerance * (unit(random) - 0.5));
+  }
+  for (int i = 0; i < 100; ++i) {  // a wall's foot along x = 1, rising from the floor
+    points.emplace_back(1.0, 2.0 * unit(random) - 1.0, 0.5 * unit(random));
+  }
+  for (int i = 0; i < 10; ++i) {  // wrong matches well under the floor
+    points.emplace_back(2.0 * unit(random) - 1.0, 2.0 * unit(random) - 1.0, -0.5);
+  }
+  const double tilt = 3.0 * M_PI / 180.0;
+  Eigen::Vector3d normal(-std::sin(tilt), 0.0, std::cos(tilt));  // rises towards the wall
+  double offset = 0.0;
+  int under_before = 0;
+  for (const Eigen::Vector3d& p : points) under_before += normal.dot(p) + offset < -kTolerance;
+  ASSERT_GT(under_before, 40);  // the floor's points on the far side from the wall
+
+  ASSERT_TRUE(SettleOnPoints(points, kTolerance, &normal, &offset));
+  EXPECT_GT(normal.z(), std::cos(0.2 * M_PI / 180.0)) << normal.transpose();
+  EXPECT_NEAR(offset, 0.0, 0.2 * kTolerance);
+  int on = 0, under = 0;
+  for (const Eigen::Vector3d& p : points) {
+    const double d = normal.dot(p) + offset;
+    on += std::abs(d) <= kTolerance;
+    under += d < -kTolerance;
+  }
+  EXPECT_GE(on, 200);      // the floor, and the wall's lowest points
+  EXPECT_EQ(under, 10);    // the wrong matches alone
+
+  // Nothing within reach: the plane as given.
+  Eigen::Vector3d far_normal = Eigen::Vector3d::UnitZ();
+  double far_offset = -5.0;
+  EXPECT_FALSE(SettleOnPoints(points, kTolerance, &far_normal, &far_offset));
+  EXPECT_EQ(far_offset, -5.0);
 }
 
 }  // namespace

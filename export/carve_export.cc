@@ -462,7 +462,8 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
   }
   if (!options.support.empty()) {
     const std::vector<Eigen::Vector3f> before = model.mesh.vertices;
-    model.levelling = LevelOntoSupport(options.support, grid.voxel_size(), &model.mesh);
+    model.levelling =
+        LevelOntoSupport(options.support, grid.voxel_size(), options.level_band, &model.mesh);
     if (options.undo_self_intersections && model.levelling.vertices > 0) {
       // Where levelling made triangles pass through each other, those vertices go back.
       const SelfIntersectionRepair undone = UndoSelfIntersections(before, &model.mesh);

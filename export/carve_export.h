@@ -108,9 +108,10 @@ struct ModelMeshOptions {
   // stand for no surface the photos saw. Empty: none.
   Ground ground;
   // The plane the subject stands on where the sparse points show it (its footprint), held or
-  // not: after the silhouette fit, the mesh within two voxels of it is levelled onto it
-  // (LevelOntoSupport). Empty: not levelled.
+  // not: after the silhouette fit, the mesh within two voxels of it, or `level_band` where that is
+  // wider, is levelled onto it (LevelOntoSupport). Empty: not levelled.
   Ground support;
+  double level_band = 0.0;  // world units; 0: two voxels
   // Threads for refining and colouring (0 or less: every core); the mesh does not depend on it.
   int num_threads = 0;
   // After colouring, a texture atlas from the photos (TextureMeshFromPhotos): each triangle

@@ -1,5 +1,6 @@
 #include "export/support_levelling.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -17,11 +18,12 @@ std::string SupportLevelling::Summary() const {
   return text.str();
 }
 
-SupportLevelling LevelOntoSupport(const Ground& support, double voxel_size, TriangleMesh* mesh) {
+SupportLevelling LevelOntoSupport(const Ground& support, double voxel_size, double min_band,
+                                  TriangleMesh* mesh) {
   CHECK(voxel_size > 0.0);
   CHECK(mesh->normals.size() == mesh->vertices.size());
   SupportLevelling levelling;
-  levelling.band = 2.0 * voxel_size;
+  levelling.band = std::max(2.0 * voxel_size, min_band);
   if (support.empty()) return levelling;
   const GroundMap map(support);
   const double min_cos = std::cos(kLevelledNormalDegrees / 180.0 * M_PI);
@@ -39,8 +41,8 @@ SupportLevelling LevelOntoSupport(const Ground& support, double voxel_size, Tria
     const double facing = support.normal.dot(mesh->normals[i].cast<double>());
     const double target = facing <= -min_cos ? std::min(height, -0.5 * voxel_size) : 0.0;
     if (target == height) continue;
-    // All the way within a voxel, then less, to nothing at two.
-    const double share = std::min(1.0, 2.0 - std::abs(height) / voxel_size);
+    // All the way within half the band (a voxel at two voxels), then less, to nothing at the band.
+    const double share = std::min(1.0, 2.0 - 2.0 * std::abs(height) / levelling.band);
     mesh->vertices[i] = (vertex + share * (target - height) * support.normal).cast<float>();
     moved += share * std::abs(target - height);
     ++levelling.vertices;

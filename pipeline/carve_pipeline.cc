@@ -414,7 +414,13 @@ void CarvePipeline::MakeSurface() {
   exporter::ModelMeshOptions options = request_.mesh;
   options.ground = run_.ground;
   options.remove_unseen = !CaptureIsObject();
-  if (request_.level_support) options.support = run_.support;
+  if (request_.level_support) {
+    options.support = run_.support;
+    // What the default grid over the same box levels (two of its voxels): a finer grid levels no
+    // less (the sparse points place the plane no closer for it, and over a plain floor the photo
+    // hull bulges a few fine voxels high).
+    options.level_band = 2.0 * VoxelGrid(project_.bounds.box, CarveOptions().resolution).voxel_size();
+  }
   for (const SurfacePoint& point : surface_points_) options.sparse_points.push_back(point.xyz);
   // Each step's line as it ends: the mesh stage can take longer than the carve.
   options.progress = [](const std::string& line) { LOG(INFO) << line; };

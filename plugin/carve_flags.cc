@@ -216,8 +216,9 @@ void AddMeshFlags(OptionParser* parser, CarveRequest* request) {
                      "over the photos; at most a voxel a pass); 0: none");
   parser->AddDefault("mesh_level_support", &request->level_support,
                      "smooth mesh: where the sparse points show a plane the subject stands on (a "
-                     "table, a floor, a mat), level the mesh within two voxels of it onto the "
-                     "plane (a thin top's underside half a voxel under it), where its points are; "
+                     "table, a floor, a mat), level the mesh within two voxels of it (on a grid "
+                     "finer than the default, two of the default grid's) onto the plane (a thin "
+                     "top's underside half a voxel under it), where its points are; "
                      "0: as carved and refined");
   parser->AddDefault("mesh_remove_box_walls", &request->mesh.remove_grid_walls,
                      "smooth mesh: leave out the surface on the volume box's walls (where the box "

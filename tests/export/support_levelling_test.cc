@@ -43,7 +43,7 @@ TEST(LevelOntoSupport, AThinTopNearThePlaneLiesOnItWithItsUndersideBelow) {
   // Top 0.8 voxels above the plane, underside 0.4 above: a mat the carve left a voxel thick.
   TriangleMesh mesh = Box({-0.5f, -0.5f, 0.02f}, {0.5f, 0.5f, 0.04f});
   ASSERT_EQ(mesh.normals[0].z() < -0.5f, true);  // the underside's corners face down
-  const SupportLevelling levelling = LevelOntoSupport(PlaneZ0(), kVoxel, &mesh);
+  const SupportLevelling levelling = LevelOntoSupport(PlaneZ0(), kVoxel, 0.0, &mesh);
   EXPECT_EQ(levelling.vertices, 8);
   for (int k = 0; k < 8; ++k) {
     EXPECT_NEAR(mesh.vertices[k].z(), k & 4 ? 0.0 : -0.5 * kVoxel, 1e-6) << k;
@@ -57,14 +57,40 @@ TEST(LevelOntoSupport, PartWayBetweenOneAndTwoVoxelsNoneBeyond) {
   // A top 1.5 voxels up goes half the way, to 0.75 voxels; its underside at 1.2 voxels is
   // already above the top's target and faces down: it goes 0.8 of the way to half a voxel under.
   TriangleMesh mesh = Box({-0.5f, -0.5f, 0.06f}, {0.5f, 0.5f, 0.075f});
-  LevelOntoSupport(PlaneZ0(), kVoxel, &mesh);
+  LevelOntoSupport(PlaneZ0(), kVoxel, 0.0, &mesh);
   EXPECT_NEAR(mesh.vertices[4].z(), 0.75 * kVoxel, 1e-6);
   EXPECT_NEAR(mesh.vertices[0].z(), 0.06 + 0.8 * (-0.025 - 0.06), 1e-6);
 
   TriangleMesh far = Box({-0.5f, -0.5f, 0.2f}, {0.5f, 0.5f, 0.3f});
   const TriangleMesh original = far;
-  EXPECT_EQ(LevelOntoSupport(PlaneZ0(), kVoxel, &far).vertices, 0);
+  EXPECT_EQ(LevelOntoSupport(PlaneZ0(), kVoxel, 0.0, &far).vertices, 0);
   EXPECT_EQ(far.vertices, original.vertices);
+}
+
+TEST(LevelOntoSupport, OnAFineGridTheBandIsTheOneAskedFor) {
+  // Voxels of 0.002 with a band of 0.01 asked for (two voxels of a grid five times coarser): the
+  // band is 0.01, not two voxels (0.004). A slab from 0.001 to 0.004 (a bulge of two fine voxels)
+  // goes onto the plane, its underside half a voxel under it; a top at 0.0075 goes half the way;
+  // one at 0.012 stays.
+  constexpr double kFine = 0.002, kBand = 0.01;
+  TriangleMesh bulge = Box({-0.5f, -0.5f, 0.001f}, {0.5f, 0.5f, 0.004f});
+  const SupportLevelling levelling = LevelOntoSupport(PlaneZ0(), kFine, kBand, &bulge);
+  EXPECT_DOUBLE_EQ(levelling.band, kBand);
+  EXPECT_EQ(levelling.vertices, 8);
+  for (int k = 0; k < 8; ++k) EXPECT_NEAR(bulge.vertices[k].z(), k & 4 ? 0.0 : -0.5 * kFine, 1e-6) << k;
+
+  TriangleMesh higher = Box({-0.5f, -0.5f, 0.0065f}, {0.5f, 0.5f, 0.0075f});
+  LevelOntoSupport(PlaneZ0(), kFine, kBand, &higher);
+  EXPECT_NEAR(higher.vertices[4].z(), 0.5 * 0.0075, 1e-6);
+
+  TriangleMesh above = Box({-0.5f, -0.5f, 0.011f}, {0.5f, 0.5f, 0.012f});
+  EXPECT_EQ(LevelOntoSupport(PlaneZ0(), kFine, kBand, &above).vertices, 0);
+  // Without it, two fine voxels: the slab at 0.0075 stays where it is.
+  TriangleMesh narrow = Box({-0.5f, -0.5f, 0.0065f}, {0.5f, 0.5f, 0.0075f});
+  EXPECT_DOUBLE_EQ(LevelOntoSupport(PlaneZ0(), kFine, 0.0, &narrow).band, 2.0 * kFine);
+  EXPECT_FLOAT_EQ(narrow.vertices[4].z(), 0.0075f);
+  // A band asked for that is narrower than two voxels changes nothing.
+  EXPECT_DOUBLE_EQ(LevelOntoSupport(PlaneZ0(), kVoxel, kBand, &narrow).band, 2.0 * kVoxel);
 }
 
 TEST(LevelOntoSupport, ASidewaysFacingVertexNearThePlaneGoesOntoItAsTheTopDoes) {
@@ -73,7 +99,7 @@ TEST(LevelOntoSupport, ASidewaysFacingVertexNearThePlaneGoesOntoItAsTheTopDoes) 
   // voxels up) 0.8 of the way: nothing near the plane is left standing as a spike.
   TriangleMesh mesh = Box({-0.5f, -0.005f, 0.01f}, {0.5f, 0.005f, 0.06f});
   for (int k = 0; k < 8; ++k) ASSERT_LT(std::abs(mesh.normals[k].z()), 0.5f) << k;
-  EXPECT_EQ(LevelOntoSupport(PlaneZ0(), kVoxel, &mesh).vertices, 8);
+  EXPECT_EQ(LevelOntoSupport(PlaneZ0(), kVoxel, 0.0, &mesh).vertices, 8);
   for (int k = 0; k < 8; ++k) {
     EXPECT_NEAR(mesh.vertices[k].z(), k & 4 ? 0.06 * 0.2 : 0.0, 1e-6) << k;
   }
@@ -83,10 +109,10 @@ TEST(LevelOntoSupport, OnlyWhereThePlanesPointsAre) {
   // The same mat beyond the footprint's reach (x from 2 to 3): no point shows the plane there.
   TriangleMesh mesh = Box({2.0f, -0.5f, 0.02f}, {3.0f, 0.5f, 0.04f});
   const TriangleMesh original = mesh;
-  EXPECT_EQ(LevelOntoSupport(PlaneZ0(), kVoxel, &mesh).vertices, 0);
+  EXPECT_EQ(LevelOntoSupport(PlaneZ0(), kVoxel, 0.0, &mesh).vertices, 0);
   EXPECT_EQ(mesh.vertices, original.vertices);
   // And nothing without a support.
-  EXPECT_EQ(LevelOntoSupport(Ground(), kVoxel, &mesh).vertices, 0);
+  EXPECT_EQ(LevelOntoSupport(Ground(), kVoxel, 0.0, &mesh).vertices, 0);
 }
 
 TEST(LevelOntoSupport, ABlockStandingOnThePlaneKeepsItsTopAndWalls) {
@@ -95,7 +121,7 @@ TEST(LevelOntoSupport, ABlockStandingOnThePlaneKeepsItsTopAndWalls) {
   // or go at most half a voxel under it; nothing moves along the plane.
   TriangleMesh mesh = Box({-0.2f, -0.2f, 0.0f}, {0.2f, 0.2f, 1.0f});
   const TriangleMesh original = mesh;
-  LevelOntoSupport(PlaneZ0(), kVoxel, &mesh);
+  LevelOntoSupport(PlaneZ0(), kVoxel, 0.0, &mesh);
   for (int k = 0; k < 8; ++k) {
     EXPECT_EQ(mesh.vertices[k].head<2>(), original.vertices[k].head<2>()) << k;
     if (k & 4) {

@@ -3,12 +3,14 @@
 
 #include <algorithm>
 #include <array>
-#include <map>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <map>
+#include <queue>
 #include <random>
 #include <vector>
 
@@ -206,6 +208,49 @@ std::vector<uint8_t> UnseenVertices(const TriangleMesh& mesh, const std::vector<
   return unseen;
 }
 
+int64_t KeepUnseenNearSeen(const TriangleMesh& mesh, const std::vector<uint8_t>& excluded,
+                           double reach, std::vector<uint8_t>* unseen) {
+  CHECK(unseen->size() == mesh.vertices.size() && excluded.size() == mesh.vertices.size());
+  std::vector<std::vector<int>> neighbours(mesh.vertices.size());
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    for (int j = 0; j < 3; ++j) {
+      neighbours[t[j]].push_back(t[(j + 1) % 3]);
+      neighbours[t[j]].push_back(t[(j + 2) % 3]);
+    }
+  }
+  // Distances along the edges from the seen surface, through unseen vertices only (Dijkstra).
+  std::vector<double> distance(mesh.vertices.size(), std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  for (size_t i = 0; i < distance.size(); ++i) {
+    if (!(*unseen)[i] && !excluded[i]) {
+      distance[i] = 0.0;
+      queue.push({0.0, static_cast<int>(i)});
+    }
+  }
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > distance[v]) continue;
+    for (int w : neighbours[v]) {
+      if (!(*unseen)[w] || excluded[w]) continue;
+      const double through = d + (mesh.vertices[v] - mesh.vertices[w]).cast<double>().norm();
+      if (through < distance[w] && through <= reach) {
+        distance[w] = through;
+        queue.push({through, w});
+      }
+    }
+  }
+  int64_t kept = 0;
+  for (size_t i = 0; i < distance.size(); ++i) {
+    if ((*unseen)[i] && distance[i] <= reach) {
+      (*unseen)[i] = 0;
+      ++kept;
+    }
+  }
+  return kept;
+}
+
 std::vector<uint8_t> GroundFillVertices(const TriangleMesh& mesh, const Ground& ground,
                                         double voxel_size) {
   std::vector<uint8_t> fill(mesh.vertices.size(), 0);
@@ -362,7 +407,7 @@ void MarkAndRemoveWalls(const VoxelGrid& grid, const std::vector<CalibratedView>
   const std::vector<uint8_t> fill =
       GroundFillVertices(model->mesh, options.ground, grid.voxel_size());
   const std::vector<uint8_t> uncovered = UncoveredVertices(model->mesh, views, options.min_views);
-  const std::vector<uint8_t> unseen =
+  std::vector<uint8_t> unseen =
       options.remove_unseen
           ? UnseenVertices(model->mesh, views, options.min_views, grid.voxel_size())
           : std::vector<uint8_t>(model->mesh.vertices.size(), 0);
@@ -373,6 +418,9 @@ void MarkAndRemoveWalls(const VoxelGrid& grid, const std::vector<CalibratedView>
   for (size_t i = 0; i < fill.size(); ++i) wall_or_fill[i] |= fill[i];
   framed_out = wall_or_fill;
   for (size_t i = 0; i < fill.size(); ++i) framed_out[i] |= uncovered[i];
+  if (options.remove_unseen) {
+    model->unseen_vertices_kept = KeepUnseenNearSeen(model->mesh, framed_out, grid.voxel_size(), &unseen);
+  }
   any = framed_out;
   for (size_t i = 0; i < fill.size(); ++i) any[i] |= unseen[i];
   for (const Eigen::Vector3i& t : model->mesh.triangles) {
@@ -393,7 +441,8 @@ void MarkAndRemoveWalls(const VoxelGrid& grid, const std::vector<CalibratedView>
                       " beyond the frames of all but " + std::to_string(options.min_views - 1) +
                       " photo, " + std::to_string(model->unseen_triangles_removed) +
                       " seen by fewer than " + std::to_string(options.min_views) +
-                      " photos), then " +
+                      " photos, those within a voxel of what they see kept: " +
+                      std::to_string(model->unseen_vertices_kept) + " vertices), then " +
                       std::to_string(model->wall_sliver_triangles_removed) +
                       " triangles of slivers only the walls held to the model (no sparse point "
                       "on them)");

@@ -156,6 +156,9 @@ struct ModelMesh {
   // Of wall_triangles_removed, those fewer than min_views photos see (all three corners
   // UnseenVertices, with ModelMeshOptions::remove_unseen) that none of the above took.
   int64_t unseen_triangles_removed = 0;
+  // Vertices fewer than min_views photos see that stayed, within a voxel of what they see
+  // (KeepUnseenNearSeen).
+  int64_t unseen_vertices_kept = 0;
 };
 
 // Leaves out the triangles whose three corners are on the grid's wall (model->on_grid_wall),
@@ -177,6 +180,13 @@ std::vector<uint8_t> UncoveredVertices(const TriangleMesh& mesh,
 // faces). UncoveredVertices with the mesh's own occlusion: what fewer see, the carve never judged.
 std::vector<uint8_t> UnseenVertices(const TriangleMesh& mesh, const std::vector<CalibratedView>& views,
                                     int min_views, double tolerance);
+// Clears the marks of `unseen` (UnseenVertices) on the vertices of `mesh` that lie within `reach`
+// along its edges of a vertex neither unseen nor `excluded` (the walls, the ground's fill, beyond
+// the frames): where two photos' view of a surface ends, within a voxel, is below what the carve
+// resolves, and leaving it out opens the subject's rim to a photo a little past the training ones
+// (a hole into the ball's inside, drawn black). Returns how many it cleared.
+int64_t KeepUnseenNearSeen(const TriangleMesh& mesh, const std::vector<uint8_t>& excluded,
+                           double reach, std::vector<uint8_t>* unseen);
 // Per vertex of `mesh` (with normals), 1 where it lies on the wall of `grid` (see
 // ModelMesh::on_grid_wall).
 std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid& grid);

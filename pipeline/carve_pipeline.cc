@@ -441,6 +441,7 @@ void CarvePipeline::MakeSurface() {
   run_.mesh_wall_triangles_removed = model_.wall_triangles_removed;
   run_.mesh_uncovered_triangles_removed = model_.uncovered_triangles_removed;
   run_.mesh_unseen_triangles_removed = model_.unseen_triangles_removed;
+  run_.mesh_unseen_vertices_kept = model_.unseen_vertices_kept;
   run_.mesh_triangles_before_walls = model_.triangles_before_walls;
   RecordSeconds("mesh", SecondsSince(start));
 }

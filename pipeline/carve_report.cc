@@ -432,6 +432,7 @@ void WriteMesh(const CarveRequest& request, const CarveRun& run, JsonWriter& jso
         .Key("box_wall_triangles_removed").Value(run.mesh_wall_triangles_removed)
         .Key("beyond_frames_triangles_removed").Value(run.mesh_uncovered_triangles_removed)
         .Key("unseen_triangles_removed").Value(run.mesh_unseen_triangles_removed)
+        .Key("unseen_vertices_kept").Value(run.mesh_unseen_vertices_kept)
         .Key("box_wall_share").Value(run.WallShare())
         .Key("boundary_edges").Value(static_cast<int64_t>(t.boundary_edges))
         .Key("non_manifold_edges").Value(static_cast<int64_t>(t.non_manifold_edges))

@@ -401,8 +401,10 @@ void AppendAfterSummary(const CarveRequest& request, const CarveRun& run, std::s
       }
       if (run.mesh_unseen_triangles_removed > 0) {
         Appendf(text, "                  %lld triangles fewer than two photos see, behind the subjects "
-                    "from every camera (never judged, kept solid by the carve): left out of the mesh\n",
-                    static_cast<long long>(run.mesh_unseen_triangles_removed));
+                    "from every camera (never judged, kept solid by the carve): left out of the mesh "
+                    "(%lld vertices within a voxel of what they see kept, closing the subjects' rims)\n",
+                    static_cast<long long>(run.mesh_unseen_triangles_removed),
+                    static_cast<long long>(run.mesh_unseen_vertices_kept));
       }
     } else if (run.mesh_grid_wall_vertices > 0) {
       Appendf(text, "                  %lld vertices on the volume box's walls, where the box cuts the "

@@ -225,8 +225,9 @@ void AddMeshFlags(OptionParser* parser, CarveRequest* request) {
                      "cuts the scene, e.g. a table or the ground running on beyond it, or a "
                      "backdrop seen through it); the mesh is open there. With it, the surface "
                      "fewer than two photos' frames hold and, on a scene (cameras facing one "
-                     "way), the surface fewer than two photos see behind the subjects are left "
-                     "out too. 0: keep it all, the mesh closed by the box");
+                     "way), the surface fewer than two photos see behind the subjects (but for "
+                     "a voxel next to what they see) are left out too. 0: keep it all, the mesh "
+                     "closed by the box");
   parser->AddDefault("mesh_undo_self_intersections", &request->mesh.undo_self_intersections,
                      "smooth mesh: where refinement and smoothing made triangles pass through "
                      "each other, move their vertices back towards the surface before "

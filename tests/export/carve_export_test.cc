@@ -609,6 +609,39 @@ TEST(CarveExport, VerticesBehindAnOccluderFromEveryPhotoAreUnseen) {
   EXPECT_EQ(UnseenVertices(mesh, views, 1, 0.05)[6], 1);
 }
 
+TEST(CarveExport, UnseenVerticesWithinReachOfTheSeenSurfaceAlongTheMeshStay) {
+  // A strip of triangles along x: vertices at x = 0, 0.4, 0.8, ... 2.4 on two rows (y 0 and 0.1).
+  // Seen: x = 0; unseen: the rest; the wall (excluded): x = 2.4. Reach 1.0 along the edges: the
+  // unseen vertices at x 0.4 and 0.8 stay marked no more (the row's edges reach them), those from
+  // 1.2 on keep their mark; the wall, although seen, is no start.
+  TriangleMesh mesh;
+  constexpr int kColumns = 7;
+  for (int c = 0; c < kColumns; ++c) {
+    mesh.vertices.emplace_back(0.4f * c, 0.0f, 0.0f);
+    mesh.vertices.emplace_back(0.4f * c, 0.1f, 0.0f);
+  }
+  for (int c = 0; c + 1 < kColumns; ++c) {
+    const int a = 2 * c, b = 2 * c + 1, d = 2 * c + 2, e = 2 * c + 3;
+    mesh.triangles.emplace_back(a, d, e);
+    mesh.triangles.emplace_back(a, e, b);
+  }
+  std::vector<uint8_t> unseen(mesh.vertices.size(), 1), excluded(mesh.vertices.size(), 0);
+  unseen[0] = unseen[1] = 0;
+  excluded[12] = excluded[13] = 1;
+  unseen[12] = unseen[13] = 0;  // seen, but on the wall
+  std::vector<uint8_t> marks = unseen;
+  EXPECT_EQ(KeepUnseenNearSeen(mesh, excluded, 1.0, &marks), 4);
+  EXPECT_EQ(marks, (std::vector<uint8_t>{0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 0, 0}));
+  // A reach of nothing keeps the marks as they were.
+  marks = unseen;
+  EXPECT_EQ(KeepUnseenNearSeen(mesh, excluded, 0.0, &marks), 0);
+  EXPECT_EQ(marks, unseen);
+  // Without a seen start nothing is cleared (the wall does not count).
+  std::vector<uint8_t> none(mesh.vertices.size(), 1);
+  none[12] = none[13] = 0;
+  EXPECT_EQ(KeepUnseenNearSeen(mesh, excluded, 10.0, &none), 0);
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

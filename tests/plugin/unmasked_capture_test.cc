@@ -289,6 +289,8 @@ TEST(UnmaskedCapture, ForwardFacingPhotosAreASceneBoxedToTheDepthTheyPlace) {
   // and kept the space solid: its surface is left out too.
   EXPECT_GT(JsonNumber(report, "unseen_triangles_removed"), 0);
   EXPECT_NE(output.find("behind the subjects from every camera"), std::string::npos) << output;
+  // But not within a voxel of what two photos see: the subjects' rims stay closed.
+  EXPECT_GT(JsonNumber(report, "unseen_vertices_kept"), 0);
   EXPECT_NE(output.find("open where the box cuts the scene, beyond the photos' frames and behind "
                         "the subjects"),
             std::string::npos)

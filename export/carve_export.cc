@@ -1,4 +1,3 @@
-#include "export/mesh_renderer.h"
 #include "export/carve_export.h"
 
 #include <algorithm>
@@ -24,6 +23,7 @@
 
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
+#include "export/mesh_renderer.h"
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
               "the point visibility file is written little-endian by memcpy");

@@ -7,10 +7,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <queue>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <glog/logging.h>

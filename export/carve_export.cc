@@ -213,13 +213,7 @@ std::vector<uint8_t> UnseenVertices(const TriangleMesh& mesh, const std::vector<
 int64_t KeepUnseenNearSeen(const TriangleMesh& mesh, const std::vector<uint8_t>& excluded,
                            double reach, std::vector<uint8_t>* unseen) {
   CHECK(unseen->size() == mesh.vertices.size() && excluded.size() == mesh.vertices.size());
-  std::vector<std::vector<int>> neighbours(mesh.vertices.size());
-  for (const Eigen::Vector3i& t : mesh.triangles) {
-    for (int j = 0; j < 3; ++j) {
-      neighbours[t[j]].push_back(t[(j + 1) % 3]);
-      neighbours[t[j]].push_back(t[(j + 2) % 3]);
-    }
-  }
+  const std::vector<std::vector<int>> neighbours = VertexNeighbours(mesh);
   // Distances along the edges from the seen surface, through unseen vertices only (Dijkstra).
   std::vector<double> distance(mesh.vertices.size(), std::numeric_limits<double>::infinity());
   using Item = std::pair<double, int>;

@@ -152,6 +152,10 @@ bool ModelMeshOptions::IsValid(std::string* reason) const {
     *reason = "mesh refinement convergence (voxels) must be a number >= 0";
     return false;
   }
+  if (!(refine_search_pixels >= 0.0) || !std::isfinite(refine_search_pixels)) {
+    *reason = "mesh refinement search (pixels) must be a number >= 0";
+    return false;
+  }
   return true;
 }
 
@@ -365,15 +369,22 @@ void RefineModel(const std::vector<CalibratedView>& views, const VoxelGrid& grid
   refinement.passes = options.refine_passes;
   refinement.converged_offset = options.refine_converged_voxels * grid.voxel_size();
   refinement.search_range = grid.voxel_size();
+  const double pixel = MedianPixelFootprint(views, grid.Box().center());
+  if (grid.voxel_size() < pixel) {
+    refinement.search_range = std::max(grid.voxel_size(), options.refine_search_pixels * pixel);
+  }
   refinement.patch_radius = 0.5 * grid.voxel_size();
   refinement.depth_tolerance = grid.voxel_size();
   refinement.voxel_size = grid.voxel_size();
   refinement.min_views = std::max(2, options.min_views);
   refinement.num_threads = options.num_threads;
   if (refinement.passes == 0) return;
+  char reach[64];
+  std::snprintf(reach, sizeof(reach), "%.2f", refinement.search_range / grid.voxel_size());
   Tell(options, "mesh refinement: at most " + std::to_string(refinement.passes) + " passes over " +
                     std::to_string(model->mesh.vertices.size()) + " vertices, from " +
-                    std::to_string(views.size()) + " photos ...");
+                    std::to_string(views.size()) + " photos, searching +-" + reach +
+                    " voxels ...");
   model->refinement = RefineMeshFromPhotos(views, refinement, &model->mesh);
   Tell(options, model->refinement.Summary());
   if (options.final_smoothing_iterations == 0) return;

@@ -49,9 +49,9 @@ struct ModelMeshOptions {
   int64_t max_triangles = 0;      // face budget (0: none)
   int smoothing_iterations = 20;  // windowed-sinc passes (0: the stair-stepped iso-surface)
   int min_views = 2;              // vertices seen by fewer photos take their neighbours' colour
-  // Passes of RefineMeshFromPhotos (search +-1 voxel along the normals, patches half a voxel
-  // across) before colouring, at most; 0: the smoothed iso-surface as it is. They stop after the
-  // first pass that moves the vertices by less than `refine_converged_voxels` voxels on average.
+  // Passes of RefineMeshFromPhotos (search +-1 voxel along the normals, or further: below;
+  // patches half a voxel across) before colouring, at most; 0: the smoothed iso-surface as it
+  // is. They stop after the first pass that moves the vertices by less than `refine_converged_voxels` voxels on average.
   // The surface the carve leaves lies more voxels out on a finer grid: on the paper's generated
   // scene the mean |offset| per pass fell below 0.1 voxel after 3 passes at 128 voxels and 5 at
   // 256; two passes (the earlier fixed count) left 256's cloud at 94.0% completeness and 87.4%
@@ -61,6 +61,17 @@ struct ModelMeshOptions {
   // 7), so four is the most (docs/studies/mesh.md).
   int refine_passes = 4;
   double refine_converged_voxels = 0.1;
+  // Each pass searches +-1 voxel along the normals; on a grid finer than the photos (a voxel
+  // narrower than a pixel: the median over the views of a pixel's width at the volume's centre)
+  // +-this many pixels instead, where that is further. The photos can only tell apart offsets
+  // that move the surface's image by a pixel or more: there a voxel's search left most vertices
+  // unjudged or judged on noise. Held out, every 4th photo, 512 voxels (0.94 px): dinoSparseRing
+  // 17.66 -> 18.05 dB, templeSparseRing 16.12 -> 16.37; paper scene F-score 94.05 -> 94.44%;
+  // a generated ring of 8 photos of 240x180 at 256 voxels (0.56 px) 84.2 -> 86.5%. Where a voxel
+  // spans 1.1-1.3 pixels the wider search cost F-score on generated scenes (8 photos of 240x180
+  // at 128: 97.5 -> 96.4%; the room ring at 512: 83.8 -> 82.3%), so a voxel of a pixel or more
+  // keeps its own search (docs/studies/2026-12-07-refinement-search.md). 0: a voxel always.
+  double refine_search_pixels = 3.0;
   // After refinement, each vertex moves towards the mesh smoothed again (windowed sinc, this
   // many passes at the first smoothing's pass band), by the share the photos leave open:
   // 1 - MeshRefinementSummary::pinned. Where the photos place a vertex (texture, a clear cost

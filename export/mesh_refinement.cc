@@ -281,6 +281,7 @@ MeshRefinementSummary RefineMeshFromPhotos(const std::vector<CalibratedView>& vi
   const size_t n = mesh->vertices.size();
   MeshRefinementSummary summary;
   summary.vertices = static_cast<int64_t>(n);
+  summary.search_range = options.search_range;
   if (mesh->normals.size() != n) ComputeVertexNormals(mesh);
   const std::vector<std::vector<int>> neighbours = VertexNeighbours(*mesh);
   double offset_sum = 0.0, abs_offset_sum = 0.0;

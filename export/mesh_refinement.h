@@ -51,6 +51,7 @@ struct MeshRefinementSummary {
   int64_t unresolved = 0;  // seen by min_views photos, no two of which tell them apart (first pass)
   int64_t moved = 0;      // given a non-zero offset before smoothing, in the last pass
   int passes = 0;         // passes run
+  double search_range = 0.0;  // world units either side, as asked
   double last_mean_abs_offset = 0.0;  // over all vertices, in the last pass
   double mean_offset = 0.0;  // signed, along the normal (negative: inwards), over all passes
   double mean_abs_offset = 0.0;

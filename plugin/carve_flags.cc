@@ -200,6 +200,10 @@ void AddMeshFlags(OptionParser* parser, CarveRequest* request) {
   parser->AddDefault("mesh_refine_converged", &request->mesh.refine_converged_voxels,
                      "smooth mesh: the refinement stops after a pass that moves the vertices by "
                      "less than this many voxels on average (0: run every pass)");
+  parser->AddDefault("mesh_refine_search_pixels", &request->mesh.refine_search_pixels,
+                     "smooth mesh: each refinement pass searches a voxel either side; on a grid "
+                     "finer than the photos (a voxel under a pixel), this many photo pixels "
+                     "where further (0: a voxel always)");
   parser->AddDefault("mesh_final_smoothing", &request->mesh.final_smoothing_iterations,
                      "smooth mesh: after refinement, windowed-sinc passes that smooth each vertex "
                      "by the share the photos leave open (none where a clear cost minimum pins "

@@ -8,6 +8,7 @@
 #include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
 
+#include "calib/calibrated_view.h"
 #include "export/holdout_score.h"
 #include "export/mesh_renderer.h"
 #include "export/volume_renderer.h"
@@ -241,11 +242,11 @@ struct MaskedCarve {
   std::vector<CalibratedView> views;
   CarveResult result;
 };
-MaskedCarve CarveMaskedScene() {
-  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(8, 320, 240));
+MaskedCarve CarveMaskedScene(int width = 320, int height = 240, int resolution = 64) {
+  const SyntheticScene scene = GenerateSyntheticScene(testing::SceneOptions(8, width, height));
   std::vector<CalibratedView> views = testing::SceneViews(scene, /*with_masks=*/true);
   CarveOptions carve;
-  carve.resolution = 64;
+  carve.resolution = resolution;
   CarveResult result = CarveVolume(views, scene.object_box, carve);
   return MaskedCarve{std::move(views), std::move(result)};
 }
@@ -346,6 +347,32 @@ TEST(CarveExport, RefinementPassesStopWhenTheMeshStopsMoving) {
   EXPECT_LT(converged.last_mean_abs_offset, 0.1 * voxel);
   EXPECT_LT(mean_truth_distance(converged_mesh), mean_truth_distance(one_mesh));
   EXPECT_LT(mean_truth_distance(one_mesh), mean_truth_distance(unrefined.mesh));
+}
+
+TEST(CarveExport, OnAGridFinerThanThePhotosTheRefinementSearchesTheirPixels) {
+  // 320 x 240 at 64 voxels: a voxel spans several pixels, and the search is a voxel whatever is
+  // asked.
+  const MaskedCarve coarse = CarveMaskedScene();
+  const double coarse_voxel = coarse.result.volume.grid().voxel_size();
+  const double coarse_pixel =
+      MedianPixelFootprint(coarse.views, coarse.result.volume.grid().Box().center());
+  ASSERT_GT(coarse_voxel, 2.0 * coarse_pixel);
+  ModelMeshOptions options;
+  options.refine_passes = 1;
+  options.refine_search_pixels = 3.0 * coarse_voxel / coarse_pixel;
+  EXPECT_DOUBLE_EQ(MeshCarvedModel(coarse.result, coarse.views, options).refinement.search_range,
+                   coarse_voxel);
+  // The same scene in photos of 48 x 36: a voxel spans under a pixel, and the search reaches the
+  // pixels asked (or a voxel, where that is further).
+  const MaskedCarve fine = CarveMaskedScene(48, 36, 64);
+  const double voxel = fine.result.volume.grid().voxel_size();
+  const double pixel = MedianPixelFootprint(fine.views, fine.result.volume.grid().Box().center());
+  ASSERT_LT(voxel, pixel);
+  options.refine_search_pixels = 3.0;
+  EXPECT_NEAR(MeshCarvedModel(fine.result, fine.views, options).refinement.search_range,
+              3.0 * pixel, 1e-9 * pixel);
+  options.refine_search_pixels = 0.0;
+  EXPECT_DOUBLE_EQ(MeshCarvedModel(fine.result, fine.views, options).refinement.search_range, voxel);
 }
 
 // Mean distance (voxels) from each vertex to the centroid of its neighbours: the mesh's bumps.

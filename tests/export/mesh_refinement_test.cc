@@ -119,6 +119,32 @@ TEST(RefineMeshFromPhotos, PhotosFromOneSideAtAGrazingAngleDoNotJudgeThoseFromAr
   EXPECT_GT(from_around.judged, static_cast<int64_t>(around.vertices.size() / 2));
 }
 
+// On a grid finer than the photos' pixels: photos 0.8 away, 60 degrees above the floor, a pixel
+// covers 0.002 of it (0.0023 tilted); a voxel of 0.001 is half a pixel. Over +-1 voxel the three
+// photos' sampled points part by 0.001 x tan 30 x sqrt(3) = 0.001, under a pixel: no offset is
+// told from another, each vertex moves half a voxel in once, and a sheet 2.5 pixels (0.005) up
+// stays up. Searching +-3 pixels (0.006) they part by 0.006: judged, and the sheet comes down.
+TEST(RefineMeshFromPhotos, ASearchOfAFewPixelsJudgesWhereASubPixelVoxelsCannot) {
+  constexpr double kFine = 0.001, kLift = 0.005;
+  const std::vector<CalibratedView> views = FloorViews({{10, 60}, {130, 60}, {250, 60}}, 0.8);
+  MeshRefinementOptions options = FloorOptions();
+  options.voxel_size = kFine;
+  options.depth_tolerance = kFine;
+  options.patch_radius = 0.5 * kFine;
+  options.search_range = kFine;
+  TriangleMesh by_voxel = FloorSheet(kLift);
+  const MeshRefinementSummary voxel_search = RefineMeshFromPhotos(views, options, &by_voxel);
+  EXPECT_GT(voxel_search.unresolved, static_cast<int64_t>(by_voxel.vertices.size() / 2));
+  EXPECT_GT(MedianHeight(by_voxel), 0.6 * kLift);
+
+  options.search_range = 0.006;
+  TriangleMesh by_pixels = FloorSheet(kLift);
+  const MeshRefinementSummary pixel_search = RefineMeshFromPhotos(views, options, &by_pixels);
+  EXPECT_EQ(pixel_search.unresolved, 0);
+  EXPECT_GT(pixel_search.judged, static_cast<int64_t>(by_pixels.vertices.size() / 2));
+  EXPECT_LT(MedianHeight(by_pixels), 0.2 * kLift);  // within half a pixel of the floor
+}
+
 }  // namespace
 }  // namespace exporter
 }  // namespace raycarve

@@ -8,6 +8,7 @@
 #include "carve/ground.h"
 #include "calib/calibrated_view.h"
 #include "export/mesh_colouring.h"
+#include "export/mesh_exclusions.h"
 #include "export/mesh_refinement.h"
 #include "export/mesh_silhouettes.h"
 #include "export/point_cloud_io.h"
@@ -51,7 +52,8 @@ struct ModelMeshOptions {
   int min_views = 2;              // vertices seen by fewer photos take their neighbours' colour
   // Passes of RefineMeshFromPhotos (search +-1 voxel along the normals, or further: below;
   // patches half a voxel across) before colouring, at most; 0: the smoothed iso-surface as it
-  // is. They stop after the first pass that moves the vertices by less than `refine_converged_voxels` voxels on average.
+  // is. They stop after the first pass that moves the vertices by less than
+  // `refine_converged_voxels` voxels on average.
   // The surface the carve leaves lies more voxels out on a finer grid: on the paper's generated
   // scene the mean |offset| per pass fell below 0.1 voxel after 3 passes at 128 voxels and 5 at
   // 256; two passes (the earlier fixed count) left 256's cloud at 94.0% completeness and 87.4%
@@ -178,36 +180,6 @@ struct ModelMesh {
 // the vertices no triangle uses any more (with their per-vertex data), counting them.
 void RemoveGridWalls(ModelMesh* model, const std::vector<Eigen::Vector3d>& anchors = {},
                      double anchor_radius = 0.0);
-// Per vertex of `mesh`, 1 where fewer than `min_views` of `views` hold it in their frames (in
-// front of the camera, on a pixel of the photo), occlusion aside. The carve never judged what lies
-// there (a voxel that fewer than min_views views see is kept), so a surface there is the edge of
-// what the photos cover, as the box's walls are where the box cuts the scene: not a surface the
-// photos saw. Inside the box of a capture from one side (a scene), the space near the cameras and
-// beside their frames is such; an object's box is held by every photo of a ring.
-std::vector<uint8_t> UncoveredVertices(const TriangleMesh& mesh,
-                                       const std::vector<CalibratedView>& views, int min_views);
-// Per vertex of `mesh`, 1 where fewer than `min_views` of `views` see it: in the frame and no
-// more than `tolerance` behind the nearest surface of the mesh there (RenderMeshDepth, both
-// faces). UncoveredVertices with the mesh's own occlusion: what fewer see, the carve never judged.
-std::vector<uint8_t> UnseenVertices(const TriangleMesh& mesh, const std::vector<CalibratedView>& views,
-                                    int min_views, double tolerance);
-// Clears the marks of `unseen` (UnseenVertices) on the vertices of `mesh` that lie within `reach`
-// along its edges of a vertex neither unseen nor `excluded` (the walls, the ground's fill, beyond
-// the frames): where two photos' view of a surface ends, within a voxel, is below what the carve
-// resolves, and leaving it out opens the subject's rim to a photo a little past the training ones
-// (a hole into the ball's inside, drawn black). Returns how many it cleared.
-int64_t KeepUnseenNearSeen(const TriangleMesh& mesh, const std::vector<uint8_t>& excluded,
-                           double reach, std::vector<uint8_t>* unseen);
-// Per vertex of `mesh` (with normals), 1 where it lies on the wall of `grid` (see
-// ModelMesh::on_grid_wall).
-std::vector<uint8_t> GridWallVertices(const TriangleMesh& mesh, const VoxelGrid& grid);
-// Per vertex of `mesh` (with normals), 1 where it lies on the held ground's fill: its foot on the
-// plane within 1.5 voxels of the ground, and more than the ground's depth and a voxel below the
-// plane, or more than its depth and a quarter voxel below it facing sideways or down (the
-// normal over 60 degrees from the plane's). The top of the ground, facing up, is kept.
-std::vector<uint8_t> GroundFillVertices(const TriangleMesh& mesh, const Ground& ground,
-                                        double voxel_size);
-
 // One line on the smoothing after refinement: passes, the photos' mean pin, the mean move.
 std::string FinalSmoothingSummary(const ModelMesh& model, const ModelMeshOptions& options);
 

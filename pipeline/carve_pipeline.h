@@ -132,7 +132,8 @@ struct CarveRun {
   int64_t mesh_uncovered_triangles_removed = 0;
   // And the ones fewer than two photos see (a scene's: ModelMesh::unseen_...).
   int64_t mesh_unseen_triangles_removed = 0;
-  // Vertices fewer than two photos see kept within a voxel of what they see (ModelMesh::unseen_vertices_kept).
+  // Vertices fewer than two photos see, kept within a voxel of what they see
+  // (ModelMesh::unseen_vertices_kept).
   int64_t mesh_unseen_vertices_kept = 0;
   int64_t mesh_triangles_before_walls = 0;
   // The share of the mesh's triangles that lay on the box's walls and were left out (0 when none),

@@ -36,7 +36,9 @@ GroundMap::GroundMap(const Ground& ground) {
   rows_ = static_cast<int>(std::ceil(extent.y() / cell_)) + 1;
   cells_.assign(static_cast<size_t>(cols_) * rows_, Foot::kNeither);
   MarkDiscs(ground.footprint, ground.radius, Foot::kGround);
-  MarkOutline(ground.outline);
+  // Past the outline's edges by one spacing of its points (the reach is two): about where the
+  // next point would have been, where the ground's edge lies beyond its outermost points.
+  MarkOutline(ground.outline, 0.5 * ground.radius);
   MarkDiscs(ground.holes, ground.radius, Foot::kNearHole);
 }
 
@@ -63,11 +65,32 @@ void GroundMap::MarkDiscs(const std::vector<Eigen::Vector3d>& points, double rad
   }
 }
 
-void GroundMap::MarkOutline(const std::vector<Eigen::Vector3d>& outline) {
+void GroundMap::MarkOutline(const std::vector<Eigen::Vector3d>& outline, double radius) {
   if (outline.size() < 3) return;
   std::vector<Eigen::Vector2d> corners;
   for (const Eigen::Vector3d& point : outline) corners.push_back(OnPlane(point));
   const size_t n = corners.size();
+  // Within `radius` of each edge: the ground runs on past its outermost points.
+  const int reach = static_cast<int>(std::ceil(radius / cell_));
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& a = corners[i];
+    const Eigen::Vector2d& b = corners[(i + 1) % n];
+    const Eigen::Vector2d ab = b - a;
+    const double length2 = ab.squaredNorm();
+    const int c0 = std::max(0, std::min(Col(a), Col(b)) - reach);
+    const int c1 = std::min(cols_ - 1, std::max(Col(a), Col(b)) + reach);
+    const int r0 = std::max(0, std::min(Row(a), Row(b)) - reach);
+    const int r1 = std::min(rows_ - 1, std::max(Row(a), Row(b)) + reach);
+    for (int r = r0; r <= r1; ++r) {
+      for (int c = c0; c <= c1; ++c) {
+        const Eigen::Vector2d q = CellCentre(c, r);
+        const double t = length2 > 0.0 ? std::clamp((q - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+        if ((a + t * ab - q).squaredNorm() <= radius * radius) {
+          cells_[static_cast<size_t>(r) * cols_ + c] = Foot::kGround;
+        }
+      }
+    }
+  }
   // Row by row: a convex polygon meets the line through the row's cell centres in one interval,
   // between the lowest and highest crossing of its edges.
   for (int r = 0; r < rows_; ++r) {

@@ -21,13 +21,16 @@ struct Ground {
   // A point more than `depth` below the plane is under it (the plane's tolerance).
   double depth = 0.0;
   // Where the plane is ground: inside this convex outline on the plane (the hull of the sparse
-  // points on it) or within `radius` of one of the footprint points (those points), and not
-  // within `radius` of a hole (the foot on the plane of a point seen below it: a step down, the
-  // floor beyond a table's edge). Empty footprint: no ground.
+  // points on it) or within half `radius` of it (one spacing of its points: about where the next
+  // point past the outermost would be), or within `radius` of one of the footprint points (those
+  // points), and not within `radius` of a hole (the foot on the plane of a point seen below it: a
+  // step down, the floor beyond a table's edge). Empty footprint: no ground.
   std::vector<Eigen::Vector3d> footprint;
   std::vector<Eigen::Vector3d> outline;  // in order around the hull; may be empty
   std::vector<Eigen::Vector3d> holes;
   double radius = 0.0;
+  // Points on the plane left out of the footprint: lone, unchecked (exporter::GroundUnder).
+  int lone_points = 0;
 
   bool empty() const { return footprint.empty() || !(radius > 0.0); }
   // Signed distance of `point` from the plane (positive on the cameras' side).
@@ -58,7 +61,7 @@ class GroundMap {
   int Col(const Eigen::Vector2d& q) const;
   int Row(const Eigen::Vector2d& q) const;
   void MarkDiscs(const std::vector<Eigen::Vector3d>& points, double radius, Foot value);
-  void MarkOutline(const std::vector<Eigen::Vector3d>& outline);
+  void MarkOutline(const std::vector<Eigen::Vector3d>& outline, double radius);
 
   Eigen::Vector3d normal_, u_, v_;
   double offset_ = 0.0;

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include <Eigen/Eigenvalues>
+#include <glog/logging.h>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -381,13 +382,20 @@ std::vector<Eigen::Vector3d> HullOnPlane(const std::vector<Eigen::Vector3d>& poi
 }  // namespace
 
 Ground GroundUnder(const SupportingPlane& plane, const std::vector<Eigen::Vector3d>& points,
-                   const std::vector<Eigen::Vector3d>& hole_points) {
+                   const std::vector<Eigen::Vector3d>& hole_points,
+                   const std::vector<bool>& checked) {
   Ground ground;
   if (!plane.found) return ground;
+  CHECK(checked.empty() || checked.size() == points.size());
   std::vector<Eigen::Vector3d> on, below;
-  for (const Eigen::Vector3d& p : points) {
+  std::vector<bool> on_checked;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d& p = points[i];
     const double distance = plane.normal.dot(p) + plane.offset;
-    if (std::abs(distance) <= plane.tolerance) on.push_back(p - distance * plane.normal);
+    if (std::abs(distance) <= plane.tolerance) {
+      on.push_back(p - distance * plane.normal);
+      on_checked.push_back(checked.empty() || checked[i]);
+    }
   }
   for (const Eigen::Vector3d& p : hole_points) {
     const double distance = plane.normal.dot(p) + plane.offset;
@@ -414,12 +422,28 @@ Ground GroundUnder(const SupportingPlane& plane, const std::vector<Eigen::Vector
   std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
   const double radius = 2.0 * spacing[spacing.size() / 2];
   if (!(radius > 0.0)) return ground;
+  // Lone unchecked points: no other place on the plane within the discs' diameter.
+  std::vector<Eigen::Vector3d> kept;
+  kept.reserve(on.size());
+  for (size_t i = 0; i < on.size(); ++i) {
+    bool keep = on_checked[i];
+    if (!keep) {
+      tree.radiusSearch(cloud->points[i], static_cast<float>(2.0 * radius), found, distances);
+      for (float d : distances) keep = keep || d > 0.0f;
+    }
+    if (keep) {
+      kept.push_back(on[i]);
+    } else {
+      ++ground.lone_points;
+    }
+  }
+  if (kept.size() < 3) return Ground();
   ground.normal = plane.normal;
   ground.offset = plane.offset;
   ground.depth = plane.tolerance;
   ground.radius = radius;
-  ground.outline = HullOnPlane(on, plane.normal);
-  ground.footprint = std::move(on);
+  ground.outline = HullOnPlane(kept, plane.normal);
+  ground.footprint = std::move(kept);
   ground.holes = std::move(below);
   return ground;
 }

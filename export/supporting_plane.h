@@ -105,8 +105,14 @@ SupportingPlane FitSupportingPlane(const std::vector<Eigen::Vector3d>& points,
 // spacing between neighbours on the plane; `depth` the plane's tolerance. (A hole says the photos
 // saw through the plane: only points a third photo checked say so, where there are enough; a
 // wrong match between two photos lies anywhere.)
+// `checked` (parallel to `points`, empty: all) says which points a third photo checked. A point
+// on the plane that no third photo checked and that has no other point of the plane within two
+// reaches (their discs would not touch) is a lone wrong match, not ground: it is left out of the
+// footprint and the outline (Ground::lone_points), where one such point far past the ground's edge
+// would stretch the convex outline over empty space.
 Ground GroundUnder(const SupportingPlane& plane, const std::vector<Eigen::Vector3d>& points,
-                   const std::vector<Eigen::Vector3d>& hole_points);
+                   const std::vector<Eigen::Vector3d>& hole_points,
+                   const std::vector<bool>& checked = {});
 
 }  // namespace exporter
 }  // namespace raycarve

@@ -76,13 +76,18 @@ void CarvePipeline::DecideGround() {
     // A point under the plane opens a hole in the ground; a wrong match between two photos lies
     // anywhere, so holes come from the points three or more photos saw, as the plane does
     // (CheckedPoints), where there are enough.
+    // A lone point on the plane that no third photo checked is left out of the ground too: one
+    // wrong match past the ground's edge would stretch its outline over empty space.
     std::vector<Eigen::Vector3d> points, checked;
+    std::vector<bool> is_checked;
     for (const SurfacePoint& point : SurfacePointsOf(project_.reconstruction, carved_, around)) {
       points.push_back(point.xyz);
-      if (static_cast<int>(point.views.size()) >= kCheckedTrack) checked.push_back(point.xyz);
+      is_checked.push_back(static_cast<int>(point.views.size()) >= kCheckedTrack);
+      if (is_checked.back()) checked.push_back(point.xyz);
     }
     const bool enough = static_cast<int>(checked.size()) >= kMinCheckedPoints;
-    run_.support = exporter::GroundUnder(run_.plane, points, enough ? checked : points);
+    if (!enough) is_checked.clear();
+    run_.support = exporter::GroundUnder(run_.plane, points, enough ? checked : points, is_checked);
   }
   if (!run_.plane.found) {
     run_.ground_reason = "no supporting plane";
@@ -99,6 +104,11 @@ void CarvePipeline::DecideGround() {
     } else {
       text << "held solid under the plane, within " << run_.ground.radius << " of its "
            << run_.ground.footprint.size() << " sparse points";
+      if (run_.ground.lone_points > 0) {
+        text << " (" << run_.ground.lone_points
+             << (run_.ground.lone_points == 1 ? " lone point" : " lone points")
+             << " on it that only two photos saw left out as wrong matches)";
+      }
     }
     run_.ground_reason = text.str();
   }

@@ -204,6 +204,7 @@ void WriteCapture(const CarveRun& run, JsonWriter& json) {
       .Key("ground").Value(run.ground_reason)
       .Key("ground_footprint_points").Value(static_cast<int64_t>(run.ground.footprint.size()))
       .Key("ground_reach").Value(run.ground.radius)
+      .Key("ground_lone_points_left_out").Value(static_cast<int64_t>(run.ground.lone_points))
       .Key("ground_voxels").Value(s.ground_voxels)
       .Key("beyond_ground_carved").Value(s.beyond_ground_carved)
       .EndObject();

@@ -107,5 +107,21 @@ TEST(GroundMap, TheOutlineCoversWhatItsPointsLeaveBetweenThem) {
   EXPECT_EQ(GroundMap(ground).At(Eigen::Vector3d::Zero()), GroundMap::Foot::kNeither);
 }
 
+TEST(GroundMap, TheGroundRunsOnPastTheOutlinesEdgesByOneSpacing) {
+  // Four points far apart (a square of side 2 at z = 0, reaching 0.2: spacing 0.1): midway along
+  // an edge no point is near, but the ground runs on past the edge by a spacing.
+  Ground ground;
+  ground.normal = Eigen::Vector3d::UnitZ();
+  ground.radius = 0.2;
+  ground.footprint = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  ground.outline = ground.footprint;
+  const GroundMap map(ground);
+  EXPECT_EQ(map.At({0.0, -1.08, -0.3}), GroundMap::Foot::kGround);   // 0.08 past the edge
+  EXPECT_EQ(map.At({-1.08, 0.3, -0.3}), GroundMap::Foot::kGround);
+  EXPECT_EQ(map.At({0.0, -1.15, -0.3}), GroundMap::Foot::kNeither);  // 0.15: past a spacing
+  EXPECT_EQ(map.At({1.15, 1.0, -0.3}), GroundMap::Foot::kGround);    // a corner's disc
+  EXPECT_EQ(map.At({1.2, 1.2, -0.3}), GroundMap::Foot::kNeither);    // 0.28 from the corner
+}
+
 }  // namespace
 }  // namespace raycarve

@@ -110,6 +110,34 @@ TEST(GroundUnder, TheTablesPointsMakeTheGroundAndAStepDownMakesHoles) {
   EXPECT_EQ(no_holes.radius, ground.radius);
 }
 
+TEST(GroundUnder, ALoneUncheckedPointPastTheEdgeDoesNotStretchTheGround) {
+  const Eigen::Vector3d n = Eigen::Vector3d(0.2, -0.1, 1.0).normalized();
+  const Eigen::Vector3d origin(1.0, 2.0, -0.5);
+  Scene scene = TableScene(origin, n, true);
+  const SupportingPlane plane = FitSupportingPlane(scene.points, scene.cameras, PhotosUp(), 0.01);
+  ASSERT_TRUE(plane.found) << plane.Summary();
+  // Two wrong matches on the plane 4 from the table's centre (its disc reaches 2), one of them
+  // seen by a third photo; a pair of points 0.05 apart past the other side.
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  const Eigen::Vector3d lone = origin + 4.0 * u, checked = origin + 4.0 * v;
+  const Eigen::Vector3d pair = origin - 4.0 * u, beside = pair + 0.05 * v;
+  std::vector<Eigen::Vector3d> points = scene.points;
+  points.insert(points.end(), {lone, checked, pair, beside});
+  std::vector<bool> seen_by_three(points.size(), false);
+  seen_by_three[points.size() - 3] = true;
+  const Ground ground = GroundUnder(plane, points, {}, seen_by_three);
+  ASSERT_FALSE(ground.empty());
+  EXPECT_EQ(ground.lone_points, 1);
+  const GroundMap map(ground);
+  EXPECT_EQ(map.At(origin + 3.0 * u - 0.3 * n), GroundMap::Foot::kNeither);  // not stretched
+  EXPECT_EQ(map.At(origin + 3.0 * v - 0.3 * n), GroundMap::Foot::kGround);   // the checked one
+  EXPECT_EQ(map.At(origin - 3.0 * u - 0.3 * n), GroundMap::Foot::kGround);   // the pair
+  // No flags: every point counts, as before.
+  const Ground all = GroundUnder(plane, points, {});
+  EXPECT_EQ(all.lone_points, 0);
+  EXPECT_EQ(GroundMap(all).At(origin + 3.0 * u - 0.3 * n), GroundMap::Foot::kGround);
+}
+
 // A slanted roof above a floor holds more points than the floor (wrong matches along a repeated
 // pattern do the same on a tilted plane): the densest plane has the floor and a ball below it, so
 // it is no support, and the floor, the densest plane with nothing below it, is.

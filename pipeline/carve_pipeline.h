@@ -1,5 +1,6 @@
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <future>
@@ -239,6 +240,8 @@ class CarvePipeline {
   void DecideObjectRules();
   void FindDistant();   // distant_rays_ and run_.distant, once the masks are decided
   void FindGroundPixels();  // appends to distant_rays_, run_.ground_pixels, once the ground is
+  using Clock = std::chrono::steady_clock;
+  static double SecondsSince(Clock::time_point start);
   void RecordSeconds(const std::string& stage, double seconds);
   void WriteMasks(const std::filesystem::path& staging) const;
   // report.html (pipeline/report_page.h): the summary, preview.png, the convergence plot and

@@ -37,7 +37,7 @@ CalibratedView ViewFrom(const Eigen::Vector3d& target, double distance,
 
 }  // namespace
 
-Eigen::Vector3d PhotosUp(const std::vector<CalibratedView>& views) {
+Eigen::Vector3d UpOfPhotos(const std::vector<CalibratedView>& views) {
   std::vector<Rigid3d> poses;
   for (const CalibratedView& view : views) poses.push_back(view.cam_from_world);
   return EstimatePhotosUp(poses).up;
@@ -51,7 +51,7 @@ std::vector<CalibratedView> ViewsFromOutside(const TriangleMesh& mesh,
   Eigen::AlignedBox3d box;
   for (const Eigen::Vector3f& v : mesh.vertices) box.extend(v.cast<double>());
   const Eigen::Vector3d target = box.center();
-  const Eigen::Vector3d up = PhotosUp(views);
+  const Eigen::Vector3d up = UpOfPhotos(views);
   std::vector<Eigen::Vector3d> seen_from;
   for (const CalibratedView& view : views) seen_from.push_back((view.centre - target).normalized());
   // Directions around the model: above, below, and eight around the horizon and 45 degrees up;

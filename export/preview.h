@@ -23,7 +23,7 @@ cv::Mat PreviewImage(const TriangleMesh& mesh, const std::vector<CalibratedView>
 // The photos' up direction in the world (EstimatePhotosUp: the mean of their cameras' -y axes,
 // up in a photo, with photos turned a quarter turned back), unit; +z where they cancel out (or
 // there are none).
-Eigen::Vector3d PhotosUp(const std::vector<CalibratedView>& views);
+Eigen::Vector3d UpOfPhotos(const std::vector<CalibratedView>& views);
 
 // `count` pinhole cameras of `width` x `height` (40 degrees across) framing the whole mesh from
 // the directions farthest from the photos': of above, below (the photos' mean up, their camera

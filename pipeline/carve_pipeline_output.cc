@@ -146,7 +146,7 @@ void CarvePipeline::WriteReportPage(const fs::path& staging) const {
   // camera nearest the cameras' mean direction from the volume's centre (a photo's viewpoint: a
   // ring's mean direction points straight up).
   const Eigen::Vector3d centre = project_.bounds.box.center();
-  page.view_up = exporter::PhotosUp(carved_);
+  page.view_up = exporter::UpOfPhotos(carved_);
   Eigen::Vector3d mean_direction = Eigen::Vector3d::Zero();
   for (const CalibratedView& view : carved_) mean_direction += (view.centre - centre).normalized();
   double best = -2.0;

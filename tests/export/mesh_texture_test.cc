@@ -336,7 +336,7 @@ TEST(PhotosUp, PhotosAllTurnedAQuarterGiveTheWorldsUp) {
     view.centre = centre;
     views.push_back(view);
   }
-  EXPECT_GT(PhotosUp(views).z(), 1.0 - 1e-9);
+  EXPECT_GT(UpOfPhotos(views).z(), 1.0 - 1e-9);
 }
 
 }  // namespace

@@ -36,7 +36,8 @@ std::string DistantPixels::Summary() const {
   text.precision(3);
   text << "distant pixels: " << distant << " of " << textured << " textured pixels judged in "
        << masks.size() << " photos show something beyond the volume, and " << grown
-       << " pixels of plain regions bounded by them (" << rays.size() << " rays); " << nearer
+       << " pixels of plain regions bounded by them (" << rays.size() << " rays; " << grown_refused
+       << " of theirs left out: the other photos see another colour there); " << nearer
        << " were found inside it; " << seconds << " s";
   return text.str();
 }

@@ -256,6 +256,19 @@ bool RayOf(const ReducedView& i, const Eigen::Vector2d& p, const Eigen::AlignedB
   return true;
 }
 
+// The mean colour of the 3 x 3 pixels around a COLMAP pixel position; false where one is not valid.
+bool Mean3x3(const ReducedView& g, const Eigen::Vector2d& p, float* mean) {
+  float value[3];
+  mean[0] = mean[1] = mean[2] = 0.0f;
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      if (!Sample(g, p + Eigen::Vector2d(dx, dy), value)) return false;
+      for (int c = 0; c < 3; ++c) mean[c] += value[c] / 9.0f;
+    }
+  }
+  return true;
+}
+
 // Judges the textured pixels of one photo against the others (one per thread at a time).
 class PhotoJudge {
  public:
@@ -324,7 +337,67 @@ class PhotoJudge {
     return 1;
   }
 
+  // Per other photo, its brightness against this one's, per channel: the median ratio of the
+  // colours where this photo's pixels found on the surface (`found`) fall in it, as an automatic
+  // exposure sets them (1 where fewer than kMinGainSamples of them fall inside it).
+  void EstimateGains(const std::vector<Eigen::Vector2d>& found) {
+    gains_.assign(views_.size(), Eigen::Vector3d::Ones());
+    const size_t step = std::max<size_t>(1, found.size() / kGainSamples);
+    std::vector<double> ratios[3];
+    PixelRay ray;
+    for (int partner : partners_) {
+      for (std::vector<double>& r : ratios) r.clear();
+      for (size_t k = 0; k < found.size(); k += step) {
+        Eigen::Vector2d q;
+        float a[3], b[3];
+        if (!RayOf(i_, found[k], box_, {Eigen::Vector2d::Zero()}, surface_, &ray) ||
+            !ProjectInFront(views_[partner], ray.points[0], &q) || !Mean3x3(i_, found[k], a) ||
+            !Mean3x3(views_[partner], q, b)) {
+          continue;
+        }
+        for (int c = 0; c < 3; ++c) {
+          if (a[c] >= kMinGainLevel && b[c] >= kMinGainLevel) ratios[c].push_back(b[c] / a[c]);
+        }
+      }
+      for (int c = 0; c < 3; ++c) {
+        if (static_cast<int>(ratios[c].size()) < kMinGainSamples) continue;
+        std::nth_element(ratios[c].begin(), ratios[c].begin() + ratios[c].size() / 2, ratios[c].end());
+        gains_[partner][c] = ratios[c][ratios[c].size() / 2];
+      }
+    }
+  }
+
+  // Whether the photos asked (up to max_partners that tell `ray` from the surface) see, where the
+  // surface puts the ray's point, the colour `colour` (3 x 3 pixels' mean, within `tolerance` after
+  // their gain): false where most of them see another.
+  bool SeenOnSurface(const PixelRay& ray, const float* colour, double tolerance) {
+    int agree = 0, asked = 0;
+    for (int partner : partners_) {
+      if (asked >= options_.max_partners) break;
+      PairGeometry pair;
+      float mean[3];
+      if (!PairFor(i_, views_[partner], partner, ray, 0, options_, &pair) ||
+          !Mean3x3(views_[partner], pair.on_surface, mean)) {
+        continue;
+      }
+      ++asked;
+      double squared = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        const double gain = gains_.empty() ? 1.0 : gains_[partner][c];
+        squared += (mean[c] - gain * colour[c]) * (mean[c] - gain * colour[c]);
+      }
+      agree += std::sqrt(squared / 3.0) <= tolerance;
+    }
+    return asked < options_.min_agreeing_views || 2 * agree >= asked;
+  }
+
  private:
+  // The gains: from up to this many pixels found, channels at least this bright in both photos,
+  // and at least this many ratios.
+  static constexpr size_t kGainSamples = 400;
+  static constexpr float kMinGainLevel = 8.0f;
+  static constexpr int kMinGainSamples = 20;
+
   // The best match on the pair's segment: searched with the coarse patch, then the whole patch
   // at the best sample and its two neighbours. -1 where none can be judged.
   double BestInside(const CentredPatch& a, const PairGeometry& pair) {
@@ -359,6 +432,7 @@ class PhotoJudge {
   const SupposedSurface& surface_;
   const DistantOptions& options_;
   std::vector<int> partners_;
+  std::vector<Eigen::Vector3d> gains_;  // EstimateGains
   std::vector<size_t> kept_;
   // Scratch, kept between pixels.
   std::vector<PairGeometry> pairs_;
@@ -406,7 +480,7 @@ bool QuadrantsTextured(const std::vector<float>& values, int radius, double text
 struct PhotoVerdicts {
   std::vector<DistantRay> rays;
   cv::Mat mask;
-  int64_t textured = 0, found = 0, nearer = 0, grown = 0;
+  int64_t textured = 0, found = 0, nearer = 0, grown = 0, grown_refused = 0;
 };
 
 // Judges photo v's textured pixels (every `stride`) against the others, then its plain regions.
@@ -462,9 +536,28 @@ PhotoVerdicts JudgePhoto(const std::vector<ReducedView>& reduced, int v, const E
     }
   }
   if (options.grow_plain_regions) {
+    if (options.check_grown_colour) {
+      std::vector<Eigen::Vector2d> found;
+      for (int row = 0; row < out.mask.rows; ++row) {
+        for (int col = 0; col < out.mask.cols; ++col) {
+          if (out.mask.at<uint8_t>(row, col) == kDistantJudged) found.push_back(PixelCentre(row, col));
+        }
+      }
+      judge.EstimateGains(found);
+    }
+    const std::vector<Eigen::Vector2d> centre = {Eigen::Vector2d::Zero()};
     for (const Eigen::Vector2d& p : GrowIntoPlainRegions(Grey(i), i.valid, i.texture, i.factor, options,
                                                          seen, &out.mask, &out.grown)) {
-      if (RayOf(i, p, box, {}, surface, &ray)) add_ray(ray, ray.t1);
+      if (!RayOf(i, p, box, centre, surface, &ray)) continue;
+      // A plain patch matches anything plain: its colour is what is asked. Within the photo's
+      // plain spread (a patch under `texture` is plain), after the other photo's gain.
+      float colour[3];
+      if (options.check_grown_colour &&
+          (!Mean3x3(i, p, colour) || !judge.SeenOnSurface(ray, colour, i.texture))) {
+        ++out.grown_refused;
+        continue;
+      }
+      add_ray(ray, ray.t1);
     }
   }
   return out;
@@ -512,6 +605,7 @@ DistantPixels FindPixelsOnSurface(const std::vector<CalibratedView>& views,
     result.distant += photo.found;
     result.nearer += photo.nearer;
     result.grown += photo.grown;
+    result.grown_refused += photo.grown_refused;
     result.factors.push_back(reduced[v].factor);
     result.masks.push_back(std::move(photo.mask));
   }

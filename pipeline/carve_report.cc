@@ -217,6 +217,7 @@ void WriteCapture(const CarveRun& run, JsonWriter& json) {
       .Key("found_pixels").Value(distant.distant)
       .Key("nearer_pixels").Value(distant.nearer)
       .Key("plain_region_pixels").Value(distant.grown)
+      .Key("plain_region_rays_refused").Value(distant.grown_refused)
       .Key("distant_rays").Value(s.distant_rays)
       .Key("distant_voxels_carved").Value(s.distant_carved)
       .Key("distant_through_ground_not_drawn").Value(s.distant_through_ground)

@@ -410,7 +410,7 @@ std::vector<uint64_t> ReadTilePart(const std::string& path, const TilePlan& plan
 
 namespace {
 
-constexpr char kRaysMagic[8] = {'R', 'C', 'R', 'A', 'Y', 'S', '0', '2'};
+constexpr char kRaysMagic[8] = {'R', 'C', 'R', 'A', 'Y', 'S', '0', '3'};
 
 struct RaysHeader {
   char magic[8];
@@ -419,6 +419,7 @@ struct RaysHeader {
   int64_t distant;
   int64_t nearer;
   int64_t grown;
+  int64_t grown_refused;
   int64_t photos_judged;
   uint64_t count;
 };
@@ -440,6 +441,7 @@ void WriteDistantPixels(const std::string& path, const std::string& plan_id,
   header.distant = distant.distant;
   header.nearer = distant.nearer;
   header.grown = distant.grown;
+  header.grown_refused = distant.grown_refused;
   header.photos_judged = distant.photos_judged;
   header.count = distant.rays.size();
   std::string bytes(reinterpret_cast<const char*>(&header), sizeof(header));
@@ -477,6 +479,7 @@ DistantPixels ReadDistantPixels(const std::string& path, const TilePlan& plan) {
   distant.distant = header.distant;
   distant.nearer = header.nearer;
   distant.grown = header.grown;
+  distant.grown_refused = header.grown_refused;
   if (header.photos_judged < 0 || header.photos_judged > std::numeric_limits<int>::max()) {
     throw InputError(path + ": photos_judged out of range");
   }

@@ -18,6 +18,7 @@
 #include "calib/pixel.h"
 #include "calib/plain_regions.h"
 #include "calib/ray_box.h"
+#include "calib/reduced_view.h"
 
 namespace raycarve {
 
@@ -31,59 +32,6 @@ constexpr double kMeanPenalty = 0.25;
 // the whole patch. (Where the search costs most: it ran 8.5 s of a 26 s carve of 25 photos of
 // 1600 x 1200 judged whole and a pixel apart.)
 constexpr double kSegmentStep = 1.5;
-
-// A photo as judged: reduced, with its geometry in the reduced pixels. Eight bits a channel: a
-// photo of 640 x 480 holds 1.2 MB here, 200 of them 240 MB.
-struct ReducedView {
-  cv::Mat rgb;    // CV_8UC3
-  cv::Mat valid;  // CV_8UC1
-  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // camera from world
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  Eigen::Matrix<double, 3, 4> P = Eigen::Matrix<double, 3, 4>::Zero();
-  int factor = 1;
-  double texture = 0.0;  // the smallest standard deviation of a textured patch
-};
-
-// The photo in grey levels (CV_32F).
-cv::Mat Grey(const ReducedView& g) {
-  cv::Mat rgb, grey;
-  g.rgb.convertTo(rgb, CV_32FC3);
-  cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
-  return grey;
-}
-
-ReducedView ReducedViewOf(const CalibratedView& view, const DistantOptions& options) {
-  ReducedView g;
-  g.factor = std::max(1, (std::max(view.width, view.height) + options.max_side - 1) / options.max_side);
-  g.factor = std::min(g.factor, std::max(1, std::min(view.width, view.height)));
-  const CalibratedView reduced = ReduceView(view, g.factor);
-  g.rgb = reduced.image;
-  g.valid = reduced.valid.empty() ? cv::Mat(reduced.image.size(), CV_8UC1, cv::Scalar(255))
-                                  : reduced.valid.clone();
-  g.K = reduced.K;
-  g.R = reduced.cam_from_world.rotation.toRotationMatrix();
-  g.centre = reduced.centre;
-  g.P = reduced.P;
-  g.texture = std::max(options.min_texture, options.texture_noise_factor * ImageNoiseSigma(Grey(g)));
-  return g;
-}
-
-// Bilinear RGB at a COLMAP pixel position into value[0..2]; false outside the valid pixels.
-bool Sample(const ReducedView& g, const Eigen::Vector2d& colmap, float* value) {
-  const Eigen::Vector2d cv = OpenCvFromColmap(colmap);
-  const int x0 = static_cast<int>(std::floor(cv.x())), y0 = static_cast<int>(std::floor(cv.y()));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= g.rgb.cols || y0 + 1 >= g.rgb.rows) return false;
-  if (!g.valid.at<uint8_t>(y0, x0) || !g.valid.at<uint8_t>(y0 + 1, x0 + 1)) return false;
-  const float fx = static_cast<float>(cv.x() - x0), fy = static_cast<float>(cv.y() - y0);
-  const cv::Vec3b* a = g.rgb.ptr<cv::Vec3b>(y0);
-  const cv::Vec3b* b = g.rgb.ptr<cv::Vec3b>(y0 + 1);
-  for (int c = 0; c < 3; ++c) {
-    value[c] = (1 - fy) * ((1 - fx) * a[x0][c] + fx * a[x0 + 1][c]) +
-               fy * ((1 - fx) * b[x0][c] + fx * b[x0 + 1][c]);
-  }
-  return true;
-}
 
 // A patch of RGB samples (k * 3 + channel), each channel less its mean: the means and the
 // squared norm of what is left.
@@ -256,19 +204,6 @@ bool RayOf(const ReducedView& i, const Eigen::Vector2d& p, const Eigen::AlignedB
   return true;
 }
 
-// The mean colour of the 3 x 3 pixels around a COLMAP pixel position; false where one is not valid.
-bool Mean3x3(const ReducedView& g, const Eigen::Vector2d& p, float* mean) {
-  float value[3];
-  mean[0] = mean[1] = mean[2] = 0.0f;
-  for (int dy = -1; dy <= 1; ++dy) {
-    for (int dx = -1; dx <= 1; ++dx) {
-      if (!Sample(g, p + Eigen::Vector2d(dx, dy), value)) return false;
-      for (int c = 0; c < 3; ++c) mean[c] += value[c] / 9.0f;
-    }
-  }
-  return true;
-}
-
 // Judges the textured pixels of one photo against the others (one per thread at a time).
 class PhotoJudge {
  public:
@@ -342,21 +277,31 @@ class PhotoJudge {
   // exposure sets them (1 where fewer than kMinGainSamples of them fall inside it).
   void EstimateGains(const std::vector<Eigen::Vector2d>& found) {
     gains_.assign(views_.size(), Eigen::Vector3d::Ones());
-    const size_t step = std::max<size_t>(1, found.size() / kGainSamples);
-    std::vector<double> ratios[3];
+    // The sampled pixels' surface points and colours, once for every partner.
+    std::vector<Eigen::Vector4d> points;
+    std::vector<Eigen::Vector3f> colours;
     PixelRay ray;
+    Eigen::Vector3f colour;
+    for (size_t k = 0; k < found.size(); k += std::max<size_t>(1, found.size() / kGainSamples)) {
+      if (RayOf(i_, found[k], box_, {Eigen::Vector2d::Zero()}, surface_, &ray) &&
+          Mean3x3(i_, found[k], colour.data())) {
+        points.push_back(ray.points[0]);
+        colours.push_back(colour);
+      }
+    }
+    std::vector<double> ratios[3];
     for (int partner : partners_) {
       for (std::vector<double>& r : ratios) r.clear();
-      for (size_t k = 0; k < found.size(); k += step) {
+      for (size_t k = 0; k < points.size(); ++k) {
         Eigen::Vector2d q;
-        float a[3], b[3];
-        if (!RayOf(i_, found[k], box_, {Eigen::Vector2d::Zero()}, surface_, &ray) ||
-            !ProjectInFront(views_[partner], ray.points[0], &q) || !Mean3x3(i_, found[k], a) ||
-            !Mean3x3(views_[partner], q, b)) {
+        if (!ProjectInFront(views_[partner], points[k], &q) ||
+            !Mean3x3(views_[partner], q, colour.data())) {
           continue;
         }
         for (int c = 0; c < 3; ++c) {
-          if (a[c] >= kMinGainLevel && b[c] >= kMinGainLevel) ratios[c].push_back(b[c] / a[c]);
+          if (colours[k][c] >= kMinGainLevel && colour[c] >= kMinGainLevel) {
+            ratios[c].push_back(colour[c] / colours[k][c]);
+          }
         }
       }
       for (int c = 0; c < 3; ++c) {

@@ -22,6 +22,7 @@
 
 #include "calib/atomic_file.h"
 #include "calib/input_error.h"
+#include "carve/view_workers.h"
 #include "export/mesh_renderer.h"
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
@@ -400,8 +401,9 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     model.silhouettes = FitMeshToSilhouettes(views, fit, &model.mesh);
     if (model.silhouettes.passes > 0) Tell(options, model.silhouettes.Summary());
   }
+  const int threads = options.num_threads > 0 ? options.num_threads : ResolveNumThreads(-1);
   if (options.undo_self_intersections) {
-    model.self_intersections = UndoSelfIntersections(unrefined, &model.mesh);
+    model.self_intersections = UndoSelfIntersections(unrefined, &model.mesh, nullptr, threads);
     Tell(options, "mesh self-intersections: " + model.self_intersections.Summary());
   }
   if (!options.support.empty()) {
@@ -409,8 +411,15 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     model.levelling =
         LevelOntoSupport(options.support, grid.voxel_size(), options.level_band, &model.mesh);
     if (options.undo_self_intersections && model.levelling.vertices > 0) {
-      // Where levelling made triangles pass through each other, those vertices go back.
-      const SelfIntersectionRepair undone = UndoSelfIntersections(before, &model.mesh);
+      // Where levelling made triangles pass through each other, those vertices go back. The mesh
+      // had none before (when pairs_after is 0), so only the levelled vertices' triangles count.
+      std::vector<uint8_t> levelled(before.size(), 0);
+      for (size_t v = 0; v < before.size(); ++v) {
+        levelled[v] = model.mesh.vertices[v] != before[v] ? 1 : 0;
+      }
+      const SelfIntersectionRepair undone = UndoSelfIntersections(
+          before, &model.mesh, model.self_intersections.pairs_after == 0 ? &levelled : nullptr,
+          options.num_threads);
       model.levelling.undone = undone.vertices_moved_back;
       model.self_intersections.pairs_after = undone.pairs_after;
     }

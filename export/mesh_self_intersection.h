@@ -17,12 +17,15 @@ namespace exporter {
 // The pairs of triangles (indices, first < second) that intersect anywhere but in what they
 // share: two triangles with no common vertex that touch at all; two with one common vertex that
 // meet elsewhere too (an edge of one through the other). Two with a common edge are not tested
-// (they meet only along it unless they lie folded flat onto each other). Candidates come from
-// CGAL's box intersection of the triangles' bounding boxes, tests from CGAL's exact predicates.
+// (they meet only along it unless they lie folded flat onto each other). Candidates are the
+// pairs whose bounding boxes overlap in a cell of a uniform grid, tests come from CGAL's exact
+// predicates, run on up to `num_threads` threads (the answer is the same for any count).
 // Triangles with a repeated vertex are left out (AnalyseTopology counts them). Sorted. With
-// `check` (one flag per triangle), only the pairs with a flagged triangle.
+// `check` (one flag per triangle), only the pairs with a flagged triangle, found in the grid's
+// cells that flagged triangles touch.
 std::vector<std::pair<int, int>> FindSelfIntersections(const TriangleMesh& mesh,
-                                                       const std::vector<uint8_t>* check = nullptr);
+                                                       const std::vector<uint8_t>* check = nullptr,
+                                                       int num_threads = 1);
 
 // How UndoSelfIntersections went.
 struct SelfIntersectionRepair {
@@ -41,9 +44,13 @@ struct SelfIntersectionRepair {
 // then all the way, for at most 30 rounds.
 // Vertices of triangles that do not intersect stay where they are. When `safe` itself
 // intersects, what it shares with the mesh cannot be undone: pairs_after says so. Normals are
-// recomputed for the vertices moved.
+// recomputed for the vertices moved. With `moved` (a flag per vertex: those that moved since the
+// mesh last had no self-intersections), only pairs with a triangle that has a moved corner are
+// looked for, pairs_before included: the rest of the mesh is taken to be as clean as it was.
 SelfIntersectionRepair UndoSelfIntersections(const std::vector<Eigen::Vector3f>& safe,
-                                             TriangleMesh* mesh);
+                                             TriangleMesh* mesh,
+                                             const std::vector<uint8_t>* moved = nullptr,
+                                             int num_threads = 1);
 
 }  // namespace exporter
 }  // namespace raycarve

@@ -3,6 +3,7 @@
 #include "export/mesh_self_intersection.h"
 
 #include <algorithm>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -72,6 +73,39 @@ TEST(FindSelfIntersections, SharedCornersAndEdgesAreNotIntersectionsButACrossing
   EXPECT_EQ(pairs[0], std::make_pair(0, 3));
 }
 
+TEST(FindSelfIntersections, FlaggedTrianglesAndThreadsFindTheSamePairsAsTheWholeSearch) {
+  // Forty tetrahedra of sizes 0.3-1.5 scattered in a 6-unit cube: many overlap, many do not;
+  // the grid's cells then hold triangles of different tetrahedra.
+  TriangleMesh mesh;
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> place(0.0f, 6.0f), size(0.3f, 1.5f);
+  for (int k = 0; k < 40; ++k) {
+    const int base = static_cast<int>(mesh.vertices.size());
+    AddTetrahedron(Eigen::Vector3f(place(random), place(random), place(random)), &mesh);
+    const float scale = size(random);
+    for (int v = base + 1; v < base + 4; ++v) {
+      mesh.vertices[v] = mesh.vertices[base] + scale * (mesh.vertices[v] - mesh.vertices[base]);
+    }
+  }
+  const std::vector<std::pair<int, int>> all = FindSelfIntersections(mesh);
+  ASSERT_GT(all.size(), 20u);
+  EXPECT_EQ(FindSelfIntersections(mesh, nullptr, 2), all);
+  EXPECT_EQ(FindSelfIntersections(mesh, nullptr, 3), all);
+  // Flag every fifth triangle: exactly the pairs with a flagged member.
+  std::vector<uint8_t> check(mesh.triangles.size(), 0);
+  for (size_t t = 0; t < check.size(); t += 5) check[t] = 1;
+  std::vector<std::pair<int, int>> flagged;
+  for (const auto& [a, b] : all) {
+    if (check[a] || check[b]) flagged.emplace_back(a, b);
+  }
+  ASSERT_FALSE(flagged.empty());
+  ASSERT_LT(flagged.size(), all.size());
+  EXPECT_EQ(FindSelfIntersections(mesh, &check), flagged);
+  EXPECT_EQ(FindSelfIntersections(mesh, &check, 2), flagged);
+  const std::vector<uint8_t> none(mesh.triangles.size(), 0);
+  EXPECT_TRUE(FindSelfIntersections(mesh, &none).empty());
+}
+
 TEST(UndoSelfIntersections, WhatWasPushedThroughGoesBackAndTheRestStays) {
   // Safe: three tetrahedra apart. Folded: the second pushed into the first; the third untouched.
   TriangleMesh safe;
@@ -106,6 +140,21 @@ TEST(UndoSelfIntersections, WhatWasPushedThroughGoesBackAndTheRestStays) {
         << v;
   }
   EXPECT_NE(repair.Summary().find("0 pairs left"), std::string::npos) << repair.Summary();
+
+  // Told which vertices moved (the second tetrahedron's), the repair looks only at their
+  // triangles and does the same.
+  TriangleMesh folded_again = safe;
+  std::vector<uint8_t> moved(safe.vertices.size(), 0);
+  for (int v = 4; v < 8; ++v) {
+    folded_again.vertices[v] -= Eigen::Vector3f(1.8f, -0.2f, -0.2f);
+    moved[v] = 1;
+  }
+  const SelfIntersectionRepair told =
+      UndoSelfIntersections(safe.vertices, &folded_again, &moved, 2);
+  EXPECT_EQ(told.pairs_before, repair.pairs_before);
+  EXPECT_EQ(told.rounds, repair.rounds);
+  EXPECT_EQ(told.vertices_moved_back, repair.vertices_moved_back);
+  EXPECT_EQ(folded_again.vertices, folded.vertices);
 
   // A mesh without intersections is left exactly as it is.
   TriangleMesh clean = safe;

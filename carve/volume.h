@@ -41,6 +41,8 @@ class Volume {
 
   // The solid bits, a bit per voxel in index order.
   const std::vector<uint64_t>& solid_bits() const { return solid_; }
+  // The surface bits, likewise.
+  const std::vector<uint64_t>& surface_bits() const { return surface_; }
 
   size_t MemoryBytes() const { return (solid_.size() + surface_.size()) * sizeof(uint64_t); }
 

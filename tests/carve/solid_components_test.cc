@@ -3,6 +3,8 @@
 #include "carve/carver.h"
 #include "carve/incremental_carver.h"
 
+#include <algorithm>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -85,6 +87,64 @@ TEST_F(SolidComponents, SmallComponentsAreCarvedAndTheirRaysStepOn) {
   while (carver.Step()) {
   }
   EXPECT_GT(carver.evaluated(), 0);
+}
+
+// Random solid voxels (9% of a 24-voxel grid, near where 26-neighbour clusters join up: lone
+// voxels, clumps touching along edges and corners, some large): the components that
+// RemoveSmallComponents finds are those of a plain breadth-first search over the 26 neighbours,
+// for every size bound.
+TEST_F(SolidComponents, ComponentsAreThoseOfABreadthFirstSearch) {
+  const VoxelGrid& grid = grid_;
+  std::mt19937 random(11);
+  std::bernoulli_distribution solid(0.09);
+  std::vector<uint8_t> is_solid(grid.num_voxels(), 0);
+  for (int64_t i = 0; i < grid.num_voxels(); ++i) {
+    if (!solid(random)) continue;
+    is_solid[i] = 1;
+    const Eigen::Vector3i voxel = grid.Voxel(i);
+    Set(voxel.x(), voxel.y(), voxel.z());
+  }
+  // The reference: component sizes by breadth-first search.
+  std::vector<int> label(grid.num_voxels(), -1);
+  std::vector<int64_t> sizes;
+  for (int64_t start = 0; start < grid.num_voxels(); ++start) {
+    if (!is_solid[start] || label[start] >= 0) continue;
+    const int id = static_cast<int>(sizes.size());
+    std::vector<int64_t> queue{start};
+    label[start] = id;
+    for (size_t k = 0; k < queue.size(); ++k) {
+      const Eigen::Vector3i voxel = grid.Voxel(queue[k]);
+      for (int dz = -1; dz <= 1; ++dz) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Eigen::Vector3i next = voxel + Eigen::Vector3i(dx, dy, dz);
+            if (!grid.Contains(next)) continue;
+            const int64_t index = grid.Index(next);
+            if (is_solid[index] && label[index] < 0) {
+              label[index] = id;
+              queue.push_back(index);
+            }
+          }
+        }
+      }
+    }
+    sizes.push_back(static_cast<int64_t>(queue.size()));
+  }
+  ASSERT_GT(std::count(sizes.begin(), sizes.end(), 1), 10);
+  ASSERT_GT(std::count_if(sizes.begin(), sizes.end(), [](int64_t size) { return size >= 3; }), 10);
+  ASSERT_GE(*std::max_element(sizes.begin(), sizes.end()), 20);
+  const Volume volume = TakeVolume();
+  // Bounds in increasing order, each on a fresh carver over the same volume.
+  for (const int64_t bound : {int64_t{2}, int64_t{3}, int64_t{5}, int64_t{20}, int64_t{1} << 40}) {
+    int64_t expected = 0;
+    for (const int64_t size : sizes) expected += size < bound ? size : 0;
+    IncrementalCarver carver(views_, Volume(volume), Options(24, 30.0));
+    EXPECT_EQ(carver.RemoveSmallComponents(bound), expected) << bound;
+    for (int64_t i = 0; i < grid.num_voxels(); ++i) {
+      const bool kept = is_solid[i] && sizes[label[i]] >= bound;
+      ASSERT_EQ(carver.volume().IsSolid(i), kept) << bound << " " << i;
+    }
+  }
 }
 
 // Pieces without sparse points: a slab with points on its top, two 3x3x3 cubes above it (one

@@ -48,7 +48,8 @@ class IncrementalCarver {
   // Carves every 26-connected component of solid voxels smaller than `min_voxels`: specks left in
   // empty space because their pixels agree by chance. Each voxel is carved as Step carves one
   // (the rays that ended in it step on and the voxels they reach are queued), so Step carries on
-  // from there. Returns the voxels carved. Cost: one pass over the solid voxels.
+  // from there. Returns the voxels carved. Cost: one pass over the runs of solid voxels along x
+  // (their rows' bits), then the voxels of the components carved.
   int64_t RemoveSmallComponents(int64_t min_voxels);
 
   // Carves every 26-connected component that no point of `points` lies in or beside (within one
@@ -57,7 +58,7 @@ class IncrementalCarver {
   // surface voxels are fewer than a quarter of the largest component's. Carved as
   // RemoveSmallComponents carves. Returns the voxels carved; `components` and `largest_expected`
   // (may be null) get how many components went and the most points one of them was expected to
-  // hold. Cost: one pass over the solid voxels.
+  // hold. Cost: as RemoveSmallComponents'.
   int64_t RemoveUnsupportedComponents(const std::vector<SurfacePoint>& points,
                                       double min_expected,
                                       int64_t* components,

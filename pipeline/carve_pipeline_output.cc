@@ -3,7 +3,9 @@
 // names, the masks used, convergence.csv, report.html and report.json), moved into place together.
 #include "pipeline/carve_pipeline.h"
 
+#include <chrono>
 #include <filesystem>
+#include <future>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -41,7 +43,13 @@ void CarvePipeline::SampleCloud() {
     // only read the mesh. (The future waits for its thread however the pipeline is left; the
     // mesh's own failure is thrown by get() in WriteOutputs.)
     const fs::path out(staged_->path());
+    // The files of a fine grid's mesh take minutes: said as they start and end.
+    LOG(INFO) << "writing the mesh (" << model_.mesh.triangles.size()
+              << " triangles: its check, mesh.ply, mesh.glb"
+              << (model_.mesh.texture.empty() ? "" : ", mesh.obj with its atlas")
+              << ", preview.png) and sampling the cloud from it ...";
     auto mesh_file = [this, out] {
+      const Clock::time_point file_start = Clock::now();
       // The undo left no pair, and since then only triangles were removed (the box's walls):
       // no new pair can have appeared, and the search (about half a second on 100k triangles)
       // need not run again.
@@ -56,6 +64,7 @@ void CarvePipeline::SampleCloud() {
         cv::cvtColor(preview, preview, cv::COLOR_RGB2BGR);
         WriteImageAtomically((out / "preview.png").string(), preview);
       }
+      LOG(INFO) << "mesh files written in " << SecondsSince(file_start) << " s";
     };
     if (ResolveNumThreads(request_.options.num_threads) > 1) {
       mesh_written_ = std::async(std::launch::async, mesh_file);
@@ -84,6 +93,8 @@ void CarvePipeline::SampleCloud() {
   }
   run_.num_cloud_points = points_.size();
   export_seconds_ += SecondsSince(start);
+  LOG(INFO) << "cloud: " << points_.size() << " points sampled from the mesh in "
+            << SecondsSince(start) << " s";
 }
 
 void CarvePipeline::MeasureCloud() {
@@ -182,10 +193,15 @@ void CarvePipeline::WriteOutputs() {
       run_.num_mesh_vertices = mesh.num_vertices;
     } else {
       exporter::WritePointVisibility(visibility_, (out / "cloud.ply.vis").string());
+      if (mesh_written_.valid() &&
+          mesh_written_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+        LOG(INFO) << "cloud.ply written; waiting for the mesh files ...";
+      }
       if (mesh_written_.valid()) mesh_written_.get();
       WriteDenseWorkspace(out);
     }
     RecordSeconds("export", export_seconds_ + SecondsSince(start));
+    LOG(INFO) << "outputs written in " << export_seconds_ + SecondsSince(start) << " s";
     WriteMasks(out);
     std::ostringstream csv;
     csv << "seconds,carved,evaluated\n";

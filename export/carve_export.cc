@@ -238,15 +238,19 @@ std::vector<Eigen::Vector3f> IsoSurfaceOf(const std::vector<Eigen::Vector3f>& is
                                           const TriangleMesh& mesh) {
   std::vector<Eigen::Vector3f> unrefined = mesh.vertices;
   if (iso_surface.size() != meshed.size() || iso_surface.empty()) return unrefined;
-  std::map<std::array<float, 3>, Eigen::Vector3f> iso_surface_at;
-  for (size_t v = 0; v < iso_surface.size(); ++v) {
-    const Eigen::Vector3f& p = meshed[v];
-    iso_surface_at.emplace(std::array<float, 3>{p.x(), p.y(), p.z()}, iso_surface[v]);
+  // Sorted by position, then index: of equal positions the first vertex answers. (A sorted array,
+  // not a tree: at 1024 voxels, six million vertices.)
+  using Key = std::pair<std::array<float, 3>, int>;
+  std::vector<Key> at(meshed.size());
+  for (size_t v = 0; v < meshed.size(); ++v) {
+    at[v] = {{meshed[v].x(), meshed[v].y(), meshed[v].z()}, static_cast<int>(v)};
   }
+  std::sort(at.begin(), at.end());
   for (Eigen::Vector3f& p : unrefined) {
-    const auto found = iso_surface_at.find({p.x(), p.y(), p.z()});
-    if (found == iso_surface_at.end()) return mesh.vertices;
-    p = found->second;
+    const std::array<float, 3> position{p.x(), p.y(), p.z()};
+    const auto found = std::lower_bound(at.begin(), at.end(), Key{position, -1});
+    if (found == at.end() || found->first != position) return mesh.vertices;
+    p = iso_surface[found->second];
   }
   return unrefined;
 }
@@ -402,8 +406,13 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
     if (model.silhouettes.passes > 0) Tell(options, model.silhouettes.Summary());
   }
   const int threads = options.num_threads > 0 ? options.num_threads : ResolveNumThreads(-1);
+  UndoOptions undo;
+  undo.num_threads = threads;
+  undo.progress = [&options](const std::string& line) {
+    Tell(options, "mesh self-intersections: " + line);
+  };
   if (options.undo_self_intersections) {
-    model.self_intersections = UndoSelfIntersections(unrefined, &model.mesh, nullptr, threads);
+    model.self_intersections = UndoSelfIntersections(unrefined, &model.mesh, undo);
     Tell(options, "mesh self-intersections: " + model.self_intersections.Summary());
   }
   if (!options.support.empty()) {
@@ -417,9 +426,11 @@ ModelMesh MeshCarvedModel(const CarveResult& result,
       for (size_t v = 0; v < before.size(); ++v) {
         levelled[v] = model.mesh.vertices[v] != before[v] ? 1 : 0;
       }
-      const SelfIntersectionRepair undone = UndoSelfIntersections(
-          before, &model.mesh, model.self_intersections.pairs_after == 0 ? &levelled : nullptr,
-          options.num_threads);
+      undo.moved = model.self_intersections.pairs_after == 0 ? &levelled : nullptr;
+      undo.progress = [&options](const std::string& line) {
+        Tell(options, "mesh levelling: " + line);
+      };
+      const SelfIntersectionRepair undone = UndoSelfIntersections(before, &model.mesh, undo);
       model.levelling.undone = undone.vertices_moved_back;
       model.self_intersections.pairs_after = undone.pairs_after;
     }

@@ -24,6 +24,10 @@ using Triangle = Kernel::Triangle_3;
 
 Point ToPoint(const Eigen::Vector3f& p) { return Point(p.x(), p.y(), p.z()); }
 
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 bool Degenerate(const Eigen::Vector3i& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
 
 // A triangle's corners in double (exact from float) and its plane's normal.
@@ -339,8 +343,9 @@ std::string SelfIntersectionRepair::Summary() const {
 
 SelfIntersectionRepair UndoSelfIntersections(const std::vector<Eigen::Vector3f>& safe,
                                              TriangleMesh* mesh,
-                                             const std::vector<uint8_t>* moved,
-                                             int num_threads) {
+                                             const UndoOptions& options) {
+  const std::vector<uint8_t>* moved = options.moved;
+  const int num_threads = options.num_threads;
   const auto start = std::chrono::steady_clock::now();
   SelfIntersectionRepair repair;
   // Small steps back keep most of what the refinement found (an eighth of the way in the first
@@ -364,6 +369,8 @@ SelfIntersectionRepair UndoSelfIntersections(const std::vector<Eigen::Vector3f>&
   std::vector<std::pair<int, int>> pairs =
       grid.Find(moved != nullptr ? &moved_triangles : nullptr, num_threads);
   repair.pairs_before = static_cast<int64_t>(pairs.size());
+  constexpr double kTellEverySeconds = 5.0;
+  double last_told = 0.0;
   if (!pairs.empty() && can_undo) {
     std::vector<uint8_t> ever_moved(mesh->vertices.size(), 0);
     while (!pairs.empty() && repair.rounds < kMaxRounds) {
@@ -392,6 +399,16 @@ SelfIntersectionRepair UndoSelfIntersections(const std::vector<Eigen::Vector3f>&
         moved_triangles[t] = involved[triangle[0]] | involved[triangle[1]] | involved[triangle[2]];
       }
       pairs = grid.Find(&moved_triangles, num_threads);
+      const double seconds = SecondsSince(start);
+      if (options.progress && seconds >= last_told + kTellEverySeconds) {
+        std::ostringstream line;
+        line.precision(3);
+        line << repair.pairs_before << " pairs of triangles folded through each other: "
+             << pairs.size() << " left after " << repair.rounds << " rounds of moving their "
+             << "vertices back, " << seconds << " s ...";
+        options.progress(line.str());
+        last_told = seconds;
+      }
     }
     repair.vertices_moved_back = std::count(ever_moved.begin(), ever_moved.end(), 1);
     if (repair.vertices_moved_back > 0) {
@@ -405,8 +422,7 @@ SelfIntersectionRepair UndoSelfIntersections(const std::vector<Eigen::Vector3f>&
     }
   }
   repair.pairs_after = static_cast<int64_t>(pairs.size());
-  repair.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  repair.seconds = SecondsSince(start);
   return repair;
 }
 

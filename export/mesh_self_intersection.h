@@ -3,6 +3,7 @@
 // inside the .cc file.
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -37,20 +38,29 @@ struct SelfIntersectionRepair {
   std::string Summary() const;
 };
 
+// How UndoSelfIntersections works.
+struct UndoOptions {
+  // A flag per vertex: those that moved since the mesh last had no self-intersections. Only pairs
+  // with a triangle that has a moved corner are then looked for, pairs_before included: the rest
+  // of the mesh is taken to be as clean as it was. Null: the whole mesh is searched.
+  const std::vector<uint8_t>* moved = nullptr;
+  int num_threads = 1;  // the answer is the same for any count
+  // Told a line (pairs left, rounds, seconds) when a round ends 5 seconds or more after the
+  // undo began or the last line; unset: nothing told.
+  std::function<void(const std::string&)> progress;
+};
+
 // Undoes the moves that made `mesh` fold through itself: while triangles intersect, the vertices
 // of every intersecting triangle and their neighbours move back towards their positions in
 // `safe` (the same vertices and triangles at an earlier stage, without self-intersections, such
-// as the iso-surface before it was smoothed and refined), halfway in the first three rounds and
-// then all the way, for at most 30 rounds.
+// as the iso-surface before it was smoothed and refined), an eighth of the way in the first
+// rounds, then a quarter, then half, then all the way, for at most 50 rounds.
 // Vertices of triangles that do not intersect stay where they are. When `safe` itself
 // intersects, what it shares with the mesh cannot be undone: pairs_after says so. Normals are
-// recomputed for the vertices moved. With `moved` (a flag per vertex: those that moved since the
-// mesh last had no self-intersections), only pairs with a triangle that has a moved corner are
-// looked for, pairs_before included: the rest of the mesh is taken to be as clean as it was.
+// recomputed for the vertices moved.
 SelfIntersectionRepair UndoSelfIntersections(const std::vector<Eigen::Vector3f>& safe,
                                              TriangleMesh* mesh,
-                                             const std::vector<uint8_t>* moved = nullptr,
-                                             int num_threads = 1);
+                                             const UndoOptions& options = {});
 
 }  // namespace exporter
 }  // namespace raycarve

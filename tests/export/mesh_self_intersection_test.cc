@@ -149,8 +149,10 @@ TEST(UndoSelfIntersections, WhatWasPushedThroughGoesBackAndTheRestStays) {
     folded_again.vertices[v] -= Eigen::Vector3f(1.8f, -0.2f, -0.2f);
     moved[v] = 1;
   }
-  const SelfIntersectionRepair told =
-      UndoSelfIntersections(safe.vertices, &folded_again, &moved, 2);
+  UndoOptions undo;
+  undo.moved = &moved;
+  undo.num_threads = 2;
+  const SelfIntersectionRepair told = UndoSelfIntersections(safe.vertices, &folded_again, undo);
   EXPECT_EQ(told.pairs_before, repair.pairs_before);
   EXPECT_EQ(told.rounds, repair.rounds);
   EXPECT_EQ(told.vertices_moved_back, repair.vertices_moved_back);

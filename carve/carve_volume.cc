@@ -414,6 +414,12 @@ CarveResult CarveLevels(const std::vector<CalibratedView>& views,
       start_volume = std::move(stages.start);
       level_options.interior_held = std::move(stages.start_held);
     } else if (level > 0) {
+      if (progress) {
+        CarveProgress setting_up{level, num_levels, statistics.evaluated, carver->carved(), 0,
+                                 SecondsSince(clock.start)};
+        setting_up.setting_up = true;
+        progress(setting_up);
+      }
       const VoxelGrid level_grid(box, resolutions[level]);
       start_volume = std::make_unique<Volume>(
           RefineVolume(carver->volume(), level_grid, options.lod_band));

@@ -247,6 +247,10 @@ struct CarveProgress {
   int64_t carved = 0;
   int64_t queued = 0;
   double seconds = 0.0;  // since carving started (after set-up)
+  // Told once as each level after the first starts its set-up (the start volume from the level
+  // before, the photos scaled, the rays cast to the first solid voxels: tens of seconds at 1024
+  // voxels); the counts are the levels' before it.
+  bool setting_up = false;
 };
 
 // One point of the carving curve (the paper's Figure 6).

@@ -40,6 +40,7 @@ std::vector<MethodRun> CarveEachMethod(const CarvePipeline& pipeline,
     options.method = method;
     LOG(INFO) << "benchmark: carving with " << CarveMethodToString(method);
     auto progress = [&](const CarveProgress& p) {
+      if (p.setting_up) return;
       LOG(INFO) << CarveMethodToString(method) << " " << p.seconds << " s: evaluated "
                 << p.evaluated << ", carved " << p.carved << ", queue " << p.queued;
     };

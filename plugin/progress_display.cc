@@ -20,6 +20,19 @@ void ProgressDisplay::Update(const CarveProgress& p) {
   const std::string level = p.levels > 1 ? "level " + std::to_string(p.level + 1) + "/" +
                                                std::to_string(p.levels) + " "
                                          : std::string();
+  if (p.setting_up) {
+    if (terminal_) {
+      std::fprintf(stderr, "\r%s %ssetting up (the rays from the photos) ...%24s", label_.c_str(),
+                   level.c_str(), "");
+      std::fflush(stderr);
+      drawn_ = true;
+      return;
+    }
+    LOG(INFO) << label_ << " " << level << std::fixed << std::setprecision(1) << p.seconds
+              << " s: setting up (the start volume from the level before, the photos scaled, "
+              << "the rays cast) ...";
+    return;
+  }
   if (terminal_) {
     const int width = 30, filled = static_cast<int>(std::lround(share * width));
     std::fprintf(stderr, "\r%s %s[%s%s] %3.0f%%  %.1f s, about %.1f s left  ", label_.c_str(),

@@ -30,6 +30,17 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 bool Degenerate(const Eigen::Vector3i& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
 
+// A flag per triangle: whether any of its corners is flagged in `vertices`.
+std::vector<uint8_t> TrianglesWithFlaggedCorner(const TriangleMesh& mesh,
+                                                const std::vector<uint8_t>& vertices) {
+  std::vector<uint8_t> triangles(mesh.triangles.size());
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Eigen::Vector3i& triangle = mesh.triangles[t];
+    triangles[t] = vertices[triangle[0]] | vertices[triangle[1]] | vertices[triangle[2]];
+  }
+  return triangles;
+}
+
 // A triangle's corners in double (exact from float) and its plane's normal.
 struct Corners {
   Eigen::Vector3d p[3];
@@ -203,9 +214,10 @@ class TriangleGrid {
         std::vector<std::pair<int, int>> found;
         for (size_t c = first; c < last; ++c) {
           for (uint32_t i = starts_[c]; i < starts_[c + 1]; ++i) {
+            const int a = members_[i];
+            const Box now_a = Current(a);
             for (uint32_t j = i + 1; j < starts_[c + 1]; ++j) {
-              const int a = members_[i];
-              Test(a, Current(a), members_[j], static_cast<int64_t>(c), &found);
+              Test(a, now_a, members_[j], static_cast<int64_t>(c), &found);
             }
           }
         }
@@ -357,11 +369,7 @@ SelfIntersectionRepair UndoSelfIntersections(const std::vector<Eigen::Vector3f>&
   std::vector<uint8_t> moved_triangles;
   if (moved != nullptr) {
     CHECK_EQ(moved->size(), mesh->vertices.size());
-    moved_triangles.resize(mesh->triangles.size());
-    for (size_t t = 0; t < mesh->triangles.size(); ++t) {
-      const Eigen::Vector3i& triangle = mesh->triangles[t];
-      moved_triangles[t] = (*moved)[triangle[0]] | (*moved)[triangle[1]] | (*moved)[triangle[2]];
-    }
+    moved_triangles = TrianglesWithFlaggedCorner(*mesh, *moved);
   }
   // Vertices only move towards `safe`: one grid serves every round.
   const bool can_undo = safe.size() == mesh->vertices.size();
@@ -393,11 +401,7 @@ SelfIntersectionRepair UndoSelfIntersections(const std::vector<Eigen::Vector3f>&
       }
       ++repair.rounds;
       // Only triangles that moved can meet anew, and every pair found had its corners moved.
-      moved_triangles.assign(mesh->triangles.size(), 0);
-      for (size_t t = 0; t < mesh->triangles.size(); ++t) {
-        const Eigen::Vector3i& triangle = mesh->triangles[t];
-        moved_triangles[t] = involved[triangle[0]] | involved[triangle[1]] | involved[triangle[2]];
-      }
+      moved_triangles = TrianglesWithFlaggedCorner(*mesh, involved);
       pairs = grid.Find(&moved_triangles, num_threads);
       const double seconds = SecondsSince(start);
       if (options.progress && seconds >= last_told + kTellEverySeconds) {
